@@ -2,6 +2,8 @@
 // DDS name (e.g. `iplan topic echo` on a discovered topic).
 #pragma once
 
+#include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -16,6 +18,8 @@ struct TypeEntry {
   void (*destroy)(void*);
   nlohmann::json (*to_json)(const void*);
   void (*from_json)(const nlohmann::json&, void*);  ///< throws std::invalid_argument
+  void (*randomize)(void*, uint64_t seed);          ///< FillRandom with a seeded generator
+  std::optional<std::string> (*first_difference)(const void*, const void*);
 };
 
 /// Every generated type. Thread-safe.
