@@ -12,7 +12,7 @@
 #include "iplan/dds/participant.h"
 #include "iplan/framework/node.h"
 #include "iplan/framework/topics.h"
-#include "process.h"
+#include "test_paths.h"
 
 namespace iplan::testing {
 namespace {

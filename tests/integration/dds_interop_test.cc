@@ -2,7 +2,7 @@
 // four vendor pairings (Fast DDS and Cyclone DDS, writer and reader).
 #include <gtest/gtest.h>
 
-#include "process.h"
+#include "test_paths.h"
 
 namespace iplan::testing {
 namespace {

@@ -1,5 +1,6 @@
-// Child processes for multi-process tests: real executables, started with
-// their own arguments and environment, output captured to files.
+// Child processes: real executables started with their own arguments and
+// environment, output captured to files (used by `iplan demo` and by the
+// multi-process tests).
 #pragma once
 
 #include <sys/types.h>
@@ -10,13 +11,15 @@
 #include <string>
 #include <vector>
 
-namespace iplan::testing {
+namespace iplan::core {
 
 class Process {
  public:
   /// Starts `argv[0]` (a path) with `argv`, the current environment plus
-  /// `env`, stdout and stderr to files under $TMPDIR. Throws on failure.
-  Process(std::vector<std::string> argv, std::map<std::string, std::string> env = {});
+  /// `env`. stdout and stderr go to files under $TMPDIR, or are inherited
+  /// when `inherit_output`. Throws std::runtime_error on failure.
+  Process(std::vector<std::string> argv, std::map<std::string, std::string> env = {},
+          bool inherit_output = false);
   ~Process();  // SIGKILL if still running
   Process(const Process&) = delete;
   Process& operator=(const Process&) = delete;
@@ -39,12 +42,7 @@ class Process {
   std::string out_path_, err_path_;
 };
 
-/// build/bin/<name>.
-std::string BinPath(const std::string& name);
-/// build/tests/<name>.
-std::string TestBinPath(const std::string& name);
-/// A DDS domain id unique to this test process (from the pid), so tests can
-/// run in parallel without hearing each other.
-int UniqueDomain(int offset = 0);
+/// The folder of the running executable (from /proc/self/exe).
+std::string ExecutableDir();
 
-}  // namespace iplan::testing
+}  // namespace iplan::core

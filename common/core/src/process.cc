@@ -1,4 +1,4 @@
-#include "process.h"
+#include "iplan/core/process.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -15,7 +15,7 @@
 
 extern char** environ;
 
-namespace iplan::testing {
+namespace iplan::core {
 namespace {
 
 std::string ReadFile(const std::string& path) {
@@ -27,7 +27,7 @@ std::string ReadFile(const std::string& path) {
 
 }  // namespace
 
-Process::Process(std::vector<std::string> argv, std::map<std::string, std::string> env) {
+Process::Process(std::vector<std::string> argv, std::map<std::string, std::string> env, bool inherit_output) {
   static int counter = 0;
   const char* tmp = std::getenv("TMPDIR");
   const std::string base = std::string(tmp && *tmp ? tmp : "/tmp") + "/iplan-test-" +
@@ -52,8 +52,10 @@ Process::Process(std::vector<std::string> argv, std::map<std::string, std::strin
   posix_spawn_file_actions_t fa;
   posix_spawn_file_actions_init(&fa);
   posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  posix_spawn_file_actions_addopen(&fa, 1, out_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-  posix_spawn_file_actions_addopen(&fa, 2, err_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  if (!inherit_output) {
+    posix_spawn_file_actions_addopen(&fa, 1, out_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    posix_spawn_file_actions_addopen(&fa, 2, err_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  }
   const int rc = posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), envp.data());
   posix_spawn_file_actions_destroy(&fa);
   if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
@@ -101,12 +103,12 @@ bool Process::WaitForOutput(const std::string& text, std::chrono::milliseconds t
   }
 }
 
-std::string BinPath(const std::string& name) { return std::string(IPLAN_BIN_DIR) + "/" + name; }
-
-std::string TestBinPath(const std::string& name) {
-  return std::string(IPLAN_BIN_DIR) + "/../tests/" + name;
+std::string ExecutableDir() {
+  char buf[4096];
+  const ssize_t n = readlink("/proc/self/exe", buf, sizeof(buf) - 1);
+  if (n <= 0) return ".";
+  std::string path(buf, static_cast<std::size_t>(n));
+  return path.substr(0, path.rfind('/'));
 }
 
-int UniqueDomain(int offset) { return 1 + static_cast<int>((getpid() * 7 + offset) % 200); }
-
-}  // namespace iplan::testing
+}  // namespace iplan::core
