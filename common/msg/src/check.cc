@@ -13,25 +13,31 @@ std::string Num(double x) {
   return buf;
 }
 
-std::optional<std::string> CheckCovariance(const std::array<double, 9>& c, const std::string& path) {
+// `path` is only called when there is something to report.
+template <class PathFn>
+std::optional<std::string> CheckCovariance(const std::array<double, 9>& c, PathFn path) {
   for (int i = 0; i < 3; ++i) {
-    if (c[i * 3 + i] < 0) return path + ": negative variance " + Num(c[i * 3 + i]);
+    if (c[i * 3 + i] < 0) return path() + ": negative variance " + Num(c[i * 3 + i]);
     for (int j = i + 1; j < 3; ++j) {
       const double a = c[i * 3 + j], b = c[j * 3 + i];
       if (std::abs(a - b) > 1e-9 * (1 + std::abs(a) + std::abs(b))) {
-        return path + ": not symmetric (" + Num(a) + " vs " + Num(b) + ")";
+        return path() + ": not symmetric (" + Num(a) + " vs " + Num(b) + ")";
       }
       if (a * a > c[i * 3 + i] * c[j * 3 + j] * (1 + 1e-9) + 1e-300) {
-        return path + ": not positive semi-definite";
+        return path() + ": not positive semi-definite";
       }
     }
   }
   return std::nullopt;
 }
 
-std::optional<std::string> CheckUnit(double x, const std::string& what) {
-  if (x < 0 || x > 1) return what + " " + Num(x) + " outside [0, 1]";
+template <class NameFn>
+std::optional<std::string> CheckUnit(double x, NameFn what) {
+  if (x < 0 || x > 1) return what() + " " + Num(x) + " outside [0, 1]";
   return std::nullopt;
+}
+std::optional<std::string> CheckUnit(double x, const char* what) {
+  return CheckUnit(x, [what] { return std::string(what); });
 }
 
 }  // namespace
@@ -45,14 +51,15 @@ std::optional<std::string> CheckSemantics(const HumanSkeleton& m) {
   if (auto e = CheckSemantics(m.header)) return e;
   if (m.joints.empty()) return std::string("skeleton has no joints");
   if (auto e = CheckUnit(m.confidence, "confidence")) return e;
-  std::set<std::string> names;
   for (std::size_t i = 0; i < m.joints.size(); ++i) {
     const auto& j = m.joints[i];
-    const std::string path = "joints[" + std::to_string(i) + "]";
-    if (j.name.empty()) return path + ": empty joint name";
-    if (!names.insert(j.name).second) return path + ": joint '" + j.name + "' appears twice";
-    if (auto e = CheckUnit(j.confidence, path + ".confidence")) return e;
-    if (auto e = CheckCovariance(j.covariance, path + ".covariance")) return e;
+    auto path = [i] { return "joints[" + std::to_string(i) + "]"; };
+    if (j.name.empty()) return path() + ": empty joint name";
+    for (std::size_t k = 0; k < i; ++k) {
+      if (m.joints[k].name == j.name) return path() + ": joint '" + j.name + "' appears twice";
+    }
+    if (auto e = CheckUnit(j.confidence, [&] { return path() + ".confidence"; })) return e;
+    if (auto e = CheckCovariance(j.covariance, [&] { return path() + ".covariance"; })) return e;
   }
   return std::nullopt;
 }
@@ -65,7 +72,7 @@ std::optional<std::string> CheckSemantics(const ActionBelief& m) {
   }
   double sum = 0;
   for (std::size_t i = 0; i < m.probabilities.size(); ++i) {
-    if (auto e = CheckUnit(m.probabilities[i], "probabilities[" + std::to_string(i) + "]")) return e;
+    if (auto e = CheckUnit(m.probabilities[i], [i] { return "probabilities[" + std::to_string(i) + "]"; })) return e;
     sum += m.probabilities[i];
   }
   if (!m.actions.empty() && std::abs(sum - 1) > 1e-3) return "probabilities sum to " + Num(sum);
@@ -79,17 +86,18 @@ std::optional<std::string> CheckSemantics(const HumanPrediction& m) {
   double sum = 0;
   for (std::size_t a = 0; a < m.actions.size(); ++a) {
     const auto& act = m.actions[a];
-    const std::string path = "actions[" + std::to_string(a) + "]";
-    if (auto e = CheckUnit(act.probability, path + ".probability")) return e;
+    auto path = [a] { return "actions[" + std::to_string(a) + "]"; };
+    if (auto e = CheckUnit(act.probability, [&] { return path() + ".probability"; })) return e;
     sum += act.probability;
     if (act.joints.size() != expected) {
-      return path + ".joints has " + std::to_string(act.joints.size()) + " entries, expected " +
+      return path() + ".joints has " + std::to_string(act.joints.size()) + " entries, expected " +
              std::to_string(m.num_steps) + " steps x " + std::to_string(m.joint_names.size()) +
              " joints = " + std::to_string(expected);
     }
     for (std::size_t k = 0; k < act.joints.size(); ++k) {
-      if (auto e = CheckCovariance(act.joints[k].covariance,
-                                   path + ".joints[" + std::to_string(k) + "].covariance")) {
+      if (auto e = CheckCovariance(act.joints[k].covariance, [&] {
+            return path() + ".joints[" + std::to_string(k) + "].covariance";
+          })) {
         return e;
       }
     }
@@ -114,17 +122,17 @@ std::optional<std::string> CheckSemantics(const JointTrajectory& m) {
   double last = -1;
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const auto& p = m.points[i];
-    const std::string path = "points[" + std::to_string(i) + "]";
+    auto path = [i] { return "points[" + std::to_string(i) + "]"; };
     if (p.positions.size() != n) {
-      return path + ".positions has " + std::to_string(p.positions.size()) + " entries for " +
+      return path() + ".positions has " + std::to_string(p.positions.size()) + " entries for " +
              std::to_string(n) + " joints";
     }
-    if (!p.velocities.empty() && p.velocities.size() != n) return path + ".velocities has the wrong size";
-    if (!p.accelerations.empty() && p.accelerations.size() != n) return path + ".accelerations has the wrong size";
-    if (!p.effort.empty() && p.effort.size() != n) return path + ".effort has the wrong size";
-    if (p.time_from_start.nanosec >= 1000000000u) return path + ".time_from_start.nanosec >= 1e9";
+    if (!p.velocities.empty() && p.velocities.size() != n) return path() + ".velocities has the wrong size";
+    if (!p.accelerations.empty() && p.accelerations.size() != n) return path() + ".accelerations has the wrong size";
+    if (!p.effort.empty() && p.effort.size() != n) return path() + ".effort has the wrong size";
+    if (p.time_from_start.nanosec >= 1000000000u) return path() + ".time_from_start.nanosec >= 1e9";
     const double t = p.time_from_start.sec + p.time_from_start.nanosec * 1e-9;
-    if (t <= last) return path + ".time_from_start does not increase";
+    if (t <= last) return path() + ".time_from_start does not increase";
     last = t;
   }
   return std::nullopt;
@@ -164,7 +172,7 @@ std::optional<std::string> CheckSemantics(const CollisionRisk& m) {
   if (auto e = CheckSemantics(m.header)) return e;
   if (m.verdict > CollisionRisk::PROTECTIVE_STOP) return "verdict " + std::to_string(m.verdict) + " unknown";
   for (std::size_t i = 0; i < m.waypoint_bounds.size(); ++i) {
-    if (auto e = CheckUnit(m.waypoint_bounds[i], "waypoint_bounds[" + std::to_string(i) + "]")) return e;
+    if (auto e = CheckUnit(m.waypoint_bounds[i], [i] { return "waypoint_bounds[" + std::to_string(i) + "]"; })) return e;
   }
   if (!m.waypoint_bounds.empty() && m.max_waypoint >= m.waypoint_bounds.size()) return std::string("max_waypoint out of range");
   return std::nullopt;

@@ -77,6 +77,33 @@ void FindNonFiniteValue(const std::string& path, const T& v, std::optional<std::
   }
 }
 
+// Allocation-free scan: true when every floating-point field is finite.
+template <class T>
+bool AllFiniteValue(const T& v) {
+  if constexpr (kIsMessage<T>) {
+    bool ok = true;
+    FieldsOf<T>::Visit([&](const char*, const auto& f) { ok = ok && AllFiniteValue(f); }, v);
+    return ok;
+  } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
+    using E = typename T::value_type;
+    if constexpr (std::is_floating_point_v<E>) {
+      // Branch-free accumulation: NaN or inf makes x - x non-zero (NaN).
+      E acc = 0;
+      for (const E& x : v) acc += x - x;
+      return acc == 0;
+    } else if constexpr (kIsMessage<E>) {
+      for (const auto& e : v) {
+        if (!AllFiniteValue(e)) return false;
+      }
+    }
+    return true;
+  } else if constexpr (std::is_floating_point_v<T>) {
+    return std::isfinite(v);
+  } else {
+    return true;
+  }
+}
+
 template <class T, class Rng>
 void FillRandomValue(T& v, Rng& rng, int depth) {
   if constexpr (kIsMessage<T>) {
@@ -121,6 +148,7 @@ std::optional<std::string> FirstDifference(const T& a, const T& b) {
 template <class T>
 std::optional<std::string> FindNonFinite(const T& m) {
   static_assert(kIsMessage<T>, "FindNonFinite takes a message type");
+  if (internal::AllFiniteValue(m)) return std::nullopt;  // the common case allocates nothing
   std::optional<std::string> where;
   internal::FindNonFiniteValue(std::string(), m, &where);
   return where;
