@@ -61,7 +61,9 @@ std::vector<Eigen::Vector3d> ParseObjects(const std::string& text) {
 struct TrainOptions {
   std::string data, subjects, out, joints, torso, hands, objects;
   std::string sigma_factors, lambdas, prefixes;
-  double rate = 15.0, noise = 0.01, max_gap = 0.6;
+  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 1.0;
+  bool normalise_size = false;
+  double ivm_tolerance = 1e-3;
   int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80;
   int gp_iterations = 150, max_forecast_windows = 600, forecast_stride = 2;
   std::uint64_t seed = 1;
@@ -88,12 +90,15 @@ void RunTrain(const TrainOptions& o) {
   config.horizon = o.horizon;
   config.dtw_band = o.band;
   config.sensor_noise_std = o.noise;
+  config.features.torso_motion_weight = o.torso_weight;
+  config.features.normalise_body_size = o.normalise_size;
   TrainParams params;
   params.max_gap = o.max_gap;
   if (!o.sigma_factors.empty()) params.sigma_factors = ParseDoubles(o.sigma_factors, "--sigma-factors");
   if (!o.lambdas.empty()) params.lambdas = ParseDoubles(o.lambdas, "--lambdas");
   if (!o.prefixes.empty()) params.prefix_fractions = ParseDoubles(o.prefixes, "--prefixes");
   params.ivm.max_import = o.max_import;
+  params.ivm.stop_tolerance = o.ivm_tolerance;
   params.pseudo_inputs = o.pseudo_inputs;
   params.gp_iterations = o.gp_iterations;
   params.max_forecast_windows = o.max_forecast_windows;
@@ -182,6 +187,7 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--pseudo-inputs,-M", t.pseudo_inputs, "SPGP pseudo-inputs per action")->capture_default_str();
   train->add_option("--band", t.band, "DTW Sakoe-Chiba band, frames")->capture_default_str();
   train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
+  train->add_option("--ivm-tolerance", t.ivm_tolerance, "IVM stopping: relative decrease over 3 additions")->capture_default_str();
   train->add_option("--sigma-factors", t.sigma_factors, "CV kernel widths x median DTW (default 0.5,1,2)");
   train->add_option("--lambdas", t.lambdas, "CV regularisers (default 1e-4,1e-3,1e-2)");
   train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
@@ -190,6 +196,8 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--forecast-stride", t.forecast_stride, "Frames between forecaster windows")->capture_default_str();
   train->add_option("--noise", t.noise, "Sensor noise std added to covariances, m")->capture_default_str();
   train->add_option("--max-gap", t.max_gap, "Recording gaps longer than this split sequences, s")->capture_default_str();
+  train->add_option("--torso-weight", t.torso_weight, "Classifier weight of torso motion")->capture_default_str();
+  train->add_flag("--normalise-size", t.normalise_size, "Classifier features divided by shoulder width");
   train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
   train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
 

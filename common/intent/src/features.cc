@@ -78,13 +78,16 @@ JointConfig DefaultJointConfig(const std::vector<std::string>& available) {
   return c;
 }
 
-FeatureLayout::FeatureLayout(const JointConfig& config) {
+FeatureLayout::FeatureLayout(const JointConfig& config, const FrameFeatureOptions& options)
+    : options_(options) {
   const std::string error = config.Validate();
   if (!error.empty()) throw std::invalid_argument("JointConfig: " + error);
   num_joints_ = static_cast<int>(config.joints.size());
   for (const std::string& t : config.torso) torso_index_.push_back(IndexOf(config.joints, t));
   for (const std::string& h : config.hands) hand_index_.push_back(IndexOf(config.joints, h));
   objects_ = config.objects;
+  shoulder_l_ = IndexOf(config.joints, "shoulder_l");
+  shoulder_r_ = IndexOf(config.joints, "shoulder_r");
 }
 
 Eigen::Vector3d FeatureLayout::Torso(
@@ -99,12 +102,22 @@ Eigen::MatrixXd FeatureLayout::FrameFeatures(const Eigen::MatrixXd& window) cons
   const int J = num_joints_;
   Eigen::MatrixXd f(T, frame_feature_size());
   const Eigen::Vector3d torso_now = Torso(window.row(T - 1));
+  double scale = 1.0;
+  if (options_.normalise_body_size && shoulder_l_ >= 0 && shoulder_r_ >= 0) {
+    double width = 0.0;
+    for (int s = 0; s < T; ++s) {
+      width += (window.block<1, 3>(s, 3 * shoulder_l_) - window.block<1, 3>(s, 3 * shoulder_r_)).norm();
+    }
+    width /= T;
+    if (width > 1e-3) scale = 0.35 / width;
+  }
   for (int s = 0; s < T; ++s) {
     const Eigen::Vector3d torso = Torso(window.row(s));
     for (int j = 0; j < J; ++j) {
-      f.block<1, 3>(s, 3 * j) = window.block<1, 3>(s, 3 * j) - torso.transpose();
+      f.block<1, 3>(s, 3 * j) = scale * (window.block<1, 3>(s, 3 * j) - torso.transpose());
     }
-    f.block<1, 3>(s, 3 * J) = (torso - torso_now).transpose();
+    f.block<1, 3>(s, 3 * J) =
+        (options_.torso_motion_weight * scale) * (torso - torso_now).transpose();
     int c = 3 * J + 3;
     for (int h : hand_index_) {
       for (const Eigen::Vector3d& o : objects_) {

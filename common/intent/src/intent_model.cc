@@ -96,6 +96,7 @@ std::string IntentModelConfig::Validate() const {
   if (velocity_frames < 1) return "velocity_frames " + std::to_string(velocity_frames) + " must be >= 1";
   if (dtw_band < 0) return "dtw_band " + std::to_string(dtw_band) + " must be >= 0";
   if (!(sensor_noise_std >= 0.0)) return "sensor_noise_std must be >= 0";
+  if (!(features.torso_motion_weight >= 0.0)) return "features.torso_motion_weight must be >= 0";
   return "";
 }
 
@@ -154,7 +155,7 @@ IntentModel TrainIntentModel(const SkeletonDataset& data, const IntentModelConfi
   if (!error.empty()) throw std::invalid_argument("IntentModelConfig: " + error);
   error = params.Validate();
   if (!error.empty()) throw std::invalid_argument("TrainParams: " + error);
-  const FeatureLayout layout(config.joints);
+  const FeatureLayout layout(config.joints, config.features);
   const std::vector<Track> tracks = MakeTracks(data, config, params.max_gap);
 
   IntentModel model;
@@ -331,13 +332,13 @@ IntentModel TrainIntentModel(const SkeletonDataset& data, const IntentModelConfi
 }
 
 Eigen::VectorXd ClassifyWindow(const IntentModel& model, const Eigen::MatrixXd& window) {
-  const FeatureLayout layout(model.config.joints);
+  const FeatureLayout layout(model.config.joints, model.config.features);
   return ClassifyPadded(model, layout, NormaliseWindow(model, window));
 }
 
 void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
                    MixturePrediction* out) {
-  const FeatureLayout layout(model.config.joints);
+  const FeatureLayout layout(model.config.joints, model.config.features);
   const Eigen::MatrixXd padded = NormaliseWindow(model, window);
   const Eigen::VectorXd p = ClassifyPadded(model, layout, padded);
   const int C = static_cast<int>(model.actions.size());

@@ -27,11 +27,15 @@ void Softmax(const Eigen::MatrixXd& F, Eigen::MatrixXd* P) {
   }
 }
 
-// Negative eigenvalues of a symmetric matrix clipped to zero.
-Eigen::MatrixXd ClipToPsd(const Eigen::MatrixXd& A) {
-  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (A + A.transpose()));
-  const Eigen::VectorXd ev = es.eigenvalues().cwiseMax(0.0);
-  return es.eigenvectors() * ev.asDiagonal() * es.eigenvectors().transpose();
+// Diagonal shift that makes a symmetric matrix positive semi-definite: every
+// principal submatrix of K + shift I is then PSD too, so the penalty of a
+// growing import set stays consistent (the objective never increases when a
+// sample is added).
+double PsdShift(const Eigen::MatrixXd& K) {
+  Eigen::SelfAdjointEigenSolver<Eigen::MatrixXd> es(0.5 * (K + K.transpose()),
+                                                    Eigen::EigenvaluesOnly);
+  const double min_ev = es.eigenvalues().minCoeff();
+  return std::max(0.0, -min_ev) + 1e-10 * std::max(1.0, es.eigenvalues().maxCoeff());
 }
 
 struct Fitter {
@@ -126,6 +130,7 @@ IvmModel FitIvm(const Eigen::MatrixXd& K, const std::vector<int>& labels,
   std::vector<double> history{H};
   const Eigen::MatrixXd K2 = K.cwiseProduct(K);
   std::vector<char> in_set(N, 0);
+  const double shift = PsdShift(K);
 
   const int max_import = static_cast<int>(std::min<Eigen::Index>(params.max_import, N));
   while (static_cast<int>(S.size()) < max_import) {
@@ -143,7 +148,7 @@ IvmModel FitIvm(const Eigen::MatrixXd& K, const std::vector<int>& labels,
       for (int c = 0; c < C; ++c) {
         double g = G0(l, c);
         if (!S.empty()) g += params.lambda * cross(l, c);
-        const double h = Hd(l, c) + params.lambda * K(l, l) + 1e-12;
+        const double h = Hd(l, c) + params.lambda * (K(l, l) + shift) + 1e-12;
         score += g * g / (2.0 * h);
       }
       if (score > best_score) {
@@ -161,7 +166,8 @@ IvmModel FitIvm(const Eigen::MatrixXd& K, const std::vector<int>& labels,
     for (Eigen::Index r = 0; r < q; ++r) {
       for (Eigen::Index s = 0; s < q; ++s) KSS(r, s) = K(S[r], S[s]);
     }
-    R = ClipToPsd(KSS);
+    R = KSS;
+    R.diagonal().array() += shift;
     A.conservativeResize(q, C);
     A.row(q - 1).setZero();
     H = fit.Objective(KnS, R, A, b, &P);

@@ -142,6 +142,8 @@ std::string SerializeIntentModel(const IntentModel& m) {
   w.I64(c.velocity_frames);
   w.I64(c.dtw_band);
   w.F64(c.sensor_noise_std);
+  w.F64(c.features.torso_motion_weight);
+  w.I64(c.features.normalise_body_size ? 1 : 0);
   WriteStrings(&w, m.actions);
   w.F64(m.classifier.sigma);
   w.U64(m.classifier.import_windows.size());
@@ -217,6 +219,8 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
   c.velocity_frames = static_cast<int>(r.I64());
   c.dtw_band = static_cast<int>(r.I64());
   c.sensor_noise_std = r.F64();
+  c.features.torso_motion_weight = r.F64();
+  c.features.normalise_body_size = r.I64() != 0;
   const std::string config_error = c.Validate();
   if (!config_error.empty()) r.Fail("configuration: " + config_error);
   m.actions = ReadStrings(&r);
@@ -229,7 +233,7 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
   m.classifier.ivm.bias = r.Vec();
   const std::uint64_t nf = r.U64();
   const Eigen::Index C = static_cast<Eigen::Index>(m.actions.size());
-  const FeatureLayout layout(c.joints);
+  const FeatureLayout layout(c.joints, c.features);
   if (nf != m.actions.size() || m.classifier.ivm.bias.size() != C ||
       m.classifier.ivm.alpha.rows() != static_cast<Eigen::Index>(q) ||
       m.classifier.ivm.alpha.cols() != C) {

@@ -33,6 +33,17 @@ struct JointConfig {
   std::string Validate() const;
 };
 
+/// Options of the per-frame classifier features.
+struct FrameFeatureOptions {
+  /// Weight of the torso-motion block relative to the posture block (>= 0).
+  double torso_motion_weight = 1.0;
+  /// If true and both shoulder_l and shoulder_r are model joints, posture and
+  /// torso motion are divided by the window's mean shoulder width and
+  /// multiplied by 0.35 m (a typical adult width), removing body-size
+  /// differences between people while keeping the unit metres.
+  bool normalise_body_size = false;
+};
+
 /// Picks the default upper-body joint set (METHOD 1: head, neck, torso,
 /// shoulder/elbow/hand left and right) from the joints a dataset provides,
 /// accepting the usual aliases: neck = shoulder_center, torso = spine, hand =
@@ -47,7 +58,8 @@ JointConfig DefaultJointConfig(const std::vector<std::string>& available);
 class FeatureLayout {
  public:
   /// Throws std::invalid_argument with JointConfig::Validate()'s message.
-  explicit FeatureLayout(const JointConfig& config);
+  explicit FeatureLayout(const JointConfig& config,
+                         const FrameFeatureOptions& options = FrameFeatureOptions{});
 
   int num_joints() const { return num_joints_; }
   /// Per-frame classifier feature size: 3 J + 3 + (hands x objects).
@@ -66,7 +78,9 @@ class FeatureLayout {
   /// Per-frame classifier features of a padded window (T, 3 J): for each row s,
   /// joints relative to that row's torso (3 J), that row's torso relative to
   /// the torso of the newest row (3), distances of each hand to each object
-  /// (hands x objects). Returns (T, frame_feature_size()), metres.
+  /// (hands x objects). The torso block is scaled by
+  /// options.torso_motion_weight; see FrameFeatureOptions for the body-size
+  /// normalisation. Returns (T, frame_feature_size()), metres.
   Eigen::MatrixXd FrameFeatures(const Eigen::MatrixXd& window) const;
 
   /// Forecaster input vector of a padded window (T, 3 J) at `rate` Hz (see
@@ -80,6 +94,9 @@ class FeatureLayout {
   std::vector<int> torso_index_;
   std::vector<int> hand_index_;
   std::vector<Eigen::Vector3d> objects_;
+  FrameFeatureOptions options_;
+  int shoulder_l_ = -1;
+  int shoulder_r_ = -1;
 };
 
 /// Returns the padded window of length T ending at row `end` (inclusive) of

@@ -30,6 +30,7 @@ struct IntentModelConfig {
   int horizon = 15;               ///< D: future frames predicted (>= 1).
   int velocity_frames = 2;        ///< Finite-difference span for velocities (>= 1).
   int dtw_band = 3;               ///< Sakoe-Chiba band half-width, frames (>= 0).
+  FrameFeatureOptions features;   ///< Classifier frame-feature options.
   double sensor_noise_std = 0.01; ///< m, isotropic, added to every predicted covariance.
 
   /// Empty string when valid, else the offending field and value.

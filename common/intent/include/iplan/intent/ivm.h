@@ -6,8 +6,9 @@
 //        p(c | x) = exp(f_c) / sum_c' exp(f_c').
 // Fit: minimise H = -(1/N) sum_i log p(y_i | x_i)
 //                   + (lambda/2) sum_c alpha_c^T R_SS alpha_c,
-// where R_SS is the kernel among import samples with negative eigenvalues
-// clipped to zero (indefinite kernels such as DTW are regularised this way).
+// where R_SS = K_SS + delta I is the kernel among import samples shifted by
+// delta = max(0, -smallest eigenvalue of the full training kernel) (indefinite
+// kernels such as DTW are regularised this way; every R_SS is then PSD).
 // Greedy selection: each round scores every remaining sample by the decrease
 // of H that one (diagonal) Newton step on its new coefficients would give,
 // adds the best, and refits all coefficients by damped block Newton. It stops
