@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fstream>
+#include <limits>
 #include <set>
 #include <sstream>
 #include <stdexcept>
@@ -135,7 +136,12 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
     }
     b.time.push_back(t);
     for (size_t c = lead.size(); c < f.size(); ++c) {
-      b.values.push_back(ParseNumber(f[c], path, line_no, header[c]));
+      // A joint the tracker did not detect may be written as nan or left empty.
+      if (f[c].empty() || f[c] == "nan" || f[c] == "NaN" || f[c] == "-nan") {
+        b.values.push_back(std::numeric_limits<double>::quiet_NaN());
+      } else {
+        b.values.push_back(ParseNumber(f[c], path, line_no, header[c]));
+      }
     }
   }
   if (builders.empty()) ThrowAt(path, line_no, "no data rows");
@@ -148,6 +154,10 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
     data.sequences.push_back(std::move(b.seq));
   }
   return data;
+}
+
+bool JointDetected(const Eigen::Ref<const Eigen::RowVectorXd>& p) {
+  return p.allFinite() && !(p.array() == 0.0).all();
 }
 
 SkeletonDataset SelectSubjects(const SkeletonDataset& data,
@@ -203,19 +213,27 @@ std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
                                 std::to_string(rate) + " and max_gap " +
                                 std::to_string(max_gap) + " must be positive");
   }
-  const int n = static_cast<int>(sequence.time.size());
   const int num_out = static_cast<int>(joint_index.size());
+  // Frames where every selected joint was detected.
+  std::vector<int> valid;
+  for (int i = 0; i < sequence.time.size(); ++i) {
+    bool ok = true;
+    for (int j : joint_index) {
+      if (!JointDetected(sequence.positions.block<1, 3>(i, 3 * j))) ok = false;
+    }
+    if (ok) valid.push_back(i);
+  }
+  const int n = static_cast<int>(valid.size());
+  auto time_of = [&](int v) { return sequence.time(valid[v]); };
   std::vector<Track> tracks;
   // Split at long gaps.
   int begin = 0;
   int part = 0;
   while (begin < n) {
     int end = begin + 1;
-    while (end < n && sequence.time(end) - sequence.time(end - 1) <= max_gap) {
-      ++end;
-    }
-    const double t0 = sequence.time(begin);
-    const double t1 = sequence.time(end - 1);
+    while (end < n && time_of(end) - time_of(end - 1) <= max_gap) ++end;
+    const double t0 = time_of(begin);
+    const double t1 = time_of(end - 1);
     const int count = static_cast<int>(std::floor((t1 - t0) * rate + 1e-9)) + 1;
     Track track;
     track.sequence_id =
@@ -226,18 +244,15 @@ std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
     int k = begin;
     for (int i = 0; i < count; ++i) {
       const double t = t0 + i / rate;
-      while (k + 1 < end - 1 && sequence.time(k + 1) <= t) ++k;
+      while (k + 1 < end - 1 && time_of(k + 1) <= t) ++k;
       const int k1 = std::min(k + 1, end - 1);
       double u = 0.0;
-      if (k1 != k) {
-        u = (t - sequence.time(k)) / (sequence.time(k1) - sequence.time(k));
-        u = std::clamp(u, 0.0, 1.0);
-      }
+      if (k1 != k) u = std::clamp((t - time_of(k)) / (time_of(k1) - time_of(k)), 0.0, 1.0);
       for (int j = 0; j < num_out; ++j) {
         const int c = 3 * joint_index[j];
         track.positions.block<1, 3>(i, 3 * j) =
-            (1.0 - u) * sequence.positions.block<1, 3>(k, c) +
-            u * sequence.positions.block<1, 3>(k1, c);
+            (1.0 - u) * sequence.positions.block<1, 3>(valid[k], c) +
+            u * sequence.positions.block<1, 3>(valid[k1], c);
       }
     }
     tracks.push_back(std::move(track));

@@ -1,5 +1,6 @@
 #include "iplan/intent/skeleton_data.h"
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
 #include <string>
@@ -84,7 +85,7 @@ TEST(SkeletonDataTest, ResamplesLinearlyAndSplitsLongGaps) {
   s.time.resize(4);
   s.time << 0.0, 0.1, 0.3, 1.5;  // gap of 0.2 s bridged, gap of 1.2 s splits
   s.positions.resize(4, 3);
-  s.positions << 0, 0, 0, 1, 0, 0, 3, 0, 0, 9, 9, 9;
+  s.positions << 0, 0, 1, 1, 0, 1, 3, 0, 1, 9, 9, 9;
   const std::vector<Track> tracks = ResampleSequence(s, {0}, 20.0, 0.5);
   ASSERT_EQ(tracks.size(), 2u);
   // 0 .. 0.3 s at 20 Hz: 7 samples, x = 10 t.
@@ -130,6 +131,33 @@ TEST(FeaturesTest, FeaturesRelativeToTorsoAndObjects) {
   JointConfig bad = c;
   bad.torso = {"pelvis"};
   EXPECT_NE(bad.Validate().find("torso joint 'pelvis'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace iplan::intent
+
+namespace iplan::intent {
+namespace {
+
+TEST(SkeletonDataTest, UndetectedJointsAreDroppedFramesNotErrors) {
+  const std::string path = WriteTemp(
+      "missing.csv", std::string(kHeader) +
+                         "s1,p1,wave,0,0.0,0,0,1,1,1,1\n"
+                         "s1,p1,wave,1,0.1,nan,nan,nan,1,1,1\n"
+                         "s1,p1,wave,2,0.2,0,0,0,1,1,1\n"  // (0,0,0): not detected
+                         "s1,p1,wave,3,0.3,3,0,1,1,1,1\n");
+  const SkeletonDataset d = LoadSkeletonCsv(path);
+  EXPECT_TRUE(std::isnan(d.sequences[0].positions(1, 0)));
+  // Joint a: frames 1 and 2 are missing, 0 and 3 are interpolated across.
+  const std::vector<Track> a = ResampleSequence(d.sequences[0], {0}, 10.0, 0.5);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(a[0].positions.rows(), 4);
+  EXPECT_NEAR(a[0].positions(1, 0), 1.0, 1e-12);
+  EXPECT_NEAR(a[0].positions(2, 0), 2.0, 1e-12);
+  // Joint b alone is complete.
+  EXPECT_EQ(ResampleSequence(d.sequences[0], {1}, 10.0, 0.5)[0].positions.rows(), 4);
+  // With a short max_gap the missing frames split the track.
+  EXPECT_EQ(ResampleSequence(d.sequences[0], {0, 1}, 10.0, 0.15).size(), 2u);
 }
 
 }  // namespace

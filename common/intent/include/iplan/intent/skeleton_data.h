@@ -30,7 +30,8 @@ struct SkeletonDataset {
   std::vector<SkeletonSequence> sequences;
 };
 
-/// Reads a skeleton CSV file in the shared layout.
+/// Reads a skeleton CSV file in the shared layout. A joint coordinate written
+/// as `nan` or left empty marks an undetected joint and is stored as NaN.
 /// Throws std::runtime_error naming the file and line for: a missing file, a
 /// header without the five leading columns or with joint columns that are not
 /// `<name>.x,<name>.y,<name>.z` triples, a row with the wrong number of fields,
@@ -38,6 +39,11 @@ struct SkeletonDataset {
 /// contiguous, or non-increasing time within a sequence.
 /// Thread-safe (no shared state). Allocates.
 SkeletonDataset LoadSkeletonCsv(const std::string& path);
+
+/// True when a joint position (3) was detected: all coordinates finite and not
+/// exactly (0, 0, 0), which trackers such as OpenPose write for a missing
+/// joint (it is the sensor origin, never a real body position).
+bool JointDetected(const Eigen::Ref<const Eigen::RowVectorXd>& p);
 
 /// Returns the sequences of `data` whose subject is in `subjects`, in file
 /// order. Throws std::invalid_argument naming a subject that has no sequence.
@@ -61,11 +67,12 @@ struct Track {
 /// Resamples `sequence` to `rate` (Hz) on the grid t0, t0 + 1/rate, ... (t0 =
 /// first sample time) by linear interpolation between neighbouring recorded
 /// frames, keeping only the joints `joint_index` (indices into the dataset's
-/// joint list, in that order). Recorded gaps up to `max_gap` seconds are
+/// joint list, in that order). Frames in which any of these joints was not
+/// detected (see JointDetected()) are dropped first. Gaps up to `max_gap` seconds are
 /// bridged by the interpolation; a longer gap splits the sequence into
 /// separate tracks (a track never interpolates across such a gap).
 /// Requires rate > 0 and max_gap > 0 (throws std::invalid_argument otherwise).
-/// Tracks with fewer than one frame are dropped.
+/// A sequence without any frame in which all joints were detected yields no track.
 std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
                                     const std::vector<int>& joint_index,
                                     double rate, double max_gap);
