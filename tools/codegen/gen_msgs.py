@@ -438,7 +438,12 @@ def gen_fastdds(structs, idl_files):
            "#include \"fastdds_convert.h\"\n\n"]
     for f in idl_files:
         base = os.path.splitext(os.path.basename(f))[0]
-        out.append(f"#include \"{base}.h\"\n#include \"{base}PubSubTypes.h\"\n")
+        out.append(f"#include \"{base}PubSubTypes.h\"\n")
+    out.append("// The class definitions are compiled here, not in their own files, so\n"
+               "// that their out-of-line field accessors inline into the conversions.\n")
+    for f in idl_files:
+        base = os.path.splitext(os.path.basename(f))[0]
+        out.append(f"#include \"{base}.cxx\"\n")
     out.append("\nnamespace iplan::dds::fastdds_gen {\n\n")
     for st in structs:
         out.append(f"void ToVendor(const msg::{st.cpp_name}& p, {fast_name(st)}& v);\n")

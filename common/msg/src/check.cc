@@ -13,9 +13,20 @@ std::string Num(double x) {
   return buf;
 }
 
+// Fast test of what CheckCovariance reports (unrolled, no branches).
+inline bool SymmetricPair(double a, double b) {
+  return std::fabs(a - b) <= 1e-9 * (1 + std::fabs(a) + std::fabs(b));
+}
+inline bool CovarianceOk(const std::array<double, 9>& c) {
+  return (c[0] >= 0) & (c[4] >= 0) & (c[8] >= 0) & SymmetricPair(c[1], c[3]) & SymmetricPair(c[2], c[6]) &
+         SymmetricPair(c[5], c[7]) & (c[1] * c[1] <= c[0] * c[4] * (1 + 1e-9) + 1e-300) &
+         (c[2] * c[2] <= c[0] * c[8] * (1 + 1e-9) + 1e-300) & (c[5] * c[5] <= c[4] * c[8] * (1 + 1e-9) + 1e-300);
+}
+
 // `path` is only called when there is something to report.
 template <class PathFn>
 std::optional<std::string> CheckCovariance(const std::array<double, 9>& c, PathFn path) {
+  if (CovarianceOk(c)) return std::nullopt;
   for (int i = 0; i < 3; ++i) {
     if (c[i * 3 + i] < 0) return path() + ": negative variance " + Num(c[i * 3 + i]);
     for (int j = i + 1; j < 3; ++j) {
@@ -94,11 +105,15 @@ std::optional<std::string> CheckSemantics(const HumanPrediction& m) {
              std::to_string(m.num_steps) + " steps x " + std::to_string(m.joint_names.size()) +
              " joints = " + std::to_string(expected);
     }
-    for (std::size_t k = 0; k < act.joints.size(); ++k) {
-      if (auto e = CheckCovariance(act.joints[k].covariance, [&] {
-            return path() + ".joints[" + std::to_string(k) + "].covariance";
-          })) {
-        return e;
+    bool all_ok = true;
+    for (const auto& g : act.joints) all_ok &= CovarianceOk(g.covariance);
+    if (!all_ok) {  // find and describe the first offender
+      for (std::size_t k = 0; k < act.joints.size(); ++k) {
+        if (auto e = CheckCovariance(act.joints[k].covariance, [&] {
+              return path() + ".joints[" + std::to_string(k) + "].covariance";
+            })) {
+          return e;
+        }
       }
     }
   }

@@ -78,20 +78,16 @@ void FindNonFiniteValue(const std::string& path, const T& v, std::optional<std::
 }
 
 // Allocation-free scan: true when every floating-point field is finite.
+// (Measured: a predictable branch per value beats branch-free variants here.)
 template <class T>
 bool AllFiniteValue(const T& v) {
   if constexpr (kIsMessage<T>) {
     bool ok = true;
-    FieldsOf<T>::Visit([&](const char*, const auto& f) { ok = ok && AllFiniteValue(f); }, v);
+    FieldsOf<T>::Visit([&ok](const char*, const auto& f) { ok = ok && AllFiniteValue(f); }, v);
     return ok;
   } else if constexpr (IsVector<T>::value || IsArray<T>::value) {
     using E = typename T::value_type;
-    if constexpr (std::is_floating_point_v<E>) {
-      // Branch-free accumulation: NaN or inf makes x - x non-zero (NaN).
-      E acc = 0;
-      for (const E& x : v) acc += x - x;
-      return acc == 0;
-    } else if constexpr (kIsMessage<E>) {
+    if constexpr (std::is_floating_point_v<E> || kIsMessage<E>) {
       for (const auto& e : v) {
         if (!AllFiniteValue(e)) return false;
       }
