@@ -6,65 +6,14 @@
 
 #include <Eigen/Eigenvalues>
 
+#include "secular_kernel.h"
+
 namespace iplan::collision {
 namespace {
 
-constexpr double kEps = std::numeric_limits<double>::epsilon();
 constexpr double kLog2Pi = 1.8378770664093454836;  // log(2 pi)
-
-// Solves sum_i d_i^2 / (1 + lambda s_i)^2 = R^2 for lambda > 0, given
-// ||d|| > R and s_i > 0. Newton's method on psi(lambda) = 1/||y(lambda)||:
-// y_i = (d_i/s_i) / (1/s_i + lambda) is the trust-region step of a convex
-// quadratic with Hessian diag(1/s_i), for which psi is concave and increasing
-// (More & Sorensen 1983), so Newton started left of the root (psi < 1/R) stays
-// left and converges monotonically and quadratically. Rounding can break that
-// near the root, hence the bracket and the bisection fallback.
-//
-// Bracket: ||d|| / (1 + lambda s_max) <= ||y(lambda)|| <= ||d|| / (1 + lambda
-// s_min), so lambda* lies in [(||d||/R - 1)/s_max, (||d||/R - 1)/s_min].
-inline double SolveSecular(const Eigen::Vector3d& d, const Eigen::Vector3d& s,
-                           double dist, double R, int* iterations) {
-  const double excess = dist / R - 1.0;
-  double lo = excess / s[2];
-  double hi = excess / s[0];
-  // Sharper lower end: ||y|| >= |d_i| / (1 + lambda s_i) for each i.
-  for (int i = 0; i < 3; ++i) lo = std::max(lo, (std::abs(d[i]) / R - 1.0) / s[i]);
-  const double inv_R = 1.0 / R;
-  double lambda = lo;
-  int it = 0;
-  for (; it < 100; ++it) {
-    double phi = 0.0;
-    double w = 0.0;  // sum s_i y_i^2 t_i = -phi'/2
-    for (int i = 0; i < 3; ++i) {
-      const double t = 1.0 / (1.0 + lambda * s[i]);
-      const double y = d[i] * t;
-      phi += y * y;
-      w += s[i] * y * y * t;
-    }
-    const double psi = 1.0 / std::sqrt(phi);
-    if (psi < inv_R) {
-      lo = lambda;
-    } else if (psi > inv_R) {
-      hi = lambda;
-    } else {
-      break;  // exact root
-    }
-    const double dpsi = psi * psi * psi * w;  // psi' = phi^{-3/2} w > 0
-    const double step = (inv_R - psi) / dpsi;
-    double next = lambda + step;
-    if (!(next > lo && next < hi)) next = 0.5 * (lo + hi);
-    const double change = std::abs(next - lambda);
-    lambda = next;
-    // Quadratic convergence: after a step of relative size 1e-8 the error is
-    // of order 1e-16 relative, so no confirming step is needed.
-    if (change <= 1e-8 * lambda || hi - lo <= 4.0 * kEps * hi) {
-      ++it;
-      break;
-    }
-  }
-  if (iterations != nullptr) *iterations = it;
-  return lambda;
-}
+using internal::LogBoundAt;
+using internal::SolveSecularLanes;
 
 }  // namespace
 
@@ -80,6 +29,7 @@ bool FactorizeGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& sigma
   out->mean = mean;
   out->eigenvectors = eig.eigenvectors();
   out->eigenvalues = s;
+  out->inverse_eigenvalues = s.cwiseInverse();
   out->inverse = out->eigenvectors * s.cwiseInverse().asDiagonal() *
                  out->eigenvectors.transpose();
   out->log_peak_density =
@@ -89,45 +39,90 @@ bool FactorizeGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& sigma
 
 double EvaluatePairLogBound(const FactorizedGaussian& g, const Eigen::Vector3d& b,
                             double R) {
-  const Eigen::Vector3d d = g.eigenvectors.transpose() * (g.mean - b);
-  const double dist2 = d.squaredNorm();
+  const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b);
+  const double dist2 = dv.squaredNorm();
   const double log_volume = std::log(BallVolume(R));
   if (dist2 <= R * R) return log_volume + g.log_peak_density;
-  const Eigen::Vector3d& s = g.eigenvalues;
-  const double lambda = SolveSecular(d, s, std::sqrt(dist2), R, nullptr);
-  // x - mu in the eigenbasis is -d_i lambda s_i / (1 + lambda s_i); its
-  // Mahalanobis norm is computed without cancellation.
-  double maha = 0.0;
+  double d[3][1], s[3][1], inv_s[3][1], lambda[1];
   for (int i = 0; i < 3; ++i) {
-    const double t = lambda / (1.0 + lambda * s[i]);
-    maha += d[i] * d[i] * t * t * s[i];
+    d[i][0] = dv[i];
+    s[i][0] = g.eigenvalues[i];
+    inv_s[i][0] = g.inverse_eigenvalues[i];
   }
-  return log_volume + g.log_peak_density - 0.5 * maha;
+  const double dist[1] = {std::sqrt(dist2)};
+  const double Rs[1] = {R};
+  const bool need[1] = {true};
+  SolveSecularLanes<1>(d, s, inv_s, dist, Rs, need, lambda, nullptr);
+  const double dd[3] = {dv[0], dv[1], dv[2]};
+  const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};
+  return LogBoundAt(dd, ss, lambda[0], log_volume, g.log_peak_density);
+}
+
+void EvaluatePairLogBounds(const FactorizedGaussian& g,
+                           const Eigen::Ref<const Eigen::Matrix3Xd>& b, const double* R,
+                           double* log_bounds) {
+  constexpr int L = 4;
+  const Eigen::Index n = b.cols();
+  const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};
+  for (Eigen::Index start = 0; start < n; start += L) {
+    const int m = static_cast<int>(std::min<Eigen::Index>(L, n - start));
+    double d[3][L], s[3][L], inv_s[3][L], dist[L], Rs[L], lambda[L], log_volume[L];
+    bool need[L];
+    for (int l = 0; l < L; ++l) {
+      // Pad a short last batch with copies of its first pair.
+      const Eigen::Index col = start + (l < m ? l : 0);
+      const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b.col(col));
+      for (int i = 0; i < 3; ++i) {
+        d[i][l] = dv[i];
+        s[i][l] = ss[i];
+        inv_s[i][l] = g.inverse_eigenvalues[i];
+      }
+      Rs[l] = R[col];
+      const double dist2 = dv.squaredNorm();
+      dist[l] = std::sqrt(dist2);
+      need[l] = dist2 > Rs[l] * Rs[l];
+      log_volume[l] = std::log(BallVolume(Rs[l]));
+    }
+    SolveSecularLanes<L>(d, s, inv_s, dist, Rs, need, lambda, nullptr);
+    for (int l = 0; l < m; ++l) {
+      if (!need[l]) {
+        log_bounds[start + l] = log_volume[l] + g.log_peak_density;
+      } else {
+        const double dd[3] = {d[0][l], d[1][l], d[2][l]};
+        log_bounds[start + l] = LogBoundAt(dd, ss, lambda[l], log_volume[l], g.log_peak_density);
+      }
+    }
+  }
 }
 
 PairBound EvaluatePairBound(const FactorizedGaussian& g, const Eigen::Vector3d& b,
                             double R) {
   PairBound out;
-  const Eigen::Vector3d d = g.eigenvectors.transpose() * (g.mean - b);
-  const double dist2 = d.squaredNorm();
+  const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b);
+  const double dist2 = dv.squaredNorm();
   const double log_volume = std::log(BallVolume(R));
   if (dist2 <= R * R) {
     out.x_max = g.mean;
     out.lambda = 0.0;
     out.log_bound = log_volume + g.log_peak_density;
   } else {
-    const Eigen::Vector3d& s = g.eigenvalues;
-    out.lambda = SolveSecular(d, s, std::sqrt(dist2), R, &out.iterations);
-    Eigen::Vector3d y;
-    double maha = 0.0;
+    double d[3][1], s[3][1], inv_s[3][1], lambda[1];
     for (int i = 0; i < 3; ++i) {
-      const double den = 1.0 + out.lambda * s[i];
-      y[i] = d[i] / den;
-      const double t = out.lambda / den;
-      maha += d[i] * d[i] * t * t * s[i];
+      d[i][0] = dv[i];
+      s[i][0] = g.eigenvalues[i];
+      inv_s[i][0] = g.inverse_eigenvalues[i];
     }
+    const double dist[1] = {std::sqrt(dist2)};
+    const double Rs[1] = {R};
+    const bool need[1] = {true};
+    SolveSecularLanes<1>(d, s, inv_s, dist, Rs, need, lambda, &out.iterations);
+    out.lambda = lambda[0];
+    Eigen::Vector3d y;
+    for (int i = 0; i < 3; ++i) y[i] = dv[i] / (1.0 + out.lambda * g.eigenvalues[i]);
     out.x_max = b + g.eigenvectors * y;
-    out.log_bound = log_volume + g.log_peak_density - 0.5 * maha;
+    const double dd[3] = {dv[0], dv[1], dv[2]};
+    const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};
+    out.log_bound = LogBoundAt(dd, ss, out.lambda, log_volume, g.log_peak_density);
   }
   out.bound = out.log_bound >= 0.0 ? 1.0 : std::exp(out.log_bound);
   return out;

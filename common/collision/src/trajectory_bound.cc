@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "check.h"
+#include "secular_kernel.h"
 
 namespace iplan::collision {
 
@@ -101,19 +102,47 @@ TrajectoryBoundWorkspace::TrajectoryBoundWorkspace(int max_robot_spheres,
 
 double EvaluateMixtureBound(const HumanPrediction& prediction, int step, int sphere,
                             const Eigen::Vector3d& b, double r_robot, int* argmax_action) {
+  // Actions are solved 4 at a time (see internal::SolveSecularLanes).
+  constexpr int L = 4;
   const double R = r_robot + prediction.radius(sphere);
+  const double log_volume = std::log(BallVolume(R));
+  const int A = prediction.num_actions();
   double sum = 0.0;
   double best_term = -1.0;
   int best_action = -1;
-  for (int c = 0; c < prediction.num_actions(); ++c) {
-    const double p = prediction.action_probability(c);
-    if (p <= 0.0) continue;
-    const double lb = EvaluatePairLogBound(prediction.sphere(c, step, sphere), b, R);
-    const double term = p * (lb >= 0.0 ? 1.0 : std::exp(lb));
-    sum += term;
-    if (term > best_term) {
-      best_term = term;
-      best_action = c;
+  for (int start = 0; start < A; start += L) {
+    const int m = std::min(L, A - start);
+    double d[3][L], s[3][L], inv_s[3][L], dist[L], Rs[L], lambda[L];
+    bool need[L];
+    for (int l = 0; l < L; ++l) {
+      const FactorizedGaussian& g = prediction.sphere(start + (l < m ? l : 0), step, sphere);
+      const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b);
+      for (int i = 0; i < 3; ++i) {
+        d[i][l] = dv[i];
+        s[i][l] = g.eigenvalues[i];
+        inv_s[i][l] = g.inverse_eigenvalues[i];
+      }
+      Rs[l] = R;
+      const double dist2 = dv.squaredNorm();
+      dist[l] = std::sqrt(dist2);
+      need[l] = dist2 > R * R;
+    }
+    internal::SolveSecularLanes<L>(d, s, inv_s, dist, Rs, need, lambda, nullptr);
+    for (int l = 0; l < m; ++l) {
+      const int c = start + l;
+      const double p = prediction.action_probability(c);
+      if (p <= 0.0) continue;
+      const double log_peak = prediction.sphere(c, step, sphere).log_peak_density;
+      const double dd[3] = {d[0][l], d[1][l], d[2][l]};
+      const double ss[3] = {s[0][l], s[1][l], s[2][l]};
+      const double lb = need[l] ? internal::LogBoundAt(dd, ss, lambda[l], log_volume, log_peak)
+                                : log_volume + log_peak;
+      const double term = p * (lb >= 0.0 ? 1.0 : std::exp(lb));
+      sum += term;
+      if (term > best_term) {
+        best_term = term;
+        best_action = c;
+      }
     }
   }
   if (argmax_action != nullptr) *argmax_action = best_action;

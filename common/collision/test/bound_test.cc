@@ -211,7 +211,7 @@ TEST(BoundTest, XmaxSatisfiesOptimalityConditions) {
     const PairBound pb = EvaluatePairBound(Factorize(c), c.b, c.R);
     ASSERT_GT(pb.lambda, 0.0);
     const Eigen::Vector3d n = pb.x_max - c.b;
-    EXPECT_NEAR(n.norm(), c.R, 1e-8 * c.R) << i;
+    EXPECT_NEAR(n.norm(), c.R, 1e-8 * c.R) << i << " iterations " << pb.iterations;
     const Eigen::Vector3d grad = c.sigma.ldlt().solve(c.mu - pb.x_max);
     EXPECT_LE((grad - pb.lambda * n).norm(), 1e-8 * grad.norm()) << i;
     EXPECT_LE(grad.cross(n).norm(), 1e-8 * grad.norm() * n.norm()) << i;
@@ -244,6 +244,29 @@ TEST(BoundTest, NewtonAgreesWithReferenceBisection) {
   }
   // Newton from the lower bracket end converges in a handful of steps.
   EXPECT_LE(newton_iterations_max, 10);
+}
+
+// The batched kernel gives the scalar results (same arithmetic per lane),
+// including a short last batch and means inside the ball.
+TEST(BoundTest, BatchedLogBoundsEqualScalar) {
+  std::mt19937_64 rng(19);
+  for (int trial = 0; trial < 200; ++trial) {
+    const Case c = RandomCase(&rng, trial % 3);
+    FactorizedGaussian g = Factorize(c);
+    const int n = 1 + trial % 11;
+    Eigen::Matrix3Xd b(3, n);
+    std::vector<double> R(n), out(n, 0.0);
+    for (int k = 0; k < n; ++k) {
+      const Case other = RandomCase(&rng, k % 3);
+      b.col(k) = c.mu + (other.b - other.mu);  // offset distribution of the cases
+      R[k] = other.R;
+    }
+    EvaluatePairLogBounds(g, b, R.data(), out.data());
+    for (int k = 0; k < n; ++k) {
+      const double scalar = EvaluatePairLogBound(g, b.col(k), R[k]);
+      EXPECT_NEAR(out[k], scalar, 1e-13 * std::max(1.0, std::abs(scalar))) << trial << " " << k;
+    }
+  }
 }
 
 // Hand-checked isotropic case: Sigma = s I, ||mu - b|| = D > R gives
