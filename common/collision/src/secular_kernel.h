@@ -59,7 +59,6 @@ inline void SolveSecularLanes(const double (&d)[3][L], const double (&s)[3][L],
   }
   int it = 0;
   for (; it < 100; ++it) {
-    bool any = false;
     for (int l = 0; l < L; ++l) {
       const double lam = lambda[l];
       double phi = 0.0;  // ||y||^2
@@ -70,15 +69,13 @@ inline void SolveSecularLanes(const double (&d)[3][L], const double (&s)[3][L],
       const double a1 = 1.0 + lam * s[1][l];
       const double a2 = 1.0 + lam * s[2][l];
       const double r = 1.0 / (a0 * a1 * a2);
-      const double ts[3] = {a1 * a2 * r, a0 * a2 * r, a0 * a1 * r};
-      for (int i = 0; i < 3; ++i) {
-        const double t = ts[i];
-        const double y = d[i][l] * t;
-        const double st = s[i][l] * t;
-        phi += y * y;
-        w += st * y * y;
-        v += st * st * y * y;
-      }
+      const double t0 = a1 * a2 * r, t1 = a0 * a2 * r, t2 = a0 * a1 * r;
+      const double y0 = d[0][l] * t0, y1 = d[1][l] * t1, y2 = d[2][l] * t2;
+      const double st0 = s[0][l] * t0, st1 = s[1][l] * t1, st2 = s[2][l] * t2;
+      const double q0 = y0 * y0, q1 = y1 * y1, q2 = y2 * y2;
+      phi = q0 + q1 + q2;
+      w = st0 * q0 + st1 * q1 + st2 * q2;
+      v = st0 * st0 * q0 + st1 * st1 * q1 + st2 * st2 * q2;
       const double norm = std::sqrt(phi);
       const double new_lo = norm > R[l] ? lam : lo[l];
       const double new_hi = norm < R[l] ? lam : hi[l];
@@ -89,21 +86,24 @@ inline void SolveSecularLanes(const double (&d)[3][L], const double (&s)[3][L],
       const double a = phi * (norm * inv_R[l] - 1.0);
       const double pw2 = phi * w * w;
       const double den = pw2 + 1.5 * a * (w * w - v * phi);
-      double next = lam + (den > 0.25 * pw2 ? a * phi * w / den : a / w);
-      if (!(next >= new_lo && next <= new_hi)) next = 0.5 * (new_lo + new_hi);
-      if (norm == R[l]) next = lam;  // exact root
+      const bool halley = den > 0.25 * pw2;
+      // Branch-free selects so that the lane loop vectorises.
+      double next = lam + (halley ? a * phi * w : a) / (halley ? den : w);
+      const bool in_bracket = (next >= new_lo) & (next <= new_hi);
+      next = in_bracket ? next : 0.5 * (new_lo + new_hi);
+      next = norm == R[l] ? lam : next;  // exact root
       // Cubic convergence: after a step of relative size 1e-6 the error is of
       // order 1e-18 relative, so no confirming step is needed.
-      const bool done = std::abs(next - lam) <= 1e-6 * next ||
-                        new_hi - new_lo <= 4.0 * kEps * new_hi || norm == R[l];
-      if (active[l]) {
-        lo[l] = new_lo;
-        hi[l] = new_hi;
-        lambda[l] = next;
-        active[l] = !done;
-        any = any || !done;
-      }
+      const bool done = (std::abs(next - lam) <= 1e-6 * next) |
+                        (new_hi - new_lo <= 4.0 * kEps * new_hi) | (norm == R[l]);
+      const bool act = active[l];
+      lo[l] = act ? new_lo : lo[l];
+      hi[l] = act ? new_hi : hi[l];
+      lambda[l] = act ? next : lam;
+      active[l] = act & !done;
     }
+    bool any = false;
+    for (int l = 0; l < L; ++l) any = any || active[l];
     if (!any) {
       ++it;
       break;
