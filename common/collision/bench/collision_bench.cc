@@ -230,16 +230,16 @@ void PairBenchmark() {
               1e9 * factorise.median, 1e9 * factorise.min, 1e9 * factorise.max);
 }
 
-void TrajectoryBenchmark() {
+void TrajectoryBenchmark(double distance, bool reach_into_path, const char* scenario) {
   const RobotModel robot =
       LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
   const HumanBodyModel body(HumanBodyParams::DefaultUpperBody());
   constexpr int kActions = 10, kSteps = 15, kWaypoints = 30;
   const double dt = 0.1;  // s between prediction steps
 
-  // A person standing 0.75 m in front of the robot; each action moves the
+  // A person standing `distance` in front of the robot; each action moves the
   // right hand towards a different point, uncertainty growing with time.
-  const Eigen::Vector3d pelvis(0.75, 0.0, 0.0);
+  const Eigen::Vector3d pelvis(distance, 0.0, 0.0);
   const std::vector<Eigen::Vector3d> rest = {
       {0.0, 0.0, 1.65}, {0.0, 0.0, 1.45}, {0.0, 0.0, 1.05},   {0.0, 0.2, 1.40}, {0.0, 0.25, 1.12},
       {0.0, 0.27, 0.85}, {0.0, -0.2, 1.40}, {0.0, -0.25, 1.12}, {0.0, -0.27, 0.85}};
@@ -250,8 +250,11 @@ void TrajectoryBenchmark() {
     for (int c = 0; c < kActions; ++c) {
       prediction.set_action_probability(c, (c + 1.0) / (kActions * (kActions + 1) / 2.0));
       const double angle = 3.14159265358979 * (0.5 + c / (kActions - 1.0));
-      const Eigen::Vector3d target = pelvis + Eigen::Vector3d(0.5 * std::cos(angle),
-                                                              0.5 * std::sin(angle), 0.9);
+      const Eigen::Vector3d target =
+          reach_into_path
+              ? Eigen::Vector3d(0.35 + 0.1 * std::cos(angle), 0.4 * std::sin(angle), 0.55)
+              : Eigen::Vector3d(pelvis + Eigen::Vector3d(0.5 * std::cos(angle),
+                                                         0.5 * std::sin(angle), 0.9));
       for (int t = 0; t < kSteps; ++t) {
         const double s = static_cast<double>(t) / (kSteps - 1);
         for (int j = 0; j < 9; ++j) {
@@ -339,9 +342,9 @@ void TrajectoryBenchmark() {
   const Stats unpruned = Measure(brute, 1.0, 5, 0.3);
   const double unpruned_wall = g_last_wall_median;
 
-  std::printf("\n== Trajectory bound: Panda (%d spheres) x %d waypoints vs %d actions x %d steps "
-              "x %d human spheres\n",
-              S, kWaypoints, kActions, kSteps, body.num_spheres());
+  std::printf("\n== Trajectory bound, %s: Panda (%d spheres) x %d waypoints vs %d actions x "
+              "%d steps x %d human spheres\n",
+              scenario, S, kWaypoints, kActions, kSteps, body.num_spheres());
   std::printf("   workload: %d pair checks, %ld evaluated exactly (x %d actions), %ld pruned; "
               "max bound %.3e at waypoint %d\n",
               kWaypoints * S * body.num_spheres(), evaluated, kActions, pruned, max_bound,
@@ -362,6 +365,7 @@ void TrajectoryBenchmark() {
 int main() {
   std::printf("iplan collision benchmarks (single thread)\n\n");
   iplan::collision::PairBenchmark();
-  iplan::collision::TrajectoryBenchmark();
+  iplan::collision::TrajectoryBenchmark(0.75, false, "person 0.75 m in front of the base");
+  iplan::collision::TrajectoryBenchmark(0.6, true, "person 0.6 m away, hand reaching into the path");
   return 0;
 }

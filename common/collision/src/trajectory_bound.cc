@@ -77,6 +77,7 @@ void HumanPrediction::UpdateSummaries() {
         s.max_log_peak = std::max(s.max_log_peak, g.log_peak_density);
         s.max_eigenvalue = std::max(s.max_eigenvalue, g.eigenvalues[2]);
       }
+      s.half_inverse_max_eigenvalue = 0.5 / s.max_eigenvalue;
       s.centre = 0.5 * (lo + hi);
       s.spread = 0.0;
       for (int c = 0; c < num_actions_; ++c) {
@@ -98,14 +99,16 @@ std::string TrajectoryBoundParams::Validate() const {
 TrajectoryBoundWorkspace::TrajectoryBoundWorkspace(int max_robot_spheres,
                                                    int max_human_spheres)
     : log_upper(static_cast<size_t>(std::max(0, max_robot_spheres)) *
-                static_cast<size_t>(std::max(0, max_human_spheres))) {}
+                static_cast<size_t>(std::max(0, max_human_spheres))),
+      log_volume(log_upper.size()) {}
 
-double EvaluateMixtureBound(const HumanPrediction& prediction, int step, int sphere,
-                            const Eigen::Vector3d& b, double r_robot, int* argmax_action) {
+namespace {
+
+// Mixture bound with log V(R) supplied by the caller (R = r_robot + r_human).
+double MixtureBound(const HumanPrediction& prediction, int step, int sphere,
+                    const Eigen::Vector3d& b, double R, double log_volume, int* argmax_action) {
   // Actions are solved 4 at a time (see internal::SolveSecularLanes).
   constexpr int L = 4;
-  const double R = r_robot + prediction.radius(sphere);
-  const double log_volume = std::log(BallVolume(R));
   const int A = prediction.num_actions();
   double sum = 0.0;
   double best_term = -1.0;
@@ -149,6 +152,14 @@ double EvaluateMixtureBound(const HumanPrediction& prediction, int step, int sph
   return std::min(sum, 1.0);
 }
 
+}  // namespace
+
+double EvaluateMixtureBound(const HumanPrediction& prediction, int step, int sphere,
+                            const Eigen::Vector3d& b, double r_robot, int* argmax_action) {
+  const double R = r_robot + prediction.radius(sphere);
+  return MixtureBound(prediction, step, sphere, b, R, std::log(BallVolume(R)), argmax_action);
+}
+
 // Pruning, and why it is safe.
 //
 // For one action c, a pair's bound is min(1, V(R) max_{x in B(b,R)} f_c(x)).
@@ -182,6 +193,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
   IPLAN_COLLISION_DEMAND(static_cast<int>(trajectory.links.size()) == S);
   IPLAN_COLLISION_DEMAND(trajectory.centres.cols() == static_cast<Eigen::Index>(W) * S);
   IPLAN_COLLISION_DEMAND(workspace->log_upper.size() >= static_cast<size_t>(S) * H);
+  IPLAN_COLLISION_DEMAND(workspace->log_volume.size() >= static_cast<size_t>(S) * H);
   if (static_cast<int>(out->size()) != W) out->resize(W);
 
   const double log_negligible =
@@ -189,6 +201,12 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
                               : -std::numeric_limits<double>::infinity();
   const double log_psum = std::log(prediction.probability_sum());
   double* log_upper = workspace->log_upper.data();
+  double* log_volume = workspace->log_volume.data();
+  for (int k = 0; k < S; ++k) {
+    for (int l = 0; l < H; ++l) {
+      log_volume[k * H + l] = std::log(BallVolume(trajectory.radii[k] + prediction.radius(l)));
+    }
+  }
 
   for (int w = 0; w < W; ++w) {
     const int t = trajectory.steps[w];
@@ -207,8 +225,8 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
         const double R = r1 + prediction.radius(l);
         const double delta = std::max(0.0, (sm.centre - b).norm() - sm.spread - R);
         const double lu = log_psum +
-                          std::min(0.0, std::log(BallVolume(R)) + sm.max_log_peak -
-                                            delta * delta / (2.0 * sm.max_eigenvalue));
+                          std::min(0.0, log_volume[k * H + l] + sm.max_log_peak -
+                                            delta * delta * sm.half_inverse_max_eigenvalue);
         log_upper[k * H + l] = lu;
         if (lu > first_value) {
           first_value = lu;
@@ -220,12 +238,13 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
     double best = -1.0;  // best exact mixture so far (-1: none yet)
     double log_best = -std::numeric_limits<double>::infinity();
     double skipped_max = 0.0;      // largest U of pairs skipped as negligible
+    double log_skipped_max = -std::numeric_limits<double>::infinity();  // same, level 1 (log)
     auto evaluate = [&](int pair) {
       const int k = pair / H;
       const int l = pair % H;
       const double lu = log_upper[pair];
       if (lu <= log_negligible) {
-        skipped_max = std::max(skipped_max, std::exp(lu));
+        log_skipped_max = std::max(log_skipped_max, lu);
         ++res.pairs_pruned;
         return;
       }
@@ -236,7 +255,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
       const Eigen::Vector3d b = trajectory.centres.col(static_cast<Eigen::Index>(w) * S + k);
       const double r1 = trajectory.radii[k];
       const double R = r1 + prediction.radius(l);
-      const double log_volume = std::log(BallVolume(R));
+      const double log_v = log_volume[pair];
       // Level 2.
       double u2 = 0.0;
       for (int c = 0; c < A; ++c) {
@@ -245,7 +264,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
         const FactorizedGaussian& g = prediction.sphere(c, t, l);
         const double delta = std::max(0.0, (g.mean - b).norm() - R);
         const double lu_c =
-            log_volume + g.log_peak_density - delta * delta / (2.0 * g.eigenvalues[2]);
+            log_v + g.log_peak_density - delta * delta * (0.5 * g.inverse_eigenvalues[2]);
         u2 += p * (lu_c >= 0.0 ? 1.0 : std::exp(lu_c));
       }
       if (u2 <= params.negligible) {
@@ -258,7 +277,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
         return;
       }
       int action = -1;
-      const double value = EvaluateMixtureBound(prediction, t, l, b, r1, &action);
+      const double value = MixtureBound(prediction, t, l, b, R, log_v, &action);
       ++res.pairs_evaluated;
       if (value > best) {
         best = value;
@@ -272,6 +291,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
     for (int pair = 0; pair < S * H; ++pair) {
       if (pair != first) evaluate(pair);
     }
+    skipped_max = std::max(skipped_max, std::exp(log_skipped_max));
     if (res.robot_sphere >= 0) {
       res.robot_link = trajectory.links[res.robot_sphere];
       res.human_segment = prediction.segment(res.human_sphere);

@@ -32,6 +32,7 @@ class HumanPrediction {
     double spread = 0.0;         ///< radius of that ball (m): max_c ||mu_c - centre||
     double max_log_peak = 0.0;   ///< max_c log of the density's peak value
     double max_eigenvalue = 0.0; ///< max_c largest covariance eigenvalue (m^2)
+    double half_inverse_max_eigenvalue = 0.0;  ///< 0.5 / max_eigenvalue (1/m^2)
   };
 
   /// Allocates storage for num_actions x num_steps x radii.size() Gaussians,
@@ -138,7 +139,8 @@ struct WaypointBound {
 struct TrajectoryBoundWorkspace {
   /// Allocates for up to `max_robot_spheres` x `max_human_spheres` pairs.
   TrajectoryBoundWorkspace(int max_robot_spheres, int max_human_spheres);
-  std::vector<double> log_upper;  ///< per pair, level-1 log upper bound
+  std::vector<double> log_upper;   ///< per pair, level-1 log upper bound
+  std::vector<double> log_volume;  ///< per pair, log V(r_robot + r_human)
 };
 
 /// Evaluates P_i for every waypoint of `trajectory` against `prediction`.
