@@ -147,7 +147,8 @@ double StaticScene::CalcSignedDistance(int object, const Eigen::Vector3d& p_WS,
   request.enable_nearest_points = false;
   request.distance_tolerance = 1e-10;  // GJK stops at 1e-6 m by default
   // FCL 0.7 with libccd asserts in EPA for some sphere/cylinder penetrations;
-  // the independent solver uses FCL's exact sphere-box / sphere-cylinder code.
+  // the independent solver does not, and matches closed forms to 1e-10 m
+  // (scene_test).
   request.gjk_solver_type = fcl::GST_INDEP;
   fcl::DistanceResultd result;
   fcl::distance(&sphere, impl_->objects[object].get(), request, result);
