@@ -75,8 +75,8 @@ double EvaluatePairLogBound(const FactorizedGaussian& g, const Eigen::Vector3d& 
 
 void EvaluatePairLogBounds(const FactorizedGaussian& g,
                            const Eigen::Ref<const Eigen::Matrix3Xd>& b, const double* R,
-                           double* log_bounds) {
-  constexpr int L = 4;
+                           double* log_bounds, const double* log_volumes) {
+  constexpr int L = 2;  // lanes: 2 measured fastest (4: -6 %, 8: -25 %)
   const Eigen::Index n = b.cols();
   const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};
   for (Eigen::Index start = 0; start < n; start += L) {
@@ -96,7 +96,7 @@ void EvaluatePairLogBounds(const FactorizedGaussian& g,
       const double dist2 = dv.squaredNorm();
       dist[l] = std::sqrt(dist2);
       need[l] = dist2 > Rs[l] * Rs[l];
-      log_volume[l] = std::log(BallVolume(Rs[l]));
+      log_volume[l] = log_volumes != nullptr ? log_volumes[col] : std::log(BallVolume(Rs[l]));
     }
     SolveSecularLanes<L>(d, s, inv_s, dist, Rs, need, lambda, nullptr);
     for (int l = 0; l < m; ++l) {

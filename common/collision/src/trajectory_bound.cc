@@ -107,8 +107,8 @@ namespace {
 // Mixture bound with log V(R) supplied by the caller (R = r_robot + r_human).
 double MixtureBound(const HumanPrediction& prediction, int step, int sphere,
                     const Eigen::Vector3d& b, double R, double log_volume, int* argmax_action) {
-  // Actions are solved 4 at a time (see internal::SolveSecularLanes).
-  constexpr int L = 4;
+  // Actions are solved 2 at a time (see internal::SolveSecularLanes).
+  constexpr int L = 2;
   const int A = prediction.num_actions();
   double sum = 0.0;
   double best_term = -1.0;

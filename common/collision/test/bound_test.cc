@@ -262,9 +262,13 @@ TEST(BoundTest, BatchedLogBoundsEqualScalar) {
       R[k] = other.R;
     }
     EvaluatePairLogBounds(g, b, R.data(), out.data());
+    std::vector<double> log_volumes(n), out2(n, 0.0);
+    for (int k = 0; k < n; ++k) log_volumes[k] = std::log(BallVolume(R[k]));
+    EvaluatePairLogBounds(g, b, R.data(), out2.data(), log_volumes.data());
     for (int k = 0; k < n; ++k) {
       const double scalar = EvaluatePairLogBound(g, b.col(k), R[k]);
       EXPECT_NEAR(out[k], scalar, 1e-13 * std::max(1.0, std::abs(scalar))) << trial << " " << k;
+      EXPECT_EQ(out2[k], out[k]);
     }
   }
 }
