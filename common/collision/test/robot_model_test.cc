@@ -9,6 +9,9 @@
 #include <gtest/gtest.h>
 #include <urdf_parser/urdf_parser.h>
 
+
+#include "alloc_counter.h"
+
 #include "iplan/collision/sphere_cover.h"
 
 namespace iplan::collision {
@@ -310,6 +313,16 @@ joints:
   EXPECT_EQ(LoadRobotModelFromUrdf(mesh, opt).spheres.size(), 0u);
   opt.locked_joints["nope"] = 0.0;
   ExpectThrowsWith([&] { LoadRobotModelFromUrdf(kUrdf, opt); }, "locked joint 'nope'");
+}
+
+TEST(RobotModelTest, ForwardKinematicsDoesNotAllocate) {
+  const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
+  RobotData data(yaml);
+  const Eigen::VectorXd q = 0.5 * (yaml.LowerLimits() + yaml.UpperLimits());
+  test_support::StartCountingAllocations();
+  CalcForwardKinematics(yaml, q, &data);
+  EXPECT_EQ(test_support::StopCountingAllocations(), 0);
+  EXPECT_GT(data.p_WS.cwiseAbs().sum(), 0.0);
 }
 
 TEST(RobotModelTest, LockedFingersLeaveSevenJoints) {

@@ -1,28 +1,12 @@
 #include "iplan/collision/trajectory_bound.h"
 
-#include <atomic>
 #include <cmath>
-#include <cstdlib>
-#include <new>
 #include <random>
 
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
-// Counts heap allocations while enabled, to check that the hot path does not
-// allocate (as Pinocchio's unit tests do).
-namespace {
-std::atomic<bool> g_count_allocations{false};
-std::atomic<long> g_allocations{0};
-}  // namespace
-
-void* operator new(std::size_t size) {
-  if (g_count_allocations) ++g_allocations;
-  if (void* p = std::malloc(size == 0 ? 1 : size)) return p;
-  throw std::bad_alloc();
-}
-void operator delete(void* p) noexcept { std::free(p); }
-void operator delete(void* p, std::size_t) noexcept { std::free(p); }
+#include "alloc_counter.h"
 
 namespace iplan::collision {
 namespace {
@@ -175,21 +159,19 @@ TEST(TrajectoryBoundTest, EvaluationDoesNotAllocate) {
   Problem p = RandomProblem(&rng, 10, 15, 16, 40, 30);
   TrajectoryBoundWorkspace ws(40, 16);
   std::vector<WaypointBound> out(30);
-  g_allocations = 0;
-  g_count_allocations = true;
+  test_support::StartCountingAllocations();
   EvaluateTrajectoryBound(p.prediction, p.trajectory, {}, &ws, &out);
   FactorizedGaussian g;
   FactorizeGaussian(Eigen::Vector3d::Zero(), RandomCovariance(&rng), &g);
   p.prediction.SetSphere(0, 0, 0, Eigen::Vector3d::Ones(), RandomCovariance(&rng));
   p.prediction.UpdateSummaries();
-  g_count_allocations = false;
-  EXPECT_EQ(g_allocations.load(), 0);
+  EXPECT_EQ(test_support::StopCountingAllocations(), 0);
   // Sanity of the counter itself.
-  g_count_allocations = true;
+  test_support::StartCountingAllocations();
   auto* v = new std::vector<int>(10);
-  g_count_allocations = false;
+  const long counted = test_support::StopCountingAllocations();
   delete v;
-  EXPECT_GT(g_allocations.load(), 0);
+  EXPECT_GT(counted, 0);
 }
 
 TEST(TrajectoryBoundTest, RejectsBadConstruction) {

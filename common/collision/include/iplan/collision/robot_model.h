@@ -80,7 +80,8 @@ struct RobotModel {
   /// One entry per collision shape of the source file.
   std::vector<ShapeCoverEntry> cover_report;
 
-  /// Index of the link / joint with this name; -1 if there is none.
+  /// Index of the link / joint with this name; -1 if there is none (linear
+  /// search; not for hot loops).
   int FindLink(const std::string& name) const;
   int FindJoint(const std::string& name) const;
   /// Lower/upper position limits of the configuration variables (size nq).
@@ -129,6 +130,8 @@ struct RobotModelOptions {
 /// @throws std::runtime_error naming the file and the problem (unreadable or
 ///         invalid URDF, unsupported joint type, mesh collision shape, unknown
 ///         locked joint, invalid options).
+/// Thread-safe (no shared state); allocates. urdfdom may print parser
+/// warnings to stderr (console_bridge) before the exception.
 RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptions& options = {});
 
 /// Loads a serial arm from a YAML file in modified (Craig) Denavit-Hartenberg
@@ -137,6 +140,7 @@ RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptio
 /// spheres, capsules and boxes per link, covered as in sphere_cover.h. See
 /// config/robots/panda.yaml for the format. Unknown keys are errors.
 /// @throws std::runtime_error naming the file, the key and the value.
+/// Thread-safe (no shared state); allocates.
 RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptions& options = {});
 
 }  // namespace iplan::collision
