@@ -1,0 +1,390 @@
+// Benchmarks of the collision bound (Release, one thread). Plain executable:
+// prints medians and spread (min, max) over repetitions.
+//
+//  1. Pair bounds per second, Newton (secular equation) and the reference
+//     bisection in the same run, on the same cases. As in batched use, each
+//     human sphere's covariance is factorised once (per time step) and then
+//     evaluated against all robot spheres of the waypoint(s) at that step; the
+//     factorisation time is included.
+//  2. A 30-waypoint Panda trajectory against a 10-action, 15-step, 16-sphere
+//     prediction: the batched evaluation alone (prediction factorised once, as
+//     in the optimiser's inner loop) and including forward kinematics and the
+//     factorisation of the whole prediction.
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <random>
+#include <string>
+#include <vector>
+
+#include <Eigen/Geometry>
+
+#include "iplan/collision/bound.h"
+#include "iplan/collision/human_model.h"
+#include "iplan/collision/robot_model.h"
+#include "iplan/collision/trajectory_bound.h"
+
+namespace iplan::collision {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+struct Stats {
+  double median, min, max;
+};
+
+// CPU time of this thread (s): the machine is shared, and time while the
+// thread is descheduled is not the code's cost. Wall time is kept alongside.
+double ThreadCpuSeconds() {
+  timespec ts;
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
+}
+
+double g_last_wall_median = 0.0;
+
+// Runs `fn` (one batch of `work` items) `reps` times; each repetition repeats
+// the batch until >= min_seconds of thread CPU time. Returns CPU seconds per
+// item (median, min, max over repetitions); the wall-clock median goes to
+// g_last_wall_median.
+Stats Measure(const std::function<void()>& fn, double work, int reps, double min_seconds) {
+  std::vector<double> per_item, wall;
+  fn();  // warm-up
+  for (int r = 0; r < reps; ++r) {
+    long iters = 0;
+    const double c0 = ThreadCpuSeconds();
+    const auto t0 = Clock::now();
+    double elapsed = 0.0;
+    do {
+      fn();
+      ++iters;
+      elapsed = ThreadCpuSeconds() - c0;
+    } while (elapsed < min_seconds);
+    per_item.push_back(elapsed / (iters * work));
+    wall.push_back(std::chrono::duration<double>(Clock::now() - t0).count() / (iters * work));
+  }
+  std::sort(per_item.begin(), per_item.end());
+  std::sort(wall.begin(), wall.end());
+  g_last_wall_median = wall[wall.size() / 2];
+  return {per_item[per_item.size() / 2], per_item.front(), per_item.back()};
+}
+
+struct HumanCase {
+  Eigen::Vector3d mu;
+  Eigen::Matrix3d sigma;
+};
+
+Eigen::Matrix3d RandomRotation(std::mt19937_64* rng) {
+  std::normal_distribution<double> n01;
+  Eigen::Quaterniond q(n01(*rng), n01(*rng), n01(*rng), n01(*rng));
+  return q.normalized().toRotationMatrix();
+}
+
+void PairBenchmark() {
+  std::mt19937_64 rng(1);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::normal_distribution<double> n01;
+  constexpr int kHuman = 2000;  // human spheres (one factorisation each)
+  constexpr int kRobot = 36;    // robot spheres per waypoint (Panda YAML model)
+  std::vector<HumanCase> humans(kHuman);
+  std::vector<Eigen::Vector3d> robot(static_cast<size_t>(kHuman) * kRobot);
+  std::vector<double> radius(static_cast<size_t>(kHuman) * kRobot);
+  int inside = 0;
+  for (int h = 0; h < kHuman; ++h) {
+    const double s_max = std::pow(0.02 + 0.15 * u01(rng), 2);
+    const double ratio = std::pow(10.0, 3.0 * u01(rng));
+    const Eigen::Matrix3d V = RandomRotation(&rng);
+    humans[h].sigma = V * Eigen::Vector3d(s_max / ratio, s_max / std::pow(ratio, u01(rng)), s_max)
+                              .asDiagonal() * V.transpose();
+    humans[h].sigma = (0.5 * (humans[h].sigma + humans[h].sigma.transpose())).eval();
+    humans[h].mu = Eigen::Vector3d(0.7, 0.0, 0.8) + 0.2 * Eigen::Vector3d(n01(rng), n01(rng), n01(rng));
+    for (int k = 0; k < kRobot; ++k) {
+      // Robot spheres spread over the workspace around the person: ~0.05 .. 1 m
+      // away, so most pairs need the secular solve.
+      const size_t i = static_cast<size_t>(h) * kRobot + k;
+      radius[i] = 0.06 + 0.04 * u01(rng) + 0.08;  // robot + human radius
+      const Eigen::Vector3d dir = Eigen::Vector3d(n01(rng), n01(rng), n01(rng)).normalized();
+      robot[i] = humans[h].mu + (0.05 + 0.95 * u01(rng)) * dir;
+      if ((robot[i] - humans[h].mu).norm() <= radius[i]) ++inside;
+    }
+  }
+  const double pairs = static_cast<double>(kHuman) * kRobot;
+  volatile double sink = 0.0;
+
+  // Accuracy on this set: Newton vs the bisection at the benchmarked tolerance.
+  ReferenceBisectionOptions bis;
+  bis.relative_tolerance = 1e-12;
+  double max_rel = 0.0, max_rel_x = 0.0;
+  double iter_newton = 0.0, iter_bis = 0.0;
+  int outside = 0;
+  for (int h = 0; h < kHuman; ++h) {
+    FactorizedGaussian g;
+    FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+    for (int k = 0; k < kRobot; ++k) {
+      const size_t i = static_cast<size_t>(h) * kRobot + k;
+      const PairBound a = EvaluatePairBound(g, robot[i], radius[i]);
+      const PairBound b = EvaluatePairBoundReferenceBisection(g, robot[i], radius[i], bis);
+      if (a.bound > 1e-300) max_rel = std::max(max_rel, std::abs(a.bound - b.bound) / a.bound);
+      max_rel_x = std::max(max_rel_x, (a.x_max - b.x_max).norm() / radius[i]);
+      if (a.lambda > 0) {
+        ++outside;
+        iter_newton += a.iterations;
+        iter_bis += b.iterations;
+      }
+    }
+  }
+
+  auto run_newton = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      const size_t base = static_cast<size_t>(h) * kRobot;
+      for (int k = 0; k < kRobot; ++k) s += EvaluatePairBound(g, robot[base + k], radius[base + k]).bound;
+    }
+    sink = sink + s;
+  };
+  auto run_newton_log = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      const size_t base = static_cast<size_t>(h) * kRobot;
+      for (int k = 0; k < kRobot; ++k) s += EvaluatePairLogBound(g, robot[base + k], radius[base + k]);
+    }
+    sink = sink + s;
+  };
+  auto run_newton_batched = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    double out[kRobot];
+    Eigen::Map<const Eigen::Matrix3Xd> all(robot[0].data(), 3, static_cast<Eigen::Index>(robot.size()));
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      const size_t base = static_cast<size_t>(h) * kRobot;
+      EvaluatePairLogBounds(g, all.middleCols(static_cast<Eigen::Index>(base), kRobot),
+                            &radius[base], out);
+      for (int k = 0; k < kRobot; ++k) s += out[k];
+    }
+    sink = sink + s;
+  };
+  std::vector<double> log_volume(radius.size());
+  for (size_t i = 0; i < radius.size(); ++i) log_volume[i] = std::log(BallVolume(radius[i]));
+  auto run_newton_batched_lv = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    double out[kRobot];
+    Eigen::Map<const Eigen::Matrix3Xd> all(robot[0].data(), 3, static_cast<Eigen::Index>(robot.size()));
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      const size_t base = static_cast<size_t>(h) * kRobot;
+      EvaluatePairLogBounds(g, all.middleCols(static_cast<Eigen::Index>(base), kRobot),
+                            &radius[base], out, &log_volume[base]);
+      for (int k = 0; k < kRobot; ++k) s += out[k];
+    }
+    sink = sink + s;
+  };
+  auto run_bisection = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      const size_t base = static_cast<size_t>(h) * kRobot;
+      for (int k = 0; k < kRobot; ++k) {
+        s += EvaluatePairBoundReferenceBisection(g, robot[base + k], radius[base + k], bis).bound;
+      }
+    }
+    sink = sink + s;
+  };
+  auto run_factorise = [&] {
+    double s = 0.0;
+    FactorizedGaussian g;
+    for (int h = 0; h < kHuman; ++h) {
+      FactorizeGaussian(humans[h].mu, humans[h].sigma, &g);
+      s += g.log_peak_density;
+    }
+    sink = sink + s;
+  };
+
+  constexpr int kReps = 11;
+  const Stats newton = Measure(run_newton, pairs, kReps, 0.3);
+  const double newton_wall = g_last_wall_median;
+  const Stats newton_log = Measure(run_newton_log, pairs, kReps, 0.3);
+  const double newton_log_wall = g_last_wall_median;
+  const Stats newton_batched = Measure(run_newton_batched, pairs, kReps, 0.3);
+  const double newton_batched_wall = g_last_wall_median;
+  const Stats newton_batched_lv = Measure(run_newton_batched_lv, pairs, kReps, 0.3);
+  const double newton_batched_lv_wall = g_last_wall_median;
+  const Stats bisection = Measure(run_bisection, pairs, 5, 0.5);
+  const double bisection_wall = g_last_wall_median;
+  const Stats factorise = Measure(run_factorise, kHuman, kReps, 0.2);
+
+  std::printf("== Pair bounds (%d human spheres x %d robot spheres = %.0f pairs per batch;\n"
+              "   one covariance factorisation per human sphere included; %.1f %% of pairs\n"
+              "   have the mean inside the ball)\n",
+              kHuman, kRobot, pairs, 100.0 * inside / pairs);
+  std::printf("   accuracy: max |bound_newton - bound_bisection| / bound = %.2e, "
+              "max ||x_newton - x_bisection|| / R = %.2e\n", max_rel, max_rel_x);
+  std::printf("   mean iterations on pairs outside the ball: Newton %.2f, bisection %.1f "
+              "(bisection relative tolerance %.0e)\n",
+              iter_newton / outside, iter_bis / outside, bis.relative_tolerance);
+  std::printf("   (thread CPU time; rate = pairs / CPU second; wall-clock median in brackets)\n");
+  auto line = [](const char* name, const Stats& s, double wall) {
+    std::printf("   %-40s median %6.2f M/s  (min %.2f, max %.2f; %.1f ns/pair) [wall %.2f M/s]\n",
+                name, 1e-6 / s.median, 1e-6 / s.max, 1e-6 / s.min, 1e9 * s.median, 1e-6 / wall);
+  };
+  line("Newton, EvaluatePairBound (+x_max)", newton, newton_wall);
+  line("Newton, EvaluatePairLogBound", newton_log, newton_log_wall);
+  line("Newton, EvaluatePairLogBounds (2 lanes)", newton_batched, newton_batched_wall);
+  line("Newton, ...Bounds + precomputed log V(R)", newton_batched_lv, newton_batched_lv_wall);
+  line("reference bisection", bisection, bisection_wall);
+  std::printf("   speed-up over bisection (medians): EvaluatePairBound %.1fx, log path %.1fx, "
+              "batched %.1fx, batched with log V %.1fx\n",
+              bisection.median / newton.median, bisection.median / newton_log.median,
+              bisection.median / newton_batched.median, bisection.median / newton_batched_lv.median);
+  std::printf("   covariance factorisation alone: median %.1f ns (min %.1f, max %.1f)\n",
+              1e9 * factorise.median, 1e9 * factorise.min, 1e9 * factorise.max);
+}
+
+void TrajectoryBenchmark(double distance, bool reach_into_path, const char* scenario) {
+  const RobotModel robot =
+      LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
+  const HumanBodyModel body(HumanBodyParams::DefaultUpperBody());
+  constexpr int kActions = 10, kSteps = 15, kWaypoints = 30;
+  const double dt = 0.1;  // s between prediction steps
+
+  // A person standing `distance` in front of the robot; each action moves the
+  // right hand towards a different point, uncertainty growing with time.
+  const Eigen::Vector3d pelvis(distance, 0.0, 0.0);
+  const std::vector<Eigen::Vector3d> rest = {
+      {0.0, 0.0, 1.65}, {0.0, 0.0, 1.45}, {0.0, 0.0, 1.05},   {0.0, 0.2, 1.40}, {0.0, 0.25, 1.12},
+      {0.0, 0.27, 0.85}, {0.0, -0.2, 1.40}, {0.0, -0.25, 1.12}, {0.0, -0.27, 0.85}};
+  HumanPrediction prediction = body.MakePrediction(kActions, kSteps);
+  Eigen::Matrix3Xd means(3, 9);
+  std::vector<Eigen::Matrix3d> covs(9);
+  auto fill_prediction = [&] {
+    for (int c = 0; c < kActions; ++c) {
+      prediction.set_action_probability(c, (c + 1.0) / (kActions * (kActions + 1) / 2.0));
+      const double angle = 3.14159265358979 * (0.5 + c / (kActions - 1.0));
+      const Eigen::Vector3d target =
+          reach_into_path
+              ? Eigen::Vector3d(0.35 + 0.1 * std::cos(angle), 0.4 * std::sin(angle), 0.55)
+              : Eigen::Vector3d(pelvis + Eigen::Vector3d(0.5 * std::cos(angle),
+                                                         0.5 * std::sin(angle), 0.9));
+      for (int t = 0; t < kSteps; ++t) {
+        const double s = static_cast<double>(t) / (kSteps - 1);
+        for (int j = 0; j < 9; ++j) {
+          means.col(j) = pelvis + rest[j];
+          const double sd = 0.02 + 0.01 * t * dt * 10.0 / kSteps * (j >= 6 ? 3.0 : 1.0);
+          // Anisotropic: more uncertainty horizontally than vertically.
+          covs[j] = Eigen::Vector3d(sd * sd, sd * sd, 0.25 * sd * sd).asDiagonal();
+        }
+        means.col(8) = (1 - s) * means.col(8) + s * target;
+        means.col(7) = (1 - 0.5 * s) * means.col(7) + 0.5 * s * target;
+        body.FillPrediction(means, covs, c, t, &prediction);
+      }
+    }
+    prediction.UpdateSummaries();
+  };
+  fill_prediction();
+
+  // Trajectory: the arm swings from one side to the other in front of it.
+  Eigen::VectorXd q0(7), q1(7);
+  q0 << -1.2, 0.3, 0.0, -1.8, 0.0, 2.0, 0.8;
+  q1 << 1.2, 0.5, 0.0, -1.5, 0.0, 2.0, 0.8;
+  std::vector<Eigen::VectorXd> qs(kWaypoints);
+  for (int w = 0; w < kWaypoints; ++w) {
+    qs[w] = q0 + (q1 - q0) * (static_cast<double>(w) / (kWaypoints - 1));
+  }
+  RobotData data(robot);
+  RobotSpheresTrajectory traj;
+  const int S = static_cast<int>(robot.spheres.size());
+  for (const CollisionSphere& s : robot.spheres) {
+    traj.radii.push_back(s.radius);
+    traj.links.push_back(s.link);
+  }
+  traj.centres.resize(3, static_cast<Eigen::Index>(kWaypoints) * S);
+  traj.steps.resize(kWaypoints);
+  auto fill_trajectory = [&] {
+    for (int w = 0; w < kWaypoints; ++w) {
+      CalcForwardKinematics(robot, qs[w], &data);
+      traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data.p_WS;
+      traj.steps[w] = (w * kSteps) / kWaypoints;
+    }
+  };
+  fill_trajectory();
+
+  TrajectoryBoundWorkspace ws(S, body.num_spheres());
+  std::vector<WaypointBound> out(kWaypoints);
+  TrajectoryBoundParams params;
+  EvaluateTrajectoryBound(prediction, traj, params, &ws, &out);
+  double max_bound = 0.0;
+  long evaluated = 0, pruned = 0;
+  int argmax_w = 0;
+  for (int w = 0; w < kWaypoints; ++w) {
+    if (out[w].bound > max_bound) {
+      max_bound = out[w].bound;
+      argmax_w = w;
+    }
+    evaluated += out[w].pairs_evaluated;
+    pruned += out[w].pairs_pruned;
+  }
+  // Same without pruning (negligible = 0 and a brute-force loop) for reference.
+  auto brute = [&] {
+    volatile double s = 0.0;
+    for (int w = 0; w < kWaypoints; ++w) {
+      for (int k = 0; k < S; ++k) {
+        for (int l = 0; l < body.num_spheres(); ++l) {
+          s = s + EvaluateMixtureBound(prediction, traj.steps[w], l,
+                                       traj.centres.col(static_cast<Eigen::Index>(w) * S + k),
+                                       traj.radii[k]);
+        }
+      }
+    }
+  };
+
+  constexpr int kReps = 21;
+  const Stats eval = Measure([&] { EvaluateTrajectoryBound(prediction, traj, params, &ws, &out); },
+                             1.0, kReps, 0.2);
+  const double eval_wall = g_last_wall_median;
+  const Stats full = Measure(
+      [&] {
+        fill_trajectory();
+        fill_prediction();
+        EvaluateTrajectoryBound(prediction, traj, params, &ws, &out);
+      },
+      1.0, kReps, 0.2);
+  const double full_wall = g_last_wall_median;
+  const Stats unpruned = Measure(brute, 1.0, 5, 0.3);
+  const double unpruned_wall = g_last_wall_median;
+
+  std::printf("\n== Trajectory bound, %s: Panda (%d spheres) x %d waypoints vs %d actions x "
+              "%d steps x %d human spheres\n",
+              scenario, S, kWaypoints, kActions, kSteps, body.num_spheres());
+  std::printf("   workload: %d pair checks, %ld evaluated exactly (x %d actions), %ld pruned; "
+              "max bound %.3e at waypoint %d\n",
+              kWaypoints * S * body.num_spheres(), evaluated, kActions, pruned, max_bound,
+              argmax_w);
+  std::printf("   (thread CPU time per call; wall-clock median in brackets)\n");
+  auto line = [](const char* name, const Stats& s, double wall) {
+    std::printf("   %-52s median %7.3f ms  (min %.3f, max %.3f) [wall %.3f ms]\n", name,
+                1e3 * s.median, 1e3 * s.min, 1e3 * s.max, 1e3 * wall);
+  };
+  line("EvaluateTrajectoryBound (prediction prepared)", eval, eval_wall);
+  line("FK 30 waypoints + factorise 2400 Gaussians + evaluate", full, full_wall);
+  line("unpruned brute force (reference)", unpruned, unpruned_wall);
+}
+
+}  // namespace
+}  // namespace iplan::collision
+
+int main() {
+  std::printf("iplan collision benchmarks (single thread)\n\n");
+  iplan::collision::PairBenchmark();
+  iplan::collision::TrajectoryBenchmark(0.75, false, "person 0.75 m in front of the base");
+  iplan::collision::TrajectoryBenchmark(0.6, true, "person 0.6 m away, hand reaching into the path");
+  return 0;
+}

@@ -1,0 +1,175 @@
+#include "iplan/collision/human_model.h"
+
+#include <algorithm>
+#include <cmath>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "check.h"
+
+namespace iplan::collision {
+namespace {
+
+int IndexOf(const std::vector<std::string>& v, const std::string& s) {
+  auto it = std::find(v.begin(), v.end(), s);
+  return it == v.end() ? -1 : static_cast<int>(it - v.begin());
+}
+
+}  // namespace
+
+std::string HumanBodyParams::Validate() const {
+  std::ostringstream msg;
+  if (joints.empty()) return "no joints";
+  std::set<std::string> seen;
+  for (const std::string& j : joints) {
+    if (!seen.insert(j).second) return "joint '" + j + "' listed twice";
+  }
+  if (segments.empty()) return "no segments";
+  for (size_t i = 0; i < segments.size(); ++i) {
+    const HumanSegmentParams& s = segments[i];
+    const std::string where = "segment " + std::to_string(i) + " ('" + s.name + "')";
+    if (IndexOf(joints, s.joint_a) < 0) return where + ": unknown joint '" + s.joint_a + "'";
+    if (IndexOf(joints, s.joint_b) < 0) return where + ": unknown joint '" + s.joint_b + "'";
+    if (s.count < 1) {
+      msg << where << ": count = " << s.count << " must be >= 1";
+      return msg.str();
+    }
+    if (!(s.radius > 0.0) || !std::isfinite(s.radius)) {
+      msg << where << ": radius = " << s.radius << " must be positive";
+      return msg.str();
+    }
+    if (!s.u.empty() && static_cast<int>(s.u.size()) != s.count) {
+      msg << where << ": " << s.u.size() << " values of u for count = " << s.count;
+      return msg.str();
+    }
+    for (double u : s.u) {
+      if (!(u >= 0.0 && u <= 1.0)) {
+        msg << where << ": u = " << u << " must be in [0, 1]";
+        return msg.str();
+      }
+    }
+  }
+  return {};
+}
+
+HumanBodyParams HumanBodyParams::DefaultUpperBody() {
+  HumanBodyParams p;
+  p.joints = {"head",          "neck",        "torso",      "shoulder_left", "elbow_left",
+              "hand_left",     "shoulder_right", "elbow_right", "hand_right"};
+  p.segments = {
+      {"head", "head", "neck", 2, 0.12, {}},
+      {"trunk", "neck", "torso", 2, 0.17, {}},
+      {"shoulder_left", "neck", "shoulder_left", 2, 0.08, {}},
+      {"upper_arm_left", "shoulder_left", "elbow_left", 2, 0.07, {}},
+      {"forearm_left", "elbow_left", "hand_left", 2, 0.06, {0.25, 1.0}},
+      {"shoulder_right", "neck", "shoulder_right", 2, 0.08, {}},
+      {"upper_arm_right", "shoulder_right", "elbow_right", 2, 0.07, {}},
+      {"forearm_right", "elbow_right", "hand_right", 2, 0.06, {0.25, 1.0}},
+  };
+  return p;
+}
+
+HumanBodyParams LoadHumanBodyParams(const std::string& path) {
+  auto fail = [&](const std::string& what) -> void {
+    throw std::runtime_error(path + ": " + what);
+  };
+  HumanBodyParams p;
+  try {
+    const YAML::Node root = YAML::LoadFile(path);
+    if (!root.IsMap()) fail("top level must be a map");
+    for (const auto& kv : root) {
+      const std::string key = kv.first.as<std::string>();
+      if (key != "joints" && key != "segments") fail("unknown key '" + key + "' at the top level");
+    }
+    if (!root["joints"] || !root["joints"].IsSequence()) fail("'joints' must be a list of names");
+    for (const auto& j : root["joints"]) p.joints.push_back(j.as<std::string>());
+    if (!root["segments"] || !root["segments"].IsSequence()) fail("'segments' must be a list");
+    for (size_t i = 0; i < root["segments"].size(); ++i) {
+      const YAML::Node n = root["segments"][i];
+      const std::string where = "segments[" + std::to_string(i) + "]";
+      if (!n.IsMap()) fail(where + " must be a map");
+      for (const auto& kv : n) {
+        const std::string key = kv.first.as<std::string>();
+        static const std::set<std::string> kAllowed = {"name",  "joint_a", "joint_b",
+                                                       "count", "radius",  "u"};
+        if (kAllowed.count(key) == 0) fail("unknown key '" + key + "' in " + where);
+      }
+      HumanSegmentParams s;
+      for (const char* key : {"name", "joint_a", "joint_b", "count", "radius"}) {
+        if (!n[key]) fail("missing key '" + std::string(key) + "' in " + where);
+      }
+      s.name = n["name"].as<std::string>();
+      s.joint_a = n["joint_a"].as<std::string>();
+      s.joint_b = n["joint_b"].as<std::string>();
+      s.count = n["count"].as<int>();
+      s.radius = n["radius"].as<double>();
+      if (n["u"]) s.u = n["u"].as<std::vector<double>>();
+      p.segments.push_back(s);
+    }
+  } catch (const YAML::Exception& e) {
+    fail(std::string("invalid YAML: ") + e.what());
+  }
+  if (const std::string why = p.Validate(); !why.empty()) fail(why);
+  return p;
+}
+
+HumanBodyModel::HumanBodyModel(HumanBodyParams params) : params_(std::move(params)) {
+  if (const std::string why = params_.Validate(); !why.empty()) {
+    throw std::invalid_argument("HumanBodyParams: " + why);
+  }
+  for (size_t i = 0; i < params_.segments.size(); ++i) {
+    const HumanSegmentParams& s = params_.segments[i];
+    for (int k = 0; k < s.count; ++k) {
+      const double u = s.u.empty() ? (k + 0.5) / s.count : s.u[k];
+      spheres_.push_back({static_cast<int>(i), IndexOf(params_.joints, s.joint_a),
+                          IndexOf(params_.joints, s.joint_b), u, s.radius});
+    }
+  }
+}
+
+std::vector<double> HumanBodyModel::Radii() const {
+  std::vector<double> r;
+  for (const SphereDef& s : spheres_) r.push_back(s.radius);
+  return r;
+}
+
+std::vector<int> HumanBodyModel::Segments() const {
+  std::vector<int> r;
+  for (const SphereDef& s : spheres_) r.push_back(s.segment);
+  return r;
+}
+
+void HumanBodyModel::CalcSphereGaussian(int sphere, const Eigen::Matrix3Xd& joint_means,
+                                        const std::vector<Eigen::Matrix3d>& joint_covs,
+                                        Eigen::Vector3d* mean, Eigen::Matrix3d* cov) const {
+  IPLAN_COLLISION_DEMAND(joint_means.cols() == num_joints());
+  IPLAN_COLLISION_DEMAND(static_cast<int>(joint_covs.size()) == num_joints());
+  const SphereDef& s = spheres_[sphere];
+  const double a = 1.0 - s.u;
+  const double b = s.u;
+  *mean = a * joint_means.col(s.joint_a) + b * joint_means.col(s.joint_b);
+  *cov = (a * a) * joint_covs[s.joint_a] + (b * b) * joint_covs[s.joint_b];
+}
+
+bool HumanBodyModel::FillPrediction(const Eigen::Matrix3Xd& joint_means,
+                                    const std::vector<Eigen::Matrix3d>& joint_covs, int action,
+                                    int step, HumanPrediction* prediction) const {
+  IPLAN_COLLISION_DEMAND(prediction->num_spheres() == num_spheres());
+  bool ok = true;
+  Eigen::Vector3d mean;
+  Eigen::Matrix3d cov;
+  for (int i = 0; i < num_spheres(); ++i) {
+    CalcSphereGaussian(i, joint_means, joint_covs, &mean, &cov);
+    ok = prediction->SetSphere(action, step, i, mean, cov) && ok;
+  }
+  return ok;
+}
+
+HumanPrediction HumanBodyModel::MakePrediction(int num_actions, int num_steps) const {
+  return HumanPrediction(num_actions, num_steps, Radii(), Segments());
+}
+
+}  // namespace iplan::collision

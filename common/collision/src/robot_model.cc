@@ -1,0 +1,501 @@
+#include "iplan/collision/robot_model.h"
+
+#include <cmath>
+#include <functional>
+#include <limits>
+#include <set>
+#include <sstream>
+#include <stdexcept>
+
+#include <urdf_parser/urdf_parser.h>
+#include <yaml-cpp/yaml.h>
+
+#include "check.h"
+
+namespace iplan::collision {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+
+[[noreturn]] void Fail(const std::string& path, const std::string& what) {
+  throw std::runtime_error(path + ": " + what);
+}
+
+Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.translation() = Eigen::Vector3d(pose.position.x, pose.position.y, pose.position.z);
+  Eigen::Quaterniond q(pose.rotation.w, pose.rotation.x, pose.rotation.y, pose.rotation.z);
+  X.linear() = q.normalized().toRotationMatrix();
+  return X;
+}
+
+// Adds the spheres of a list (frame = link `link`) with contained ones removed.
+void AddLinkSpheres(int link, std::vector<Sphere> spheres, bool remove_contained,
+                    RobotModel* model) {
+  if (remove_contained) RemoveContainedSpheres(&spheres);
+  for (const Sphere& s : spheres) model->spheres.push_back({link, s.centre, s.radius});
+}
+
+void Finalize(const RobotModelOptions& options, const std::string& path, RobotModel* model) {
+  // Locked joints become fixed at their value; then number the q variables.
+  std::set<std::string> unknown;
+  for (const auto& [name, value] : options.locked_joints) unknown.insert(name);
+  for (Joint& j : model->joints) {
+    auto it = options.locked_joints.find(j.name);
+    if (it == options.locked_joints.end()) continue;
+    unknown.erase(j.name);
+    if (j.type == JointType::kRevolute) {
+      j.X_PJ = j.X_PJ * Eigen::AngleAxisd(it->second, j.axis);
+    } else if (j.type == JointType::kPrismatic) {
+      j.X_PJ = j.X_PJ * Eigen::Translation3d(it->second * j.axis);
+    }
+    j.type = JointType::kFixed;
+    j.mimic_q_index = -1;
+  }
+  if (!unknown.empty()) Fail(path, "locked joint '" + *unknown.begin() + "' does not exist");
+  // Mimic joints were recorded with their master's joint index in
+  // mimic_q_index; translate to q indices now.
+  model->nq = 0;
+  model->q_joints.clear();
+  for (size_t j = 0; j < model->joints.size(); ++j) {
+    Joint& joint = model->joints[j];
+    joint.q_index = -1;
+    if (joint.type != JointType::kFixed && joint.mimic_q_index < 0) {
+      joint.q_index = model->nq++;
+      model->q_joints.push_back(static_cast<int>(j));
+    }
+  }
+  for (Joint& joint : model->joints) {
+    if (joint.type == JointType::kFixed || joint.mimic_q_index < 0) continue;
+    const Joint& master = model->joints[joint.mimic_q_index];
+    if (master.q_index < 0) {
+      // Master locked or itself a mimic: freeze this joint at the master's value.
+      Fail(path, "mimic joint '" + joint.name + "' follows '" + master.name +
+                     "', which is not a free joint (lock both or neither)");
+    }
+    joint.mimic_q_index = master.q_index;
+  }
+}
+
+}  // namespace
+
+int RobotModel::FindLink(const std::string& n) const {
+  for (size_t i = 0; i < link_names.size(); ++i) {
+    if (link_names[i] == n) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int RobotModel::FindJoint(const std::string& n) const {
+  for (size_t i = 0; i < joints.size(); ++i) {
+    if (joints[i].name == n) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+Eigen::VectorXd RobotModel::LowerLimits() const {
+  Eigen::VectorXd v(nq);
+  for (int i = 0; i < nq; ++i) v[i] = joints[q_joints[i]].limits.lower;
+  return v;
+}
+
+Eigen::VectorXd RobotModel::UpperLimits() const {
+  Eigen::VectorXd v(nq);
+  for (int i = 0; i < nq; ++i) v[i] = joints[q_joints[i]].limits.upper;
+  return v;
+}
+
+RobotData::RobotData(const RobotModel& model)
+    : X_WL(model.link_names.size(), Eigen::Isometry3d::Identity()),
+      p_WS(3, static_cast<Eigen::Index>(model.spheres.size())) {
+  p_WS.setZero();
+}
+
+void CalcForwardKinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                           RobotData* data) {
+  IPLAN_COLLISION_DEMAND(data != nullptr && q.size() == model.nq);
+  IPLAN_COLLISION_DEMAND(data->X_WL.size() == model.link_names.size());
+  IPLAN_COLLISION_DEMAND(data->p_WS.cols() == static_cast<Eigen::Index>(model.spheres.size()));
+  data->X_WL[0].setIdentity();
+  for (const Joint& j : model.joints) {
+    const Eigen::Isometry3d& X_WP = data->X_WL[j.parent_link];
+    Eigen::Isometry3d& X_WC = data->X_WL[j.child_link];
+    double value = 0.0;
+    if (j.q_index >= 0) {
+      value = q[j.q_index];
+    } else if (j.mimic_q_index >= 0) {
+      value = j.mimic_multiplier * q[j.mimic_q_index] + j.mimic_offset;
+    }
+    switch (j.type) {
+      case JointType::kFixed:
+        X_WC = X_WP * j.X_PJ;
+        break;
+      case JointType::kRevolute:
+        X_WC = X_WP * j.X_PJ * Eigen::AngleAxisd(value, j.axis);
+        break;
+      case JointType::kPrismatic:
+        X_WC = X_WP * j.X_PJ * Eigen::Translation3d(value * j.axis);
+        break;
+    }
+  }
+  for (size_t s = 0; s < model.spheres.size(); ++s) {
+    const CollisionSphere& cs = model.spheres[s];
+    data->p_WS.col(static_cast<Eigen::Index>(s)) = data->X_WL[cs.link] * cs.p_LS;
+  }
+}
+
+RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptions& options) {
+  if (const std::string why = options.cover.Validate(); !why.empty()) Fail(path, why);
+  const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDFFile(path);
+  if (!urdf) Fail(path, "cannot read or parse the URDF file");
+  const urdf::LinkConstSharedPtr root = urdf->getRoot();
+  if (!root) Fail(path, "URDF has no root link");
+
+  RobotModel model;
+  model.name = urdf->getName();
+  // Depth-first, parents before children; joint j's child is link j + 1.
+  std::vector<urdf::LinkConstSharedPtr> links;
+  std::function<void(const urdf::LinkConstSharedPtr&)> visit =
+      [&](const urdf::LinkConstSharedPtr& link) {
+        links.push_back(link);
+        for (const urdf::LinkSharedPtr& child : link->child_links) visit(child);
+      };
+  visit(root);
+  for (const auto& link : links) model.link_names.push_back(link->name);
+  model.link_parent_joint.assign(links.size(), -1);
+
+  std::vector<std::string> mimic_master(links.size());
+  for (size_t i = 1; i < links.size(); ++i) {
+    const urdf::JointConstSharedPtr uj = links[i]->parent_joint;
+    Joint j;
+    j.name = uj->name;
+    j.parent_link = model.FindLink(uj->parent_link_name);
+    j.child_link = static_cast<int>(i);
+    j.X_PJ = ToIsometry(uj->parent_to_joint_origin_transform);
+    j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
+    switch (uj->type) {
+      case urdf::Joint::FIXED:
+        j.type = JointType::kFixed;
+        break;
+      case urdf::Joint::REVOLUTE:
+      case urdf::Joint::CONTINUOUS:
+        j.type = JointType::kRevolute;
+        break;
+      case urdf::Joint::PRISMATIC:
+        j.type = JointType::kPrismatic;
+        break;
+      default:
+        Fail(path, "joint '" + j.name + "' has an unsupported type (" +
+                       std::to_string(static_cast<int>(uj->type)) +
+                       "); only fixed, revolute, continuous and prismatic are supported");
+    }
+    if (j.type != JointType::kFixed) {
+      const double n = j.axis.norm();
+      if (!(n > 0.0)) Fail(path, "joint '" + j.name + "' has a zero axis");
+      j.axis /= n;
+      j.limits.acceleration = options.default_acceleration;
+      j.limits.jerk = options.default_jerk;
+      if (uj->type == urdf::Joint::CONTINUOUS || !uj->limits) {
+        j.limits.lower = -std::numeric_limits<double>::infinity();
+        j.limits.upper = std::numeric_limits<double>::infinity();
+      } else {
+        j.limits.lower = uj->limits->lower;
+        j.limits.upper = uj->limits->upper;
+      }
+      j.limits.velocity = uj->limits ? uj->limits->velocity
+                                     : std::numeric_limits<double>::infinity();
+      if (uj->mimic) {
+        j.mimic_multiplier = uj->mimic->multiplier;
+        j.mimic_offset = uj->mimic->offset;
+        mimic_master[i] = uj->mimic->joint_name;
+      }
+    }
+    model.link_parent_joint[i] = static_cast<int>(model.joints.size());
+    model.joints.push_back(j);
+  }
+  for (size_t i = 1; i < links.size(); ++i) {
+    if (mimic_master[i].empty()) continue;
+    Joint& j = model.joints[model.link_parent_joint[i]];
+    j.mimic_q_index = model.FindJoint(mimic_master[i]);
+    if (j.mimic_q_index < 0) {
+      Fail(path, "mimic joint '" + j.name + "' follows unknown joint '" + mimic_master[i] + "'");
+    }
+  }
+
+  // Collision shapes -> spheres.
+  for (size_t i = 0; i < links.size(); ++i) {
+    std::vector<Sphere> spheres;
+    for (const urdf::CollisionSharedPtr& col : links[i]->collision_array) {
+      if (!col || !col->geometry) continue;
+      const Eigen::Isometry3d X_LG = ToIsometry(col->origin);
+      ShapeCoverEntry entry;
+      entry.link = links[i]->name;
+      std::vector<Sphere> cover;
+      switch (col->geometry->type) {
+        case urdf::Geometry::SPHERE: {
+          const double r = static_cast<const urdf::Sphere&>(*col->geometry).radius;
+          if (!(r > 0.0)) {
+            Fail(path, "link '" + entry.link + "': sphere radius " + std::to_string(r));
+          }
+          cover.push_back({X_LG.translation(), r});
+          entry.cover.shape = "sphere";
+          entry.cover.num_spheres = 1;
+          entry.cover.shape_volume = 4.0 / 3.0 * kPi * r * r * r;
+          break;
+        }
+        case urdf::Geometry::CYLINDER: {
+          const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
+          try {
+            cover = CoverCylinder(c.radius, c.length, X_LG, options.cover, &entry.cover);
+          } catch (const std::invalid_argument& e) {
+            Fail(path, "link '" + entry.link + "': " + e.what());
+          }
+          break;
+        }
+        case urdf::Geometry::BOX: {
+          const auto& b = static_cast<const urdf::Box&>(*col->geometry);
+          try {
+            cover = CoverBox(0.5 * Eigen::Vector3d(b.dim.x, b.dim.y, b.dim.z), X_LG,
+                             options.cover, &entry.cover);
+          } catch (const std::invalid_argument& e) {
+            Fail(path, "link '" + entry.link + "': " + e.what());
+          }
+          break;
+        }
+        case urdf::Geometry::MESH:
+          if (options.ignore_mesh_collisions) continue;
+          Fail(path, "link '" + entry.link +
+                         "' has a mesh collision shape; meshes are not supported "
+                         "(replace by primitives or set ignore_mesh_collisions)");
+      }
+      spheres.insert(spheres.end(), cover.begin(), cover.end());
+      model.cover_report.push_back(entry);
+    }
+    AddLinkSpheres(static_cast<int>(i), std::move(spheres), options.remove_contained_spheres,
+                   &model);
+  }
+  Finalize(options, path, &model);
+  return model;
+}
+
+// ---------------------------------------------------------------------------
+// YAML (modified DH).
+namespace {
+
+void CheckKeys(const YAML::Node& node, const std::set<std::string>& allowed,
+               const std::string& where, const std::string& path) {
+  if (!node.IsMap()) Fail(path, where + " must be a map");
+  for (const auto& kv : node) {
+    const std::string key = kv.first.as<std::string>();
+    if (allowed.count(key) == 0) Fail(path, "unknown key '" + key + "' in " + where);
+  }
+}
+
+double GetDouble(const YAML::Node& node, const std::string& key, const std::string& where,
+                 const std::string& path, const double* fallback = nullptr) {
+  const YAML::Node v = node[key];
+  if (!v) {
+    if (fallback != nullptr) return *fallback;
+    Fail(path, "missing key '" + key + "' in " + where);
+  }
+  double x = 0.0;
+  try {
+    x = v.as<double>();
+  } catch (const YAML::Exception&) {
+    Fail(path, "key '" + key + "' in " + where + " is not a number: '" + v.as<std::string>("?") + "'");
+  }
+  if (!std::isfinite(x)) Fail(path, "key '" + key + "' in " + where + " is not finite");
+  return x;
+}
+
+std::string GetString(const YAML::Node& node, const std::string& key, const std::string& where,
+                      const std::string& path) {
+  const YAML::Node v = node[key];
+  if (!v || !v.IsScalar()) Fail(path, "missing or non-scalar key '" + key + "' in " + where);
+  return v.as<std::string>();
+}
+
+Eigen::Vector3d GetVector3(const YAML::Node& node, const std::string& key,
+                           const std::string& where, const std::string& path) {
+  const YAML::Node v = node[key];
+  if (!v || !v.IsSequence() || v.size() != 3) {
+    Fail(path, "key '" + key + "' in " + where + " must be a list of 3 numbers");
+  }
+  Eigen::Vector3d out;
+  for (int i = 0; i < 3; ++i) {
+    try {
+      out[i] = v[i].as<double>();
+    } catch (const YAML::Exception&) {
+      Fail(path, "key '" + key + "' in " + where + " must be a list of 3 numbers");
+    }
+  }
+  if (!out.allFinite()) Fail(path, "key '" + key + "' in " + where + " is not finite");
+  return out;
+}
+
+// Modified DH: RotX(alpha) TransX(a) RotZ(theta) TransZ(d).
+Eigen::Isometry3d ModifiedDh(double a, double d, double alpha, double theta) {
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.rotate(Eigen::AngleAxisd(alpha, Eigen::Vector3d::UnitX()));
+  X.translate(Eigen::Vector3d(a, 0, 0));
+  X.rotate(Eigen::AngleAxisd(theta, Eigen::Vector3d::UnitZ()));
+  X.translate(Eigen::Vector3d(0, 0, d));
+  return X;
+}
+
+}  // namespace
+
+RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptions& options) {
+  if (const std::string why = options.cover.Validate(); !why.empty()) Fail(path, why);
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    Fail(path, std::string("cannot read YAML: ") + e.what());
+  }
+  CheckKeys(root, {"name", "convention", "base_link", "joints", "fixed_frames", "spheres",
+                   "capsules", "boxes"},
+            "the top level", path);
+  if (GetString(root, "convention", "the top level", path) != "modified_dh") {
+    Fail(path, "convention '" + root["convention"].as<std::string>() +
+                   "' is not supported (only 'modified_dh')");
+  }
+  RobotModel model;
+  model.name = GetString(root, "name", "the top level", path);
+  model.link_names.push_back(GetString(root, "base_link", "the top level", path));
+  model.link_parent_joint.push_back(-1);
+
+  auto add_frame = [&](const YAML::Node& n, const std::string& where, bool movable) {
+    Joint j;
+    const std::string link = GetString(n, "link", where, path);
+    if (model.FindLink(link) >= 0) Fail(path, "link '" + link + "' defined twice");
+    const double zero = 0.0;
+    j.name = n["name"] ? GetString(n, "name", where, path) : link + "_fixed";
+    if (n["parent"]) {
+      j.parent_link = model.FindLink(GetString(n, "parent", where, path));
+      if (j.parent_link < 0) {
+        Fail(path, "parent '" + n["parent"].as<std::string>() + "' of " + where + " is unknown");
+      }
+    } else {
+      j.parent_link = static_cast<int>(model.link_names.size()) - 1;
+    }
+    j.X_PJ = ModifiedDh(GetDouble(n, "a", where, path), GetDouble(n, "d", where, path),
+                        GetDouble(n, "alpha", where, path),
+                        GetDouble(n, "theta", where, path, &zero));
+    j.axis = Eigen::Vector3d::UnitZ();
+    if (movable) {
+      const std::string type = n["type"] ? GetString(n, "type", where, path) : "revolute";
+      if (type == "revolute") {
+        j.type = JointType::kRevolute;
+      } else if (type == "prismatic") {
+        j.type = JointType::kPrismatic;
+        // DH prismatic joints translate along z after the offset d.
+      } else {
+        Fail(path, "type '" + type + "' of " + where + " must be revolute or prismatic");
+      }
+      j.limits.lower = GetDouble(n, "lower", where, path);
+      j.limits.upper = GetDouble(n, "upper", where, path);
+      j.limits.velocity = GetDouble(n, "velocity", where, path);
+      j.limits.acceleration =
+          GetDouble(n, "acceleration", where, path, &options.default_acceleration);
+      j.limits.jerk = GetDouble(n, "jerk", where, path, &options.default_jerk);
+      if (!(j.limits.lower < j.limits.upper) || !(j.limits.velocity > 0) ||
+          !(j.limits.acceleration > 0) || !(j.limits.jerk > 0)) {
+        std::ostringstream msg;
+        msg << where << ": invalid limits lower=" << j.limits.lower
+            << " upper=" << j.limits.upper << " velocity=" << j.limits.velocity
+            << " acceleration=" << j.limits.acceleration << " jerk=" << j.limits.jerk;
+        Fail(path, msg.str());
+      }
+    }
+    j.child_link = static_cast<int>(model.link_names.size());
+    model.link_names.push_back(link);
+    model.link_parent_joint.push_back(static_cast<int>(model.joints.size()));
+    model.joints.push_back(j);
+  };
+
+  const YAML::Node joints = root["joints"];
+  if (!joints || !joints.IsSequence() || joints.size() == 0) {
+    Fail(path, "'joints' must be a non-empty list");
+  }
+  for (size_t i = 0; i < joints.size(); ++i) {
+    const std::string where = "joints[" + std::to_string(i) + "]";
+    CheckKeys(joints[i], {"name", "link", "parent", "type", "a", "d", "alpha", "theta",
+                          "lower", "upper", "velocity", "acceleration", "jerk"},
+              where, path);
+    add_frame(joints[i], where, true);
+  }
+  if (const YAML::Node frames = root["fixed_frames"]) {
+    for (size_t i = 0; i < frames.size(); ++i) {
+      const std::string where = "fixed_frames[" + std::to_string(i) + "]";
+      CheckKeys(frames[i], {"name", "link", "parent", "a", "d", "alpha", "theta"}, where, path);
+      add_frame(frames[i], where, false);
+    }
+  }
+
+  std::vector<std::vector<Sphere>> per_link(model.link_names.size());
+  auto link_of = [&](const YAML::Node& n, const std::string& where) {
+    const int l = model.FindLink(GetString(n, "link", where, path));
+    if (l < 0) Fail(path, "link '" + n["link"].as<std::string>() + "' of " + where + " is unknown");
+    return l;
+  };
+  auto add_cover = [&](int link, std::vector<Sphere> cover, const CoverReport& report) {
+    per_link[link].insert(per_link[link].end(), cover.begin(), cover.end());
+    model.cover_report.push_back({model.link_names[link], report});
+  };
+  if (const YAML::Node list = root["spheres"]) {
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "spheres[" + std::to_string(i) + "]";
+      CheckKeys(list[i], {"link", "centre", "radius"}, where, path);
+      const int l = link_of(list[i], where);
+      const double r = GetDouble(list[i], "radius", where, path);
+      if (!(r > 0)) Fail(path, where + ": radius " + std::to_string(r) + " must be positive");
+      CoverReport rep;
+      rep.shape = "sphere";
+      rep.num_spheres = 1;
+      rep.shape_volume = 4.0 / 3.0 * kPi * r * r * r;
+      add_cover(l, {{GetVector3(list[i], "centre", where, path), r}}, rep);
+    }
+  }
+  if (const YAML::Node list = root["capsules"]) {
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "capsules[" + std::to_string(i) + "]";
+      CheckKeys(list[i], {"link", "p1", "p2", "radius"}, where, path);
+      const int l = link_of(list[i], where);
+      CoverReport rep;
+      try {
+        auto cover = CoverCapsule(GetVector3(list[i], "p1", where, path),
+                                  GetVector3(list[i], "p2", where, path),
+                                  GetDouble(list[i], "radius", where, path), options.cover, &rep);
+        add_cover(l, std::move(cover), rep);
+      } catch (const std::invalid_argument& e) {
+        Fail(path, where + ": " + e.what());
+      }
+    }
+  }
+  if (const YAML::Node list = root["boxes"]) {
+    for (size_t i = 0; i < list.size(); ++i) {
+      const std::string where = "boxes[" + std::to_string(i) + "]";
+      CheckKeys(list[i], {"link", "centre", "half_extents"}, where, path);
+      const int l = link_of(list[i], where);
+      CoverReport rep;
+      Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
+      X_LB.translation() = GetVector3(list[i], "centre", where, path);
+      try {
+        auto cover = CoverBox(GetVector3(list[i], "half_extents", where, path), X_LB,
+                              options.cover, &rep);
+        add_cover(l, std::move(cover), rep);
+      } catch (const std::invalid_argument& e) {
+        Fail(path, where + ": " + e.what());
+      }
+    }
+  }
+  for (size_t l = 0; l < per_link.size(); ++l) {
+    AddLinkSpheres(static_cast<int>(l), std::move(per_link[l]), options.remove_contained_spheres,
+                   &model);
+  }
+  Finalize(options, path, &model);
+  return model;
+}
+
+}  // namespace iplan::collision

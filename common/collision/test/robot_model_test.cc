@@ -1,0 +1,341 @@
+#include "iplan/collision/robot_model.h"
+
+#include <cmath>
+#include <fstream>
+#include <functional>
+#include <random>
+#include <string>
+
+#include <gtest/gtest.h>
+#include <urdf_parser/urdf_parser.h>
+
+
+#include "alloc_counter.h"
+
+#include "iplan/collision/sphere_cover.h"
+
+namespace iplan::collision {
+namespace {
+
+const std::string kUrdf = std::string(IPLAN_SHARED_DIR) + "/robots/panda/panda_collision.urdf";
+const std::string kYaml = std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml";
+constexpr double kPi = 3.14159265358979323846;
+
+Eigen::Vector3d RandomUnit(std::mt19937_64* rng) {
+  std::normal_distribution<double> n01;
+  return Eigen::Vector3d(n01(*rng), n01(*rng), n01(*rng)).normalized();
+}
+
+// Random points of a cylinder (radius rho, length L, axis z, centred): half
+// in the volume, half on the surface, including the rims (worst case for a
+// sphere chain).
+std::vector<Eigen::Vector3d> SampleCylinder(double rho, double L, int n, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < n; ++i) {
+    const double th = 2 * kPi * u01(*rng);
+    double a = rho * std::sqrt(u01(*rng));
+    double z = L * (u01(*rng) - 0.5);
+    switch (i % 4) {
+      case 1: a = rho; break;                                   // side
+      case 2: z = u01(*rng) < 0.5 ? -0.5 * L : 0.5 * L; break;  // caps
+      case 3: a = rho; z = u01(*rng) < 0.5 ? -0.5 * L : 0.5 * L; break;  // rims
+      default: break;
+    }
+    pts.emplace_back(a * std::cos(th), a * std::sin(th), z);
+  }
+  return pts;
+}
+
+std::vector<Eigen::Vector3d> SampleBall(double r, int n, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < n; ++i) {
+    const double rr = i % 2 == 0 ? r : r * std::cbrt(u01(*rng));
+    pts.push_back(rr * RandomUnit(rng));
+  }
+  return pts;
+}
+
+std::vector<Eigen::Vector3d> SampleBox(const Eigen::Vector3d& h, int n, std::mt19937_64* rng) {
+  std::uniform_real_distribution<double> u11(-1.0, 1.0);
+  std::vector<Eigen::Vector3d> pts;
+  for (int i = 0; i < n; ++i) {
+    Eigen::Vector3d p(u11(*rng), u11(*rng), u11(*rng));
+    if (i % 2 == 1) p[i % 3] = p[i % 3] < 0 ? -1.0 : 1.0;          // faces
+    if (i % 8 == 7) p = p.cwiseSign();                             // corners
+    pts.push_back(p.cwiseProduct(h));
+  }
+  return pts;
+}
+
+bool Covered(const std::vector<Sphere>& spheres, const Eigen::Vector3d& p, double tol = 1e-12) {
+  for (const Sphere& s : spheres) {
+    if ((p - s.centre).norm() <= s.radius + tol) return true;
+  }
+  return false;
+}
+
+Eigen::Isometry3d RandomPose(std::mt19937_64* rng) {
+  std::normal_distribution<double> n01;
+  Eigen::Quaterniond q(n01(*rng), n01(*rng), n01(*rng), n01(*rng));
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = q.normalized().toRotationMatrix();
+  X.translation() = Eigen::Vector3d(n01(*rng), n01(*rng), n01(*rng));
+  return X;
+}
+
+TEST(SphereCoverTest, CoversNeverUnderCoverAndExcessBoundHolds) {
+  std::mt19937_64 rng(17);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    SphereCoverParams params;
+    params.max_radial_excess = 0.002 + 0.03 * u01(rng);
+    params.max_box_cell_half_size = 0.01 + 0.1 * u01(rng);
+    const Eigen::Isometry3d X = RandomPose(&rng);
+    const double rho = 0.01 + 0.1 * u01(rng);
+    const double L = 0.001 + 0.5 * u01(rng);
+    CoverReport rep;
+    // Cylinder.
+    const auto cyl = CoverCylinder(rho, L, X, params, &rep);
+    for (const auto& p : SampleCylinder(rho, L, 400, &rng)) {
+      ASSERT_TRUE(Covered(cyl, X * p)) << trial;
+    }
+    EXPECT_EQ(rep.num_spheres, static_cast<int>(cyl.size()));
+    EXPECT_LE(cyl[0].radius - rho, params.max_radial_excess * (1 + 1e-12));
+    EXPECT_GE(rep.volume_ratio, 1.0);
+    // Excess bound: points on the spheres are within max_excess of the shape.
+    for (const Sphere& s : cyl) {
+      for (int i = 0; i < 50; ++i) {
+        const Eigen::Vector3d p_C = X.inverse() * (s.centre + s.radius * RandomUnit(&rng));
+        const double radial = std::max(0.0, p_C.head<2>().norm() - rho);
+        const double axial = std::max(0.0, std::abs(p_C.z()) - 0.5 * L);
+        ASSERT_LE(std::hypot(radial, axial), rep.max_excess + 1e-12);
+      }
+    }
+    // Capsule.
+    const Eigen::Vector3d p1 = X.translation();
+    const Eigen::Vector3d p2 = p1 + L * RandomUnit(&rng);
+    const auto cap = CoverCapsule(p1, p2, rho, params, &rep);
+    for (int i = 0; i < 400; ++i) {
+      const double t = i % 3 == 0 ? (i % 2) : u01(rng);
+      const Eigen::Vector3d s = (1 - t) * p1 + t * p2;
+      Eigen::Vector3d dir = RandomUnit(&rng);
+      if (i % 3 != 0) dir = (dir - dir.dot((p2 - p1).normalized()) * (p2 - p1).normalized()).normalized();
+      ASSERT_TRUE(Covered(cap, s + rho * (i % 5 == 0 ? std::cbrt(u01(rng)) : 1.0) * dir)) << trial;
+    }
+    EXPECT_LE(rep.max_excess, params.max_radial_excess * (1 + 1e-12));
+    // Box.
+    const Eigen::Vector3d h(0.01 + 0.2 * u01(rng), 0.01 + 0.2 * u01(rng), 0.01 + 0.2 * u01(rng));
+    const auto box = CoverBox(h, X, params, &rep);
+    for (const auto& p : SampleBox(h, 400, &rng)) ASSERT_TRUE(Covered(box, X * p)) << trial;
+  }
+  EXPECT_THROW(CoverCylinder(-1.0, 1.0, Eigen::Isometry3d::Identity(), {}, nullptr),
+               std::invalid_argument);
+}
+
+TEST(SphereCoverTest, RemoveContainedKeepsUnion) {
+  std::vector<Sphere> s = {{Eigen::Vector3d::Zero(), 1.0},
+                           {Eigen::Vector3d(0.2, 0, 0), 0.5},
+                           {Eigen::Vector3d(0.9, 0, 0), 0.5},
+                           {Eigen::Vector3d::Zero(), 1.0}};
+  const std::vector<int> kept = RemoveContainedSpheres(&s);
+  EXPECT_EQ(kept, (std::vector<int>{0, 2}));
+}
+
+// Configuration of the URDF model (7 arm joints + the finger) from the arm
+// configuration and the finger opening.
+Eigen::VectorXd UrdfQ(const RobotModel& urdf, const Eigen::VectorXd& q_arm, double finger) {
+  Eigen::VectorXd q(urdf.nq);
+  q.head(7) = q_arm;
+  q[7] = finger;
+  return q;
+}
+
+TEST(RobotModelTest, PandaYamlForwardKinematicsMatchesUrdf) {
+  const RobotModel urdf = LoadRobotModelFromUrdf(kUrdf);
+  const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
+  ASSERT_EQ(urdf.nq, 8);  // 7 arm joints + finger 1 (finger 2 mimics it)
+  ASSERT_EQ(yaml.nq, 7);
+  for (int i = 0; i < 7; ++i) {
+    EXPECT_EQ(urdf.joints[urdf.q_joints[i]].name, yaml.joints[yaml.q_joints[i]].name);
+  }
+  RobotData du(urdf), dy(yaml);
+  std::mt19937_64 rng(23);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const Eigen::VectorXd lo = yaml.LowerLimits(), hi = yaml.UpperLimits();
+  RecordProperty("yaml_spheres", static_cast<int>(yaml.spheres.size()));
+  RecordProperty("urdf_spheres", static_cast<int>(urdf.spheres.size()));
+  const std::vector<std::string> frames = {"panda_link0", "panda_link1", "panda_link2",
+                                           "panda_link3", "panda_link4", "panda_link5",
+                                           "panda_link6", "panda_link7", "panda_link8",
+                                           "panda_hand"};
+  for (int trial = 0; trial < 1000; ++trial) {
+    Eigen::VectorXd q(7);
+    for (int i = 0; i < 7; ++i) {
+      // Beyond the limits too: the kinematics must agree everywhere.
+      q[i] = lo[i] - 0.5 + (hi[i] - lo[i] + 1.0) * u01(rng);
+    }
+    CalcForwardKinematics(urdf, UrdfQ(urdf, q, 0.04 * u01(rng)), &du);
+    CalcForwardKinematics(yaml, q, &dy);
+    for (const std::string& f : frames) {
+      const Eigen::Isometry3d& A = du.X_WL[urdf.FindLink(f)];
+      const Eigen::Isometry3d& B = dy.X_WL[yaml.FindLink(f)];
+      ASSERT_LE((A.translation() - B.translation()).norm(), 1e-9) << f << " trial " << trial;
+      ASSERT_LE((A.linear() - B.linear()).norm(), 1e-9) << f << " trial " << trial;
+    }
+  }
+}
+
+TEST(RobotModelTest, PandaYamlLimitsMatchUrdf) {
+  const RobotModel urdf = LoadRobotModelFromUrdf(kUrdf);
+  const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
+  for (int i = 0; i < 7; ++i) {
+    const JointLimits& a = urdf.joints[urdf.q_joints[i]].limits;
+    const JointLimits& b = yaml.joints[yaml.q_joints[i]].limits;
+    EXPECT_DOUBLE_EQ(a.lower, b.lower) << i;
+    EXPECT_DOUBLE_EQ(a.upper, b.upper) << i;
+    EXPECT_DOUBLE_EQ(a.velocity, b.velocity) << i;
+    EXPECT_GE(b.acceleration, 7.5);
+    EXPECT_GE(b.jerk, 3750.0);
+  }
+  // URDF has no acceleration limits: the documented default is used.
+  EXPECT_EQ(urdf.joints[urdf.q_joints[0]].limits.acceleration, RobotModelOptions{}.default_acceleration);
+}
+
+// Every point of every collision shape of the URDF (at random configurations
+// and finger openings) lies inside some sphere of the URDF-derived model and
+// of the YAML model.
+TEST(RobotModelTest, SpheresCoverEveryUrdfCollisionShape) {
+  const RobotModel urdf = LoadRobotModelFromUrdf(kUrdf);
+  const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
+  // Independent read of the shapes.
+  const urdf::ModelInterfaceSharedPtr model = urdf::parseURDFFile(kUrdf);
+  ASSERT_TRUE(model);
+  RobotData du(urdf), dy(yaml);
+  std::mt19937_64 rng(29);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  const Eigen::VectorXd lo = yaml.LowerLimits(), hi = yaml.UpperLimits();
+  int shapes_checked = 0;
+  for (int trial = 0; trial < 20; ++trial) {
+    Eigen::VectorXd q(7);
+    for (int i = 0; i < 7; ++i) q[i] = lo[i] + (hi[i] - lo[i]) * u01(rng);
+    const double finger = trial == 0 ? 0.0 : trial == 1 ? 0.04 : 0.04 * u01(rng);
+    CalcForwardKinematics(urdf, UrdfQ(urdf, q, finger), &du);
+    CalcForwardKinematics(yaml, q, &dy);
+    auto to_spheres = [](const RobotData& d, const RobotModel& m) {
+      std::vector<Sphere> s;
+      for (size_t i = 0; i < m.spheres.size(); ++i) {
+        s.push_back({d.p_WS.col(static_cast<Eigen::Index>(i)), m.spheres[i].radius});
+      }
+      return s;
+    };
+    const std::vector<Sphere> su = to_spheres(du, urdf), sy = to_spheres(dy, yaml);
+    for (const auto& [name, link] : model->links_) {
+      const Eigen::Isometry3d& X_WL = du.X_WL[urdf.FindLink(name)];
+      for (const urdf::CollisionSharedPtr& col : link->collision_array) {
+        const urdf::Pose& o = col->origin;
+        Eigen::Isometry3d X_LG = Eigen::Isometry3d::Identity();
+        X_LG.translation() = Eigen::Vector3d(o.position.x, o.position.y, o.position.z);
+        X_LG.linear() = Eigen::Quaterniond(o.rotation.w, o.rotation.x, o.rotation.y,
+                                           o.rotation.z).toRotationMatrix();
+        std::vector<Eigen::Vector3d> pts;
+        if (col->geometry->type == urdf::Geometry::SPHERE) {
+          pts = SampleBall(static_cast<const urdf::Sphere&>(*col->geometry).radius, 300, &rng);
+        } else if (col->geometry->type == urdf::Geometry::CYLINDER) {
+          const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
+          pts = SampleCylinder(c.radius, c.length, 300, &rng);
+        } else {
+          FAIL() << "unexpected shape in " << name;
+        }
+        ++shapes_checked;
+        for (const Eigen::Vector3d& p_G : pts) {
+          const Eigen::Vector3d p_W = X_WL * X_LG * p_G;
+          ASSERT_TRUE(Covered(su, p_W, 1e-9)) << name << " (URDF model) trial " << trial;
+          ASSERT_TRUE(Covered(sy, p_W, 1e-9)) << name << " (YAML model) trial " << trial;
+        }
+      }
+    }
+  }
+  // Over-approximation is reported per shape, and every shape was checked.
+  EXPECT_EQ(shapes_checked, 20 * static_cast<int>(urdf.cover_report.size()));
+  EXPECT_GT(shapes_checked, 20 * 30);
+  for (const ShapeCoverEntry& e : yaml.cover_report) {
+    EXPECT_GE(e.cover.volume_ratio, 1.0) << e.link;
+    if (e.cover.shape == "capsule") {
+      EXPECT_LE(e.cover.max_excess, RobotModelOptions{}.cover.max_radial_excess + 1e-12) << e.link;
+    }
+    EXPECT_GT(e.cover.max_excess, 0.0) << e.link << " " << e.cover.shape;
+  }
+}
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+void ExpectThrowsWith(const std::function<void()>& f, const std::string& needle) {
+  try {
+    f();
+    ADD_FAILURE() << "no exception, expected one containing '" << needle << "'";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(needle), std::string::npos) << e.what();
+  }
+}
+
+TEST(RobotModelTest, LoadErrorsNameTheProblem) {
+  ExpectThrowsWith([] { LoadRobotModelFromUrdf("/nonexistent.urdf"); }, "/nonexistent.urdf");
+  ExpectThrowsWith([] { LoadRobotModelFromYaml("/nonexistent.yaml"); }, "/nonexistent.yaml");
+  const std::string bad_key = WriteTemp("bad_key.yaml", R"(
+name: x
+convention: modified_dh
+base_link: l0
+joints:
+  - {name: j1, link: l1, a: 0, d: 0.1, alpha: 0, lower: -1, upper: 1, velocity: 1, acceleraton: 3}
+)");
+  ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_key); }, "unknown key 'acceleraton' in joints[0]");
+  ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_key); }, bad_key);
+  const std::string bad_limits = WriteTemp("bad_limits.yaml", R"(
+name: x
+convention: modified_dh
+base_link: l0
+joints:
+  - {name: j1, link: l1, a: 0, d: 0.1, alpha: 0, lower: 1, upper: -1, velocity: 1}
+)");
+  ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_limits); }, "lower=1 upper=-1");
+  const std::string mesh = WriteTemp("mesh.urdf", R"(<robot name="m">
+  <link name="a"><collision><geometry><mesh filename="x.stl"/></geometry></collision></link>
+</robot>)");
+  ExpectThrowsWith([&] { LoadRobotModelFromUrdf(mesh); }, "link 'a' has a mesh collision shape");
+  RobotModelOptions opt;
+  opt.ignore_mesh_collisions = true;
+  EXPECT_EQ(LoadRobotModelFromUrdf(mesh, opt).spheres.size(), 0u);
+  opt.locked_joints["nope"] = 0.0;
+  ExpectThrowsWith([&] { LoadRobotModelFromUrdf(kUrdf, opt); }, "locked joint 'nope'");
+}
+
+TEST(RobotModelTest, ForwardKinematicsDoesNotAllocate) {
+  const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
+  RobotData data(yaml);
+  const Eigen::VectorXd q = 0.5 * (yaml.LowerLimits() + yaml.UpperLimits());
+  test_support::StartCountingAllocations();
+  CalcForwardKinematics(yaml, q, &data);
+  EXPECT_EQ(test_support::StopCountingAllocations(), 0);
+  EXPECT_GT(data.p_WS.cwiseAbs().sum(), 0.0);
+}
+
+TEST(RobotModelTest, LockedFingersLeaveSevenJoints) {
+  RobotModelOptions opt;
+  opt.locked_joints = {{"panda_finger_joint1", 0.02}, {"panda_finger_joint2", 0.02}};
+  const RobotModel m = LoadRobotModelFromUrdf(kUrdf, opt);
+  EXPECT_EQ(m.nq, 7);
+  RobotData d(m);
+  CalcForwardKinematics(m, Eigen::VectorXd::Zero(7), &d);
+  const Eigen::Vector3d left = d.X_WL[m.FindLink("panda_leftfinger")].translation();
+  const Eigen::Vector3d right = d.X_WL[m.FindLink("panda_rightfinger")].translation();
+  EXPECT_NEAR((left - right).norm(), 0.04, 1e-12);
+}
+
+}  // namespace
+}  // namespace iplan::collision
