@@ -57,17 +57,18 @@ std::string HumanBodyParams::Validate() const {
 
 HumanBodyParams HumanBodyParams::DefaultUpperBody() {
   HumanBodyParams p;
-  p.joints = {"head",          "neck",        "torso",      "shoulder_left", "elbow_left",
-              "hand_left",     "shoulder_right", "elbow_right", "hand_right"};
+  // Joint names follow the skeleton convention of perception and the
+  // recorded data: _l / _r suffixes.
+  p.joints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l", "shoulder_r", "elbow_r", "hand_r"};
   p.segments = {
       {"head", "head", "neck", 2, 0.12, {}},
       {"trunk", "neck", "torso", 2, 0.17, {}},
-      {"shoulder_left", "neck", "shoulder_left", 2, 0.08, {}},
-      {"upper_arm_left", "shoulder_left", "elbow_left", 2, 0.07, {}},
-      {"forearm_left", "elbow_left", "hand_left", 2, 0.06, {0.25, 1.0}},
-      {"shoulder_right", "neck", "shoulder_right", 2, 0.08, {}},
-      {"upper_arm_right", "shoulder_right", "elbow_right", 2, 0.07, {}},
-      {"forearm_right", "elbow_right", "hand_right", 2, 0.06, {0.25, 1.0}},
+      {"shoulder_left", "neck", "shoulder_l", 2, 0.08, {}},
+      {"upper_arm_left", "shoulder_l", "elbow_l", 2, 0.07, {}},
+      {"forearm_left", "elbow_l", "hand_l", 2, 0.06, {0.25, 1.0}},
+      {"shoulder_right", "neck", "shoulder_r", 2, 0.08, {}},
+      {"upper_arm_right", "shoulder_r", "elbow_r", 2, 0.07, {}},
+      {"forearm_right", "elbow_r", "hand_r", 2, 0.06, {0.25, 1.0}},
   };
   return p;
 }
