@@ -1,0 +1,309 @@
+#include "risk_monitor.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+#include <stdexcept>
+
+namespace iplan::collision_risk {
+namespace {
+
+constexpr double kNoPerson = 1e6;  // m, reported separation when nobody is seen
+
+std::string Fmt(double v, const char* f = "%.3g") {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, v);
+  return buf;
+}
+
+// Index of each name in `wanted` within `names`, or an error naming the first missing one.
+std::optional<std::string> MapNames(const std::vector<std::string>& names, const std::vector<std::string>& wanted,
+                                    std::vector<int>* index) {
+  index->assign(wanted.size(), -1);
+  for (std::size_t w = 0; w < wanted.size(); ++w) {
+    for (std::size_t i = 0; i < names.size(); ++i) {
+      if (names[i] == wanted[w]) (*index)[w] = static_cast<int>(i);
+    }
+    if ((*index)[w] < 0) return "missing joint '" + wanted[w] + "'";
+  }
+  return std::nullopt;
+}
+
+std::vector<std::string> RobotJointNames(const collision::RobotModel& m) {
+  std::vector<std::string> names;
+  for (int j : m.q_joints) names.push_back(m.joints[j].name);
+  return names;
+}
+
+}  // namespace
+
+std::string RiskParams::Validate() const {
+  if (!(delta_cl > 0 && delta_cl < 1)) return "delta_cl must be in (0, 1)";
+  if (!(stop_horizon >= 0)) return "stop_horizon must be >= 0";
+  if (!(slow_down_fraction > 0 && slow_down_fraction <= 1)) return "slow_down_fraction must be in (0, 1]";
+  if (!(slow_down_margin >= 0)) return "slow_down_margin must be >= 0";
+  if (!(stale_after > 0)) return "stale_after must be > 0";
+  const SsmParams& s = ssm;
+  for (double v : {s.default_human_speed, s.speed_window, s.reaction_time, s.stopping_time, s.stopping_distance,
+                   s.intrusion_distance, s.sensing_uncertainty, s.robot_uncertainty}) {
+    if (!(v >= 0)) return "ISO/TS 15066 parameters must be >= 0";
+  }
+  if (!(s.speed_window > 0)) return "speed_window must be > 0";
+  return "";
+}
+
+RiskMonitor::RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params)
+    : robot_(std::move(robot)),
+      body_(std::move(body)),
+      params_(params),
+      data_(robot_),
+      data2_(robot_),
+      workspace_(static_cast<int>(robot_.spheres.size()), 0) {
+  if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  workspace_ = collision::TrajectoryBoundWorkspace(static_cast<int>(robot_.spheres.size()), body_.num_spheres());
+}
+
+std::optional<std::string> RiskMonitor::UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
+                                                         const std::vector<double>& positions) {
+  if (names.size() != positions.size()) return std::string("names and positions differ in size");
+  std::vector<int> idx;
+  if (auto e = MapNames(names, RobotJointNames(robot_), &idx)) return "joint state: " + *e;
+  Eigen::VectorXd q(robot_.nq);
+  for (int i = 0; i < robot_.nq; ++i) q[i] = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
+  previous_state_ = state_;
+  state_ = std::make_pair(stamp_ns, q);
+  return std::nullopt;
+}
+
+std::optional<std::string> RiskMonitor::UpdateTrajectory(int64_t start_ns, const std::vector<std::string>& names,
+                                                         const std::vector<double>& times,
+                                                         const std::vector<std::vector<double>>& positions) {
+  if (times.size() != positions.size()) return std::string("times and points differ in size");
+  std::vector<int> idx;
+  if (auto e = MapNames(names, RobotJointNames(robot_), &idx)) return "trajectory: " + *e;
+  std::vector<Eigen::VectorXd> pts;
+  for (std::size_t p = 0; p < positions.size(); ++p) {
+    if (positions[p].size() != names.size()) return "trajectory point " + std::to_string(p) + " has the wrong size";
+    if (p > 0 && !(times[p] > times[p - 1])) return std::string("trajectory times do not increase");
+    Eigen::VectorXd q(robot_.nq);
+    for (int i = 0; i < robot_.nq; ++i) q[i] = positions[p][static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
+    pts.push_back(q);
+  }
+  trajectory_start_ns_ = start_ns;
+  trajectory_times_ = times;
+  trajectory_positions_ = std::move(pts);
+  return std::nullopt;
+}
+
+std::optional<std::string> RiskMonitor::UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
+                                                       const std::vector<Eigen::Vector3d>& positions) {
+  std::vector<int> idx;
+  if (auto e = MapNames(names, body_.params().joints, &idx)) return "skeleton: " + *e;
+  Eigen::Matrix3Xd p(3, body_.num_joints());
+  for (int j = 0; j < body_.num_joints(); ++j) p.col(j) = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(j)])];
+  skeletons_.emplace_back(stamp_ns, p);
+  const int64_t keep = static_cast<int64_t>((params_.ssm.speed_window + params_.stale_after) * 1e9);
+  while (skeletons_.size() > 2 && stamp_ns - skeletons_.front().first > keep) skeletons_.pop_front();
+  return std::nullopt;
+}
+
+std::optional<std::string> RiskMonitor::UpdatePrediction(const PredictionInput& in) {
+  const int A = static_cast<int>(in.actions.size());
+  if (A == 0 || in.num_steps <= 0 || !(in.time_step > 0)) return std::string("empty prediction");
+  if (static_cast<int>(in.probabilities.size()) != A || static_cast<int>(in.means.size()) != A ||
+      static_cast<int>(in.covariances.size()) != A) {
+    return std::string("prediction sizes are inconsistent");
+  }
+  std::vector<int> idx;
+  if (auto e = MapNames(in.joint_names, body_.params().joints, &idx)) return "prediction: " + *e;
+  const std::size_t J = in.joint_names.size();
+  collision::HumanPrediction pred = body_.MakePrediction(A, in.num_steps);
+  Eigen::Matrix3Xd means(3, body_.num_joints());
+  std::vector<Eigen::Matrix3d> covs(static_cast<std::size_t>(body_.num_joints()));
+  for (int a = 0; a < A; ++a) {
+    if (in.means[a].size() != J * static_cast<std::size_t>(in.num_steps) || in.covariances[a].size() != in.means[a].size()) {
+      return "prediction action " + std::to_string(a) + " has the wrong number of Gaussians";
+    }
+    pred.set_action_probability(a, in.probabilities[a]);
+    for (int k = 0; k < in.num_steps; ++k) {
+      for (int j = 0; j < body_.num_joints(); ++j) {
+        const std::size_t src = static_cast<std::size_t>(k) * J + static_cast<std::size_t>(idx[static_cast<std::size_t>(j)]);
+        means.col(j) = in.means[a][src];
+        covs[static_cast<std::size_t>(j)] = in.covariances[a][src];
+      }
+      if (!body_.FillPrediction(means, covs, a, k, &pred)) {
+        return "prediction action " + std::to_string(a) + " step " + std::to_string(k) +
+               ": a sphere covariance is not positive definite";
+      }
+    }
+  }
+  pred.UpdateSummaries();
+  prediction_ = std::move(pred);
+  prediction_meta_ = in;
+  prediction_meta_.means.clear();
+  prediction_meta_.covariances.clear();
+  return std::nullopt;
+}
+
+Eigen::VectorXd RiskMonitor::RobotConfigurationAt(int64_t t_ns) const {
+  if (trajectory_positions_.empty()) return state_->second;
+  const double t = (t_ns - trajectory_start_ns_) * 1e-9;
+  if (t <= trajectory_times_.front()) return trajectory_positions_.front();
+  if (t >= trajectory_times_.back()) return trajectory_positions_.back();
+  const auto it = std::upper_bound(trajectory_times_.begin(), trajectory_times_.end(), t);
+  const std::size_t i = static_cast<std::size_t>(it - trajectory_times_.begin());
+  const double u = (t - trajectory_times_[i - 1]) / (trajectory_times_[i] - trajectory_times_[i - 1]);
+  return (1 - u) * trajectory_positions_[i - 1] + u * trajectory_positions_[i];
+}
+
+double RiskMonitor::MeasuredHumanSpeed() const {
+  if (!params_.ssm.measure_human_speed || skeletons_.size() < 2) return params_.ssm.default_human_speed;
+  const auto& newest = skeletons_.back();
+  const int64_t window = static_cast<int64_t>(params_.ssm.speed_window * 1e9);
+  // The oldest skeleton still within the window, at least half a window back.
+  for (const auto& s : skeletons_) {
+    const int64_t dt = newest.first - s.first;
+    if (dt <= window && dt >= window / 2) {
+      return ((newest.second - s.second).colwise().norm()).maxCoeff() / (dt * 1e-9);
+    }
+  }
+  return params_.ssm.default_human_speed;  // not enough history: the ISO default
+}
+
+double RiskMonitor::RobotSpeed(int64_t now_ns) {
+  // Fastest robot sphere: along the executing trajectory when there is one,
+  // else from the last two joint states.
+  Eigen::VectorXd q0, q1;
+  double dt = 0;
+  if (!trajectory_positions_.empty()) {
+    dt = 0.02;
+    q0 = RobotConfigurationAt(now_ns);
+    q1 = RobotConfigurationAt(now_ns + static_cast<int64_t>(dt * 1e9));
+  } else if (previous_state_ && state_->first > previous_state_->first) {
+    dt = (state_->first - previous_state_->first) * 1e-9;
+    q0 = previous_state_->second;
+    q1 = state_->second;
+  } else {
+    return 0;
+  }
+  collision::CalcForwardKinematics(robot_, q0, &data_);
+  collision::CalcForwardKinematics(robot_, q1, &data2_);
+  return (data2_.p_WS - data_.p_WS).colwise().norm().maxCoeff() / dt;
+}
+
+RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
+  RiskReport r;
+  r.stamp_ns = now_ns;
+  const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
+  if (!state_ || now_ns - state_->first > stale) {
+    r.verdict = Verdict::kProtectiveStop;
+    r.reason = state_ ? "robot state is stale" : "no robot state yet";
+    return r;
+  }
+  const bool person = !skeletons_.empty() && now_ns - skeletons_.back().first <= stale;
+  const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
+  r.trajectory_stamp_ns = trajectory_positions_.empty() ? 0 : trajectory_start_ns_;
+
+  // ISO/TS 15066 layer: current separation against S_p.
+  const SsmParams& s = params_.ssm;
+  r.human_speed = person ? MeasuredHumanSpeed() : s.default_human_speed;
+  r.robot_speed = RobotSpeed(now_ns);
+  r.protective_separation = r.human_speed * (s.reaction_time + s.stopping_time) + r.robot_speed * s.reaction_time +
+                            s.stopping_distance + s.intrusion_distance + s.sensing_uncertainty + s.robot_uncertainty;
+  const auto& robot_spheres = robot_.spheres;
+  if (person) {
+    collision::CalcForwardKinematics(robot_, state_->second, &data_);
+    const Eigen::Matrix3Xd& joints = skeletons_.back().second;
+    const std::vector<Eigen::Matrix3d> zero(static_cast<std::size_t>(body_.num_joints()), Eigen::Matrix3d::Zero());
+    double best = kNoPerson;
+    for (int h = 0; h < body_.num_spheres(); ++h) {
+      const auto& def = body_.spheres()[static_cast<std::size_t>(h)];
+      const Eigen::Vector3d c = (1 - def.u) * joints.col(def.joint_a) + def.u * joints.col(def.joint_b);
+      for (std::size_t k = 0; k < robot_spheres.size(); ++k) {
+        const double d = (data_.p_WS.col(static_cast<Eigen::Index>(k)) - c).norm() - robot_spheres[k].radius - def.radius;
+        if (d < best) {
+          best = d;
+          r.separation_robot_link = robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)];
+          r.separation_human_segment = body_.params().segments[static_cast<std::size_t>(def.segment)].name;
+        }
+      }
+    }
+    r.min_separation = best;
+  }
+
+  // Prediction layer: bound along the executing trajectory.
+  if (predicted) {
+    const PredictionInput& m = prediction_meta_;
+    r.prediction_stamp_ns = m.t0_ns;
+    r.time_step = m.time_step;
+    collision::RobotSpheresTrajectory traj;
+    const int S = static_cast<int>(robot_spheres.size());
+    for (const auto& sp : robot_spheres) {
+      traj.radii.push_back(sp.radius);
+      traj.links.push_back(sp.link);
+    }
+    std::vector<int> steps;
+    for (int k = 0; k < m.num_steps; ++k) {
+      const int64_t t_k = m.t0_ns + static_cast<int64_t>((k + 1) * m.time_step * 1e9);
+      if (t_k >= now_ns) steps.push_back(k);
+    }
+    traj.steps = steps;
+    traj.centres.resize(3, static_cast<Eigen::Index>(steps.size()) * S);
+    for (std::size_t w = 0; w < steps.size(); ++w) {
+      const int64_t t_k = m.t0_ns + static_cast<int64_t>((steps[w] + 1) * m.time_step * 1e9);
+      collision::CalcForwardKinematics(robot_, RobotConfigurationAt(t_k), &data_);
+      traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data_.p_WS;
+      r.waypoint_times.push_back((t_k - now_ns) * 1e-9);
+    }
+    collision::EvaluateTrajectoryBound(*prediction_, traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
+    for (std::size_t w = 0; w < bounds_.size(); ++w) {
+      const auto& b = bounds_[w];
+      r.waypoint_bounds.push_back(std::clamp(b.bound, 0.0, 1.0));
+      if (w == 0 || b.bound > r.max_bound) {
+        r.max_bound = std::clamp(b.bound, 0.0, 1.0);
+        r.max_waypoint = static_cast<int>(w);
+        r.max_time = r.waypoint_times[w];
+        r.max_robot_link = b.robot_link >= 0 ? robot_.link_names[static_cast<std::size_t>(b.robot_link)] : "";
+        r.max_human_segment =
+            b.human_segment >= 0 ? body_.params().segments[static_cast<std::size_t>(b.human_segment)].name : "";
+        r.max_action = b.action >= 0 ? m.actions[static_cast<std::size_t>(b.action)] : "";
+      }
+    }
+  }
+
+  // Verdict: the hard layer first, then the prediction.
+  const double threshold = 1 - params_.delta_cl;
+  double first_violation = -1;
+  for (std::size_t w = 0; w < r.waypoint_bounds.size(); ++w) {
+    if (r.waypoint_bounds[w] >= threshold) {
+      first_violation = r.waypoint_times[w];
+      break;
+    }
+  }
+  if (person && r.min_separation < r.protective_separation) {
+    r.verdict = Verdict::kProtectiveStop;
+    r.reason = "separation " + Fmt(r.min_separation) + " m (" + r.separation_robot_link + " / " +
+               r.separation_human_segment + ") below the protective separation " + Fmt(r.protective_separation) + " m";
+  } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
+    r.verdict = Verdict::kProtectiveStop;
+    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) +
+               " s (" + r.max_robot_link + " / " + r.max_human_segment + ", " + r.max_action + ")";
+  } else if (first_violation >= 0) {
+    r.verdict = Verdict::kSlowDown;
+    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s";
+  } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
+    r.verdict = Verdict::kSlowDown;
+    r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
+  } else if (person && r.min_separation < r.protective_separation + params_.slow_down_margin) {
+    r.verdict = Verdict::kSlowDown;
+    r.reason = "separation " + Fmt(r.min_separation) + " m within " + Fmt(params_.slow_down_margin) +
+               " m of the protective separation";
+  } else {
+    r.verdict = Verdict::kOk;
+    r.reason = !person ? "no person seen" : (predicted ? "clear" : "clear (separation only: no current prediction)");
+  }
+  return r;
+}
+
+}  // namespace iplan::collision_risk

@@ -1,0 +1,142 @@
+// The collision-risk monitor: the cell's independent watchdog on the robot
+// trajectory that is actually executing. No DDS types.
+//
+// Two layers (METHOD 4 and 7):
+//  - prediction: the upper bound of P(contact) between the robot's spheres
+//    along the executing trajectory and the predicted human (Gaussian mixture
+//    over actions), per prediction step, from iplan::collision;
+//  - ISO/TS 15066 speed and separation monitoring, independent of any
+//    prediction: the current minimum robot-human surface distance against the
+//    protective separation distance
+//      S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r.
+// Verdict: PROTECTIVE_STOP when the separation is below S_p, or the bound
+// reaches 1 - delta_CL within the stop horizon, or the robot state is
+// unknown; SLOW_DOWN when within a margin of either; OK otherwise.
+//
+// Frames and units: positions in the world frame (= robot base frame), m;
+// times are ns since the epoch on input and s relative to the evaluation in
+// the report. Not thread-safe (one owner, the service's executor).
+#pragma once
+
+#include <cstdint>
+#include <deque>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/collision/human_model.h"
+#include "iplan/collision/robot_model.h"
+#include "iplan/collision/trajectory_bound.h"
+
+namespace iplan::collision_risk {
+
+/// ISO/TS 15066 speed and separation monitoring parameters.
+struct SsmParams {
+  bool measure_human_speed = true;  ///< from the skeleton; else v_h = default_human_speed
+  double default_human_speed = 1.6; ///< m/s, ISO value when the speed is not measured
+  double speed_window = 0.3;        ///< s, displacement window for the measured speed
+  double reaction_time = 0.1;       ///< s, T_r
+  double stopping_time = 0.3;       ///< s, T_s
+  double stopping_distance = 0.15;  ///< m, S_s
+  double intrusion_distance = 0.1;  ///< m, C
+  double sensing_uncertainty = 0.05;  ///< m, Z_d
+  double robot_uncertainty = 0.02;    ///< m, Z_r
+};
+
+struct RiskParams {
+  double delta_cl = 0.95;          ///< a waypoint is safe when its bound < 1 - delta_cl
+  double stop_horizon = 1.0;       ///< s; a violating waypoint within it means stop, later means slow down
+  double slow_down_fraction = 0.5; ///< slow down above this fraction of 1 - delta_cl
+  double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
+  double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
+  SsmParams ssm;
+  /// Empty when valid, else the reason.
+  std::string Validate() const;
+};
+
+enum class Verdict { kOk = 0, kSlowDown = 1, kProtectiveStop = 2 };
+
+struct RiskReport {
+  int64_t stamp_ns = 0;                  ///< evaluation time
+  int64_t trajectory_stamp_ns = 0;       ///< 0: no trajectory
+  int64_t prediction_stamp_ns = 0;       ///< 0: no prediction used
+  double time_step = 0;                  ///< s between waypoint_bounds entries
+  std::vector<double> waypoint_bounds;   ///< bound per future prediction step, first at +time_step or later
+  std::vector<double> waypoint_times;    ///< s after stamp_ns, per entry
+  double max_bound = 0;
+  int max_waypoint = 0;
+  double max_time = 0;                   ///< s after stamp_ns
+  std::string max_robot_link, max_human_segment, max_action;
+  double min_separation = 1e6;           ///< m; 1e6 when no person is seen
+  std::string separation_robot_link, separation_human_segment;
+  double protective_separation = 0;      ///< m, S_p
+  double human_speed = 0;                ///< m/s used for S_p
+  double robot_speed = 0;                ///< m/s used for S_p
+  Verdict verdict = Verdict::kProtectiveStop;
+  std::string reason;
+};
+
+/// A Gaussian mixture over actions of future joint positions.
+struct PredictionInput {
+  int64_t t0_ns = 0;       ///< time of the observation it starts from
+  double time_step = 0;    ///< s; step k is at t0 + (k + 1) time_step
+  int num_steps = 0;
+  std::vector<std::string> joint_names;
+  std::vector<std::string> actions;
+  std::vector<double> probabilities;
+  /// [action][step * J + joint]: mean (m) and covariance (m^2).
+  std::vector<std::vector<Eigen::Vector3d>> means;
+  std::vector<std::vector<Eigen::Matrix3d>> covariances;
+};
+
+class RiskMonitor {
+ public:
+  /// Throws std::invalid_argument when params are invalid.
+  RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params);
+
+  /// Each Update returns nullopt when accepted, else why it was rejected
+  /// (unknown joint names, wrong sizes); rejected input leaves state alone.
+  std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
+                                              const std::vector<double>& positions);
+  /// `times` in s from `start_ns`, increasing; positions one vector per point.
+  std::optional<std::string> UpdateTrajectory(int64_t start_ns, const std::vector<std::string>& names,
+                                              const std::vector<double>& times,
+                                              const std::vector<std::vector<double>>& positions);
+  std::optional<std::string> UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
+                                            const std::vector<Eigen::Vector3d>& positions);
+  std::optional<std::string> UpdatePrediction(const PredictionInput& prediction);
+
+  /// Evaluates both layers at `now_ns`. Allocates (report vectors).
+  RiskReport Evaluate(int64_t now_ns);
+
+  const collision::RobotModel& robot() const { return robot_; }
+  const collision::HumanBodyModel& body() const { return body_; }
+
+ private:
+  Eigen::VectorXd RobotConfigurationAt(int64_t t_ns) const;
+  double MeasuredHumanSpeed() const;
+  double RobotSpeed(int64_t now_ns);
+
+  collision::RobotModel robot_;
+  collision::HumanBodyModel body_;
+  RiskParams params_;
+  collision::RobotData data_;
+  collision::RobotData data2_;
+  // Robot state (model joint order).
+  std::optional<std::pair<int64_t, Eigen::VectorXd>> state_, previous_state_;
+  // Executing trajectory.
+  int64_t trajectory_start_ns_ = 0;
+  std::vector<double> trajectory_times_;
+  std::vector<Eigen::VectorXd> trajectory_positions_;
+  // Skeleton history (body joint order), newest last.
+  std::deque<std::pair<int64_t, Eigen::Matrix3Xd>> skeletons_;
+  // Latest prediction, converted for the bound.
+  std::optional<collision::HumanPrediction> prediction_;
+  PredictionInput prediction_meta_;
+  collision::TrajectoryBoundWorkspace workspace_;
+  std::vector<collision::WaypointBound> bounds_;
+};
+
+}  // namespace iplan::collision_risk

@@ -1,0 +1,177 @@
+// The risk monitor's verdicts from each layer, its ISO/TS 15066 arithmetic,
+// and its refusal of inputs it cannot map.
+#include "core/risk_monitor.h"
+
+#include <gtest/gtest.h>
+
+namespace iplan::collision_risk {
+namespace {
+
+constexpr int64_t kSec = 1000000000;
+const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
+                                          "shoulder_r", "elbow_r", "hand_r"};
+
+// A person standing upright with the torso at `torso`, facing -x, arms
+// forward; the right hand is `reach` m in front of the torso.
+std::vector<Eigen::Vector3d> Person(const Eigen::Vector3d& torso, double reach = 0.3) {
+  return {torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.30), torso,
+          torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0.0),
+          torso + Eigen::Vector3d(-0.25, -0.2, -0.05), torso + Eigen::Vector3d(0, 0.18, 0.25),
+          torso + Eigen::Vector3d(-0.1, 0.2, 0.05), torso + Eigen::Vector3d(-reach, 0.1, 0.0)};
+}
+
+class RiskMonitorTest : public ::testing::Test {
+ protected:
+  RiskMonitorTest()
+      : monitor_(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
+                 collision::HumanBodyParams::DefaultUpperBody(), Params()) {}
+  static RiskParams Params() {
+    RiskParams p;
+    p.ssm.measure_human_speed = true;
+    return p;
+  }
+  void RobotAtReady(int64_t t) {
+    const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                            "panda_joint5", "panda_joint6", "panda_joint7"};
+    ASSERT_EQ(monitor_.UpdateRobotState(t, names, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  }
+  void SeePerson(int64_t t, const Eigen::Vector3d& torso, double reach = 0.3) {
+    ASSERT_EQ(monitor_.UpdateSkeleton(t, kJoints, Person(torso, reach)), std::nullopt);
+  }
+  // A prediction in which the torso moves with `velocity` from `torso`
+  // (constant-velocity future), sigma growing from 3 cm by 5 cm per second.
+  PredictionInput Predict(int64_t t0, const Eigen::Vector3d& torso, const Eigen::Vector3d& velocity, int steps,
+                          double dt, double reach = 0.3) {
+    PredictionInput p;
+    p.t0_ns = t0;
+    p.time_step = dt;
+    p.num_steps = steps;
+    p.joint_names = kJoints;
+    p.actions = {"approach"};
+    p.probabilities = {1.0};
+    p.means.resize(1);
+    p.covariances.resize(1);
+    for (int k = 0; k < steps; ++k) {
+      const double tau = (k + 1) * dt;
+      const double sigma = 0.03 + 0.05 * tau;
+      for (const auto& j : Person(torso + velocity * tau, reach)) {
+        p.means[0].push_back(j);
+        p.covariances[0].push_back(sigma * sigma * Eigen::Matrix3d::Identity());
+      }
+    }
+    return p;
+  }
+  RiskMonitor monitor_;
+};
+
+TEST_F(RiskMonitorTest, StopsWithoutRobotState) {
+  const RiskReport r = monitor_.Evaluate(10 * kSec);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
+  EXPECT_EQ(r.reason, "no robot state yet");
+}
+
+TEST_F(RiskMonitorTest, OkWhenThePersonStaysAway) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  SeePerson(t - 2 * kSec / 10, {2.0, 0, 1.0});  // within the 0.3 s speed window: measured, 0 m/s
+  SeePerson(t, {2.0, 0, 1.0});
+  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, {2.0, 0, 1.0}, {0, 0, 0}, 15, 1.0 / 15)), std::nullopt);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.reason;
+  EXPECT_EQ(r.reason, "clear");
+  EXPECT_EQ(r.waypoint_bounds.size(), 15u);
+  EXPECT_LT(r.max_bound, 1e-6);
+  EXPECT_GT(r.min_separation, 1.0);
+  EXPECT_NEAR(r.human_speed, 0.0, 1e-9);
+  // S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r with v_h = v_r = 0.
+  EXPECT_NEAR(r.protective_separation, 0.15 + 0.1 + 0.05 + 0.02, 1e-12);
+}
+
+TEST_F(RiskMonitorTest, MeasuredHumanSpeedEntersTheProtectiveSeparation) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // Torso moving at 1 m/s towards the robot over the 0.3 s window.
+  SeePerson(t - 3 * kSec / 10, {2.3, 0, 1.0});
+  SeePerson(t, {2.0, 0, 1.0});
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_NEAR(r.human_speed, 1.0, 1e-9);
+  EXPECT_NEAR(r.protective_separation, 1.0 * (0.1 + 0.3) + 0.15 + 0.1 + 0.05 + 0.02, 1e-9);
+  EXPECT_EQ(r.reason, "clear (separation only: no current prediction)");
+}
+
+TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // The robot's hand is near (0.3, 0, 0.5); a person right at it.
+  SeePerson(t - kSec / 3, {0.75, 0, 0.5}, 0.35);
+  SeePerson(t, {0.75, 0, 0.5}, 0.35);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
+  EXPECT_LT(r.min_separation, r.protective_separation);
+  EXPECT_NE(r.reason.find("below the protective separation"), std::string::npos) << r.reason;
+}
+
+TEST_F(RiskMonitorTest, PredictionOfContactSoonStopsBeforeSeparationIsViolated) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // Person 1.0 m in front of the robot's hand, walking at 0.8 m/s towards it.
+  const Eigen::Vector3d torso(1.4, 0, 0.55), v(-0.8, 0, 0);
+  SeePerson(t - 3 * kSec / 10, torso - v * 0.3);
+  SeePerson(t, torso);
+  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_GT(r.min_separation, r.protective_separation) << "the separation layer alone would not stop yet";
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+  EXPECT_GE(r.max_bound, 0.05);
+  EXPECT_NE(r.reason.find("collision bound"), std::string::npos) << r.reason;
+  EXPECT_FALSE(r.max_robot_link.empty());
+  EXPECT_FALSE(r.max_human_segment.empty());
+  EXPECT_EQ(r.max_action, "approach");
+}
+
+TEST_F(RiskMonitorTest, ViolationBeyondTheStopHorizonSlowsDown) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  const Eigen::Vector3d torso(2.4, 0, 0.55), v(-0.8, 0, 0);
+  SeePerson(t - 3 * kSec / 10, torso - v * 0.3);
+  SeePerson(t, torso);
+  // 3 s of prediction at 0.1 s: contact is predicted after about 2 s.
+  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 30, 0.1)), std::nullopt);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kSlowDown) << r.reason;
+  EXPECT_GT(r.max_time, 1.0);
+}
+
+TEST_F(RiskMonitorTest, ExecutingTrajectoryIsWhatIsChecked) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  const Eigen::Vector3d torso(1.15, 0.0, 0.7);
+  SeePerson(t, torso);
+  // The person stands still, hand 0.55 m from the robot's hand: clear while
+  // the robot holds; a trajectory swinging the arm out to x = 0.78 m is not.
+  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, {0, 0, 0}, 15, 1.0 / 15)), std::nullopt);
+  EXPECT_LT(monitor_.Evaluate(t).max_bound, 0.05);
+  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                          "panda_joint5", "panda_joint6", "panda_joint7"};
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 1.0},
+                                      {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, 0.9, 0, -0.4, 0, 1.571, 0.785}}),
+            std::nullopt);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_GE(r.max_bound, 0.05) << r.reason;
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+}
+
+TEST_F(RiskMonitorTest, RejectsInputsItCannotMap) {
+  EXPECT_EQ(*monitor_.UpdateRobotState(0, {"j1"}, {0.0}), "joint state: missing joint 'panda_joint1'");
+  EXPECT_EQ(*monitor_.UpdateSkeleton(0, {"head"}, {Eigen::Vector3d::Zero()}), "skeleton: missing joint 'neck'");
+  PredictionInput p = Predict(0, {2, 0, 1}, {0, 0, 0}, 3, 0.1);
+  p.covariances[0][4] = -Eigen::Matrix3d::Identity();
+  ASSERT_TRUE(monitor_.UpdatePrediction(p).has_value());
+  EXPECT_NE(monitor_.UpdatePrediction(p)->find("not positive definite"), std::string::npos);
+  p = Predict(0, {2, 0, 1}, {0, 0, 0}, 3, 0.1);
+  p.means[0].pop_back();
+  EXPECT_EQ(*monitor_.UpdatePrediction(p), "prediction action 0 has the wrong number of Gaussians");
+}
+
+}  // namespace
+}  // namespace iplan::collision_risk
