@@ -1,0 +1,91 @@
+// A simulated robot arm: follows a time-stamped joint trajectory at the
+// control rate within the joint position, velocity and acceleration limits,
+// obeys protective stop / resume with a configured stopping time, and counts
+// true contacts between its collision spheres and a person's true body.
+// No DDS types. Units: rad, rad/s, rad/s^2, s, m; times in ns since the epoch.
+// Not thread-safe (one owner).
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/collision/human_model.h"
+#include "iplan/collision/robot_model.h"
+
+namespace iplan::robot_sim {
+
+struct SimulatorParams {
+  double stopping_time = 0.3;  ///< s, T_s: a protective stop brings every joint to rest within it
+  double contact_margin = 0.0; ///< m; spheres closer than this count as touching
+  /// Empty when valid, else the reason.
+  std::string Validate() const;
+};
+
+/// A trajectory to follow: points at `times` (s after start_ns).
+struct Trajectory {
+  int64_t start_ns = 0;
+  std::vector<double> times;
+  std::vector<Eigen::VectorXd> positions;  ///< model joint order
+};
+
+class RobotSimulator {
+ public:
+  /// `q0`: initial configuration (model joint order). Throws
+  /// std::invalid_argument on a wrong size, a position outside the limits or
+  /// invalid params.
+  RobotSimulator(collision::RobotModel robot, const Eigen::VectorXd& q0, SimulatorParams params);
+
+  /// Replaces the trajectory being followed. Returns why it was refused
+  /// (unknown joint names, non-increasing times, points outside the limits).
+  std::optional<std::string> SetTrajectory(int64_t start_ns, const std::vector<std::string>& names,
+                                           const std::vector<double>& times,
+                                           const std::vector<std::vector<double>>& positions);
+  /// Protective stop: decelerate every joint to rest within stopping_time.
+  void Stop();
+  /// Resume following the trajectory (from where its timing says it is now).
+  void Resume();
+  bool stopped() const { return stop_requested_; }
+
+  /// Advances the simulation to `now_ns` by one control step of `dt` s:
+  /// tracks the trajectory's position at now_ns within velocity and
+  /// acceleration limits (or decelerates when stopped).
+  void Step(int64_t now_ns, double dt);
+
+  /// Checks the robot's spheres against the person's true body (joint
+  /// positions in body joint order, 3 x J). Returns the minimum surface
+  /// distance (m) and counts a contact when it goes below contact_margin
+  /// (a contact is counted once per episode of touching).
+  double UpdateContacts(const Eigen::Matrix3Xd& true_joints, const collision::HumanBodyModel& body);
+
+  const Eigen::VectorXd& q() const { return q_; }
+  const Eigen::VectorXd& qd() const { return qd_; }
+  std::vector<std::string> joint_names() const;
+  int contacts() const { return contacts_; }
+  double min_separation_seen() const { return min_separation_seen_; }
+  /// Max over the last stop of the end-effector (last sphere) travel after the stop command (m).
+  double last_stopping_distance() const { return last_stopping_distance_; }
+  const collision::RobotModel& robot() const { return robot_; }
+
+ private:
+  Eigen::VectorXd Desired(int64_t now_ns) const;
+
+  collision::RobotModel robot_;
+  SimulatorParams params_;
+  collision::RobotData data_;
+  Eigen::VectorXd q_, qd_;
+  Eigen::VectorXd lower_, upper_, vmax_, amax_;
+  std::optional<Trajectory> trajectory_;
+  bool stop_requested_ = false;
+  Eigen::VectorXd stop_decel_;  // per joint deceleration of the current stop
+  Eigen::Vector3d stop_start_ee_ = Eigen::Vector3d::Zero();
+  double last_stopping_distance_ = 0;
+  bool touching_ = false;
+  int contacts_ = 0;
+  double min_separation_seen_ = 1e6;
+};
+
+}  // namespace iplan::robot_sim

@@ -1,0 +1,135 @@
+// iplan-robot-sim: a simulated robot for the demo cell and the tests.
+// Follows /iplan/robot/trajectory, publishes /joint_states, obeys
+// /iplan/safety/command, and counts true contacts with the simulated
+// person's true body (/iplan/sim/human_truth).
+#include <chrono>
+#include <filesystem>
+
+#include "core/robot_simulator.h"
+#include "iplan/framework/service.h"
+
+namespace iplan::robot_sim {
+namespace {
+
+using framework::ConfigSection;
+using framework::Node;
+using framework::Result;
+
+class RobotSimService : public framework::Service {
+ public:
+  Result OnConfigure(ConfigSection& config, Node& node) override {
+    std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml";
+    std::vector<double> q0 = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+    SimulatorParams params;
+    config.Read("robot", &robot_file);
+    config.Read("human_body", &body_file);
+    config.Read("initial_positions", &q0);
+    config.Read("control_rate_hz", &control_rate_hz_, framework::InRange(10.0, 2000.0));
+    config.Read("publish_rate_hz", &publish_rate_hz_, framework::InRange(1.0, 1000.0));
+    config.Read("stopping_time", &params.stopping_time, framework::Positive<double>());
+    config.Read("contact_margin", &params.contact_margin, framework::NonNegative<double>());
+    const auto base = std::filesystem::path(config.file()).parent_path();
+    try {
+      auto robot = collision::LoadRobotModelFromYaml((base / robot_file).lexically_normal().string());
+      sim_ = std::make_unique<RobotSimulator>(std::move(robot), Eigen::Map<const Eigen::VectorXd>(q0.data(), static_cast<Eigen::Index>(q0.size())), params);
+      body_ = std::make_unique<collision::HumanBodyModel>(
+          collision::LoadHumanBodyParams((base / body_file).lexically_normal().string()));
+    } catch (const std::exception& e) {
+      return Result::Fail(e.what());
+    }
+    joint_writer_ = &node.Advertise(framework::topics::JointStates());
+    using SI = const dds::SampleInfo&;
+    node.Subscribe(framework::topics::RobotTrajectory(),
+                   std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
+                     std::vector<double> times;
+                     std::vector<std::vector<double>> pos;
+                     for (const auto& p : m.points) {
+                       times.push_back(p.time_from_start.sec + p.time_from_start.nanosec * 1e-9);
+                       pos.push_back(p.positions);
+                     }
+                     if (auto why = sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos)) {
+                       if (++rejected_trajectories_ == 1 || rejected_trajectories_ % 100 == 0) {
+                         node.log().warn("trajectory refused ({} so far): {}", rejected_trajectories_, *why);
+                       }
+                       node.SetDiagnosticValue("rejected_trajectories", std::to_string(rejected_trajectories_));
+                     }
+                   }));
+    node.Subscribe(framework::topics::SafetyCommand(),
+                   std::function<void(const msg::SafetyCommand&, SI)>([this, &node](const msg::SafetyCommand& m, SI) {
+                     if (m.command == msg::SafetyCommand::PROTECTIVE_STOP && !sim_->stopped()) {
+                       sim_->Stop();
+                       ++stops_;
+                       node.log().warn("protective stop from {}: {}", m.source, m.reason);
+                     } else if (m.command == msg::SafetyCommand::RESUME && sim_->stopped()) {
+                       sim_->Resume();
+                       node.log().info("resume from {}: {}", m.source, m.reason);
+                     }
+                   }));
+    node.Subscribe(framework::topics::HumanTruth(),
+                   std::function<void(const msg::HumanSkeleton&, SI)>([this, &node](const msg::HumanSkeleton& m, SI) {
+                     Eigen::Matrix3Xd joints(3, body_->num_joints());
+                     for (int j = 0; j < body_->num_joints(); ++j) {
+                       const std::string& name = body_->params().joints[static_cast<std::size_t>(j)];
+                       const auto it = std::find_if(m.joints.begin(), m.joints.end(), [&](const msg::HumanJoint& h) { return h.name == name; });
+                       if (it == m.joints.end()) return;  // not this body model's joints
+                       joints.col(j) << it->position.x, it->position.y, it->position.z;
+                     }
+                     const int before = sim_->contacts();
+                     sim_->UpdateContacts(joints, *body_);
+                     if (sim_->contacts() > before) node.log().error("TRUE CONTACT with the person (#{})", sim_->contacts());
+                   }));
+    return Result::Ok();
+  }
+
+  Result OnActivate(Node& node) override {
+    last_ = msg::ToNanoseconds(msg::Now());
+    const auto period = std::chrono::nanoseconds(static_cast<int64_t>(1e9 / control_rate_hz_));
+    const int publish_every = std::max(1, static_cast<int>(std::lround(control_rate_hz_ / publish_rate_hz_)));
+    timer_ = node.AddTimer(period, [this, &node, publish_every] {
+      const auto t0 = std::chrono::steady_clock::now();
+      const int64_t now = msg::ToNanoseconds(msg::Now());
+      sim_->Step(now, (now - last_) * 1e-9);
+      last_ = now;
+      if (++steps_ % publish_every == 0) {
+        msg::JointState js;
+        js.header.stamp = msg::TimeFromNanoseconds(now);
+        js.name = sim_->joint_names();
+        js.position.assign(sim_->q().data(), sim_->q().data() + sim_->q().size());
+        js.velocity.assign(sim_->qd().data(), sim_->qd().data() + sim_->qd().size());
+        joint_writer_->Write(js);
+        node.SetDiagnosticValue("true_contacts", std::to_string(sim_->contacts()));
+        node.SetDiagnosticValue("min_true_separation_m", std::to_string(sim_->min_separation_seen()));
+        node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
+        node.SetDiagnosticValue("stopped", sim_->stopped() ? "true" : "false");
+        node.SetDiagnosticValue("last_stopping_distance_m", std::to_string(sim_->last_stopping_distance()));
+      }
+      node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+    });
+    return Result::Ok();
+  }
+
+  Result OnDeactivate(Node& node) override {
+    node.CancelTimer(timer_);
+    node.log().info("true contacts {}, minimum true separation {:.3f} m, protective stops {}", sim_->contacts(),
+                    sim_->min_separation_seen(), stops_);
+    return Result::Ok();
+  }
+
+ private:
+  double control_rate_hz_ = 100, publish_rate_hz_ = 50;
+  std::unique_ptr<RobotSimulator> sim_;
+  std::unique_ptr<collision::HumanBodyModel> body_;
+  dds::Writer<msg::JointState>* joint_writer_ = nullptr;
+  int timer_ = 0;
+  int64_t last_ = 0;
+  uint64_t steps_ = 0, rejected_trajectories_ = 0, stops_ = 0;
+};
+
+}  // namespace
+}  // namespace iplan::robot_sim
+
+int main(int argc, char** argv) {
+  return iplan::framework::RunService(
+      argc, argv, {"robot_sim", "simulated robot: follows trajectories, obeys protective stops, counts true contacts"},
+      [] { return std::make_unique<iplan::robot_sim::RobotSimService>(); });
+}

@@ -1,0 +1,97 @@
+#include "core/robot_simulator.h"
+
+#include <gtest/gtest.h>
+
+namespace iplan::robot_sim {
+namespace {
+
+constexpr int64_t kSec = 1000000000;
+
+class RobotSimulatorTest : public ::testing::Test {
+ protected:
+  RobotSimulatorTest()
+      : sim_(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"), Ready(),
+             SimulatorParams{}) {}
+  static Eigen::VectorXd Ready() {
+    Eigen::VectorXd q(7);
+    q << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+    return q;
+  }
+  std::vector<std::vector<double>> Points(const Eigen::VectorXd& a, const Eigen::VectorXd& b) {
+    return {std::vector<double>(a.data(), a.data() + 7), std::vector<double>(b.data(), b.data() + 7)};
+  }
+  RobotSimulator sim_;
+};
+
+TEST_F(RobotSimulatorTest, FollowsATrajectoryWithinLimits) {
+  Eigen::VectorXd goal = Ready();
+  goal[0] = 1.2;
+  goal[3] = -1.8;
+  ASSERT_EQ(sim_.SetTrajectory(0, sim_.joint_names(), {0.0, 1.5}, Points(Ready(), goal)), std::nullopt);
+  const auto& m = sim_.robot();
+  Eigen::VectorXd prev_qd = sim_.qd();
+  const double dt = 0.01;
+  for (int k = 1; k <= 300; ++k) {
+    sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+    for (int i = 0; i < 7; ++i) {
+      const auto& lim = m.joints[static_cast<std::size_t>(m.q_joints[static_cast<std::size_t>(i)])].limits;
+      ASSERT_LE(std::abs(sim_.qd()[i]), lim.velocity + 1e-9) << "joint " << i << " at step " << k;
+      ASSERT_LE(std::abs(sim_.qd()[i] - prev_qd[i]) / dt, lim.acceleration + 1e-6) << "joint " << i;
+      ASSERT_GE(sim_.q()[i], lim.lower);
+      ASSERT_LE(sim_.q()[i], lim.upper);
+    }
+    prev_qd = sim_.qd();
+  }
+  EXPECT_LT((sim_.q() - goal).norm(), 1e-3);
+}
+
+TEST_F(RobotSimulatorTest, ProtectiveStopComesToRestWithinTheStoppingTime) {
+  Eigen::VectorXd goal = Ready();
+  goal[0] = 2.0;
+  ASSERT_EQ(sim_.SetTrajectory(0, sim_.joint_names(), {0.0, 1.0}, Points(Ready(), goal)), std::nullopt);
+  const double dt = 0.01;
+  int k = 1;
+  for (; k <= 50; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  ASSERT_GT(sim_.qd().norm(), 0.5);
+  sim_.Stop();
+  const int stop_step = k;
+  for (; k <= stop_step + 31; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  EXPECT_EQ(sim_.qd().norm(), 0.0);  // at rest within 0.3 s (+ one step)
+  const Eigen::VectorXd held = sim_.q();
+  for (; k <= stop_step + 100; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  EXPECT_EQ(sim_.q(), held);
+  EXPECT_GT(sim_.last_stopping_distance(), 0.0);
+  sim_.Resume();
+  for (; k <= stop_step + 400; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  EXPECT_LT((sim_.q() - goal).norm(), 1e-3);
+}
+
+TEST_F(RobotSimulatorTest, RefusesBadTrajectories) {
+  Eigen::VectorXd far = Ready();
+  far[0] = 5.0;
+  EXPECT_EQ(*sim_.SetTrajectory(0, sim_.joint_names(), {0.0, 1.0}, Points(Ready(), far)),
+            "point 1 puts panda_joint1 outside its limits");
+  EXPECT_EQ(*sim_.SetTrajectory(0, {"a", "b"}, {0.0}, {{0.0, 0.0}}), "trajectory lacks joint 'panda_joint1'");
+  EXPECT_EQ(*sim_.SetTrajectory(0, sim_.joint_names(), {1.0, 1.0}, Points(Ready(), Ready())), "times do not increase");
+}
+
+TEST_F(RobotSimulatorTest, CountsEachTouchOnce) {
+  const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
+  Eigen::Matrix3Xd far(3, 9), near(3, 9);
+  for (int j = 0; j < 9; ++j) {
+    far.col(j) = Eigen::Vector3d(2.0, 0.0, 0.5 + 0.1 * j);
+    near.col(j) = Eigen::Vector3d(0.3, 0.0, 0.5 + 0.02 * j);  // through the robot's hand
+  }
+  EXPECT_GT(sim_.UpdateContacts(far, body), 1.0);
+  EXPECT_EQ(sim_.contacts(), 0);
+  EXPECT_LT(sim_.UpdateContacts(near, body), 0.0);
+  sim_.UpdateContacts(near, body);
+  EXPECT_EQ(sim_.contacts(), 1);
+  sim_.UpdateContacts(far, body);
+  sim_.UpdateContacts(near, body);
+  EXPECT_EQ(sim_.contacts(), 2);
+  EXPECT_LT(sim_.min_separation_seen(), 0.0);
+}
+
+}  // namespace
+}  // namespace iplan::robot_sim
