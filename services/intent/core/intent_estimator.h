@@ -11,8 +11,9 @@
 // epoch, typically Unix time).
 //
 // Dependencies: this core -> iplan::intent -> Eigen. Not thread-safe (one
-// instance per executor thread); Update allocates only while a body's buffer
-// grows or a body is first seen.
+// instance per executor thread). Update allocates (the body's frame buffer,
+// the window while it is shorter than T, and inside PredictIntent); it is
+// not real-time safe.
 #pragma once
 
 #include <cstdint>
