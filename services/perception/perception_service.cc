@@ -1,7 +1,11 @@
 // iplan-perception: publishes tracked human skeletons from a provider.
 // Provider "synthetic": a simulated person (core/synthetic_person.h).
+// Provider "replay": recorded sequences from a skeleton CSV file, at their
+// recorded times (core/skeleton_replay.h).
 #include <chrono>
+#include <filesystem>
 
+#include "core/skeleton_replay.h"
 #include "core/synthetic_person.h"
 #include "iplan/framework/service.h"
 
@@ -15,7 +19,7 @@ using framework::Result;
 class PerceptionService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    config.Read("provider", &provider_, framework::OneOf({"synthetic"}));
+    config.Read("provider", &provider_, framework::OneOf({"synthetic", "replay"}));
     config.Read("rate_hz", &rate_hz_, framework::InRange(0.5, 1000.0));
     config.Read("frame_id", &frame_id_);
     config.Read("publish_truth", &publish_truth_);
@@ -38,7 +42,8 @@ class PerceptionService : public framework::Service {
     syn.Read("seed", &seed, framework::NonNegative<int>());
     params_.seed = static_cast<uint64_t>(seed);
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
-    person_ = std::make_unique<SyntheticPerson>(params_);
+    if (Result r = ConfigureReplay(config); !r.ok) return r;
+    if (provider_ == "synthetic") person_ = std::make_unique<SyntheticPerson>(params_);
     skeleton_writer_ = &node.Advertise(framework::topics::HumanSkeleton());
     if (publish_truth_) truth_writer_ = &node.Advertise(framework::topics::HumanTruth());
     node.SetDiagnosticValue("provider", provider_);
@@ -47,6 +52,11 @@ class PerceptionService : public framework::Service {
 
   Result OnActivate(Node& node) override {
     start_ = std::chrono::system_clock::now();
+    if (replay_) {
+      start_ns_ = msg::ToNanoseconds(msg::Now());
+      timer_ = node.AddTimer(kReplayPoll, [this, &node] { ReplayTick(node); });
+      return Result::Ok();
+    }
     timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(1e9 / rate_hz_)), [this, &node] { Tick(node); });
     return Result::Ok();
   }
@@ -57,11 +67,89 @@ class PerceptionService : public framework::Service {
   }
 
  private:
-  msg::HumanSkeleton ToMessage(const std::vector<JointSample>& joints, const msg::Time& stamp) const {
+  // Frames are published within this period of their play time.
+  static constexpr std::chrono::milliseconds kReplayPoll{5};
+
+  // Reads perception.replay (its scalar keys always, so that switching the
+  // provider keeps the file valid; joint_map only for provider replay, since
+  // its keys are the file's joint names) and loads the file.
+  Result ConfigureReplay(ConfigSection& config) {
+    ConfigSection rep = config.Section("replay");
+    SkeletonReplayParams p;
+    rep.Read("file", &p.file);
+    rep.Read("sequences", &p.sequences);
+    rep.Read("subjects", &p.subjects);
+    rep.Read("loop", &p.loop);
+    rep.Read("rate", &p.rate, framework::Positive<double>());
+    rep.Read("pause", &p.pause, framework::Positive<double>());
+    rep.Read("start_delay", &p.start_delay, framework::NonNegative<double>());
+    ConfigSection tf = rep.Section("transform");
+    std::vector<double> translation = {0, 0, 0}, matrix;
+    double yaw = 0;
+    const bool has_xyz = tf.Read("translation", &translation, framework::Check<std::vector<double>>(
+        [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; }));
+    const bool has_yaw = tf.Read("yaw", &yaw);
+    if (tf.Read("matrix", &matrix)) {
+      if (has_xyz || has_yaw) {
+        tf.AddError("matrix", "give either matrix or translation/yaw, not both");
+      } else if (const std::string why = TransformFromMatrix(matrix, &p.X_WS); !why.empty()) {
+        tf.AddError("matrix", why);
+      }
+    } else {
+      p.X_WS = TransformFromTranslationYaw({translation[0], translation[1], translation[2]}, yaw);
+    }
+    if (provider_ != "replay") return Result::Ok();
+    if (p.file.empty()) {
+      rep.AddError("file", "required with provider replay");
+      return Result::Ok();  // reported by the configuration check
+    }
+    std::filesystem::path file(p.file);
+    if (file.is_relative()) file = std::filesystem::path(config.file()).parent_path() / file;
+    p.file = file.string();
+    try {
+      intent::SkeletonDataset data = intent::LoadSkeletonCsv(p.file);
+      ConfigSection map = rep.Section("joint_map");
+      for (const std::string& name : data.joint_names) {
+        std::string to;
+        if (map.Read(name, &to)) p.joint_map[name] = to;
+      }
+      replay_ = std::make_unique<SkeletonReplay>(p, std::move(data));
+    } catch (const std::exception& e) {
+      return Result::Fail(config.file() + ": key 'perception.replay': " + e.what());
+    }
+    return Result::Ok();
+  }
+
+  void ReplayTick(Node& node) {
+    const auto tick_start = std::chrono::steady_clock::now();
+    const double now = 1e-9 * static_cast<double>(msg::ToNanoseconds(msg::Now()) - start_ns_);
+    while (replay_->Next(now, &frame_)) {
+      const msg::Time stamp = msg::TimeFromNanoseconds(start_ns_ + std::llround(frame_.play_time * 1e9));
+      std::string err;
+      if (!skeleton_writer_->Write(ToMessage(frame_.joints, stamp, frame_.body_id), &err)) {
+        node.log().warn("skeleton not published: {}", err);
+      }
+      ++published_;
+      if (frame_.sequence_id != sequence_) {
+        sequence_ = frame_.sequence_id;
+        node.SetDiagnosticValue("replay_sequence", sequence_ + " (" + frame_.action + ")");
+      }
+    }
+    node.SetDiagnosticValue("published", std::to_string(published_));
+    if (replay_->finished() && !announced_end_) {
+      node.log().info("replay finished after {} skeletons", published_);
+      node.SetDiagnosticValue("replay_finished", "true");
+      announced_end_ = true;
+    }
+    node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - tick_start).count());
+  }
+
+  msg::HumanSkeleton ToMessage(const std::vector<JointSample>& joints, const msg::Time& stamp,
+                               uint32_t body_id = 1) const {
     msg::HumanSkeleton s;
     s.header.stamp = stamp;
     s.header.frame_id = frame_id_;
-    s.body_id = 1;
+    s.body_id = body_id;
     s.confidence = 1.0;
     s.joints.reserve(joints.size());
     for (const auto& j : joints) {
@@ -103,6 +191,11 @@ class PerceptionService : public framework::Service {
   std::chrono::system_clock::time_point start_;
   int timer_ = 0;
   uint64_t published_ = 0;
+  std::unique_ptr<SkeletonReplay> replay_;
+  ReplayFrame frame_;
+  int64_t start_ns_ = 0;
+  std::string sequence_;
+  bool announced_end_ = false;
 };
 
 }  // namespace
@@ -110,6 +203,6 @@ class PerceptionService : public framework::Service {
 
 int main(int argc, char** argv) {
   return iplan::framework::RunService(
-      argc, argv, {"perception", "publishes tracked human skeletons from a provider (synthetic person)"},
+      argc, argv, {"perception", "publishes tracked human skeletons from a provider (synthetic person or recorded replay)"},
       [] { return std::make_unique<iplan::perception::PerceptionService>(); });
 }

@@ -56,7 +56,17 @@ INSTANTIATE_TEST_SUITE_P(
                       BadConfig{"perception:\n  synthetic:\n    torso: [1, 2]\n",
                                 "key 'perception.synthetic.torso': must have 3 numbers"},
                       BadConfig{"node:\n  diagnostics_period: -1\n", "key 'node.diagnostics_period': must be >= 0"},
-                      BadConfig{"perceptoin:\n  rate_hz: 30\n", "unknown key 'perceptoin'"}));
+                      BadConfig{"perceptoin:\n  rate_hz: 30\n", "unknown key 'perceptoin'"},
+                      BadConfig{"perception:\n  provider: replay\n",
+                                "key 'perception.replay.file': required with provider replay"},
+                      BadConfig{"perception:\n  provider: replay\n  replay:\n    file: " IPLAN_SHARED_DIR
+                                "/data/florence3d.csv\n    joint_map:\n      wrist: hand_r\n",
+                                "unknown key 'perception.replay.joint_map.wrist'"},
+                      BadConfig{"perception:\n  provider: replay\n  replay:\n    file: " IPLAN_SHARED_DIR
+                                "/data/florence3d.csv\n    sequences: [florence_nope]\n",
+                                "key 'perception.replay': sequence 'florence_nope' is not in"},
+                      BadConfig{"perception:\n  replay:\n    transform:\n      matrix: [1, 0, 0]\n",
+                                "key 'perception.replay.transform.matrix': must have 16 numbers"}));
 
 TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
   Process missing({BinPath("iplan-perception"), "--config", "/nonexistent/perception.yaml"});

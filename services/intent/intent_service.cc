@@ -1,0 +1,180 @@
+// iplan-intent: for every accepted human skeleton, publishes the action
+// belief p(action | motion) and the predicted future motion (a Gaussian
+// mixture over actions) computed by the intent model (common/intent) through
+// the online estimator in core/. Positions stay in the skeleton's frame
+// (header.frame_id), which must be the frame the model was trained in.
+#include <chrono>
+#include <filesystem>
+#include <map>
+#include <memory>
+
+#include "core/intent_estimator.h"
+#include "iplan/framework/service.h"
+#include "iplan/intent/model_io.h"
+
+namespace iplan::intent_service {
+namespace {
+
+using framework::ConfigSection;
+using framework::Node;
+using framework::Result;
+
+class IntentService : public framework::Service {
+ public:
+  Result OnConfigure(ConfigSection& config, Node& node) override {
+    std::string model_path;
+    std::vector<std::string> joints;
+    double rate = 0;
+    const bool have_model = config.Require("model", &model_path);
+    const bool have_joints = config.Require("joints", &joints, framework::Check<std::vector<std::string>>(
+        [](const std::vector<std::string>& v) { return v.empty() ? "must name at least one joint" : ""; }));
+    const bool have_rate = config.Require("rate_hz", &rate, framework::Positive<double>());
+    config.Read("body_timeout", &params_.body_timeout, framework::Positive<double>());
+    config.Read("max_gap", &params_.max_gap, framework::Positive<double>());
+    config.Read("max_bodies", &params_.max_bodies, framework::InRange(1, 1000));
+    if (!have_model || !have_joints || !have_rate) return Result::Fail("incomplete configuration");
+    if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
+
+    // Relative model paths are relative to the configuration file's folder.
+    std::filesystem::path path(model_path);
+    if (path.is_relative()) path = std::filesystem::path(config.file()).parent_path() / path;
+    intent::ModelExpectation expected;
+    expected.joints = joints;
+    expected.rate = rate;
+    try {
+      model_ = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(path.string(), expected));
+      estimator_ = std::make_unique<IntentEstimator>(model_, params_);
+    } catch (const std::exception& e) {
+      return Result::Fail(config.file() + ": key 'intent.model': " + e.what());
+    }
+    node.log().info("model {}: {} actions, {} joints, {} Hz, window {} frames, horizon {} steps", path.string(),
+                    model_->actions.size(), joints.size(), rate, model_->config.window, model_->config.horizon);
+
+    belief_writer_ = &node.Advertise(framework::topics::ActionBelief());
+    prediction_writer_ = &node.Advertise(framework::topics::HumanPrediction());
+    node.Subscribe(framework::topics::HumanSkeleton(),
+                   std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                       [this, &node](const msg::HumanSkeleton& s, const dds::SampleInfo&) { OnSkeleton(node, s); }));
+    // Static parts of the outputs.
+    belief_.actions = model_->actions;
+    prediction_.time_step = 1.0 / model_->config.rate;
+    prediction_.num_steps = static_cast<uint32_t>(model_->config.horizon);
+    prediction_.joint_names = model_->config.joints.joints;
+    prediction_.actions.resize(model_->actions.size());
+    for (std::size_t c = 0; c < model_->actions.size(); ++c) prediction_.actions[c].action = model_->actions[c];
+    node.SetDiagnosticValue("model", path.string());
+    UpdateDiagnostics(node);
+    return Result::Ok();
+  }
+
+  Result OnActivate(Node& node) override {
+    // Bodies that stop being published are forgotten even if no other body
+    // keeps the estimator busy.
+    const auto period = std::chrono::duration<double>(params_.body_timeout / 2);
+    timer_ = node.AddTimer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this, &node] {
+      if (estimator_->DropStale(msg::ToSeconds(msg::Now())) > 0) UpdateDiagnostics(node);
+    });
+    return Result::Ok();
+  }
+
+  Result OnDeactivate(Node& node) override {
+    node.CancelTimer(timer_);
+    return Result::Ok();
+  }
+
+  Result OnCleanup(Node&) override {
+    estimator_.reset();
+    model_.reset();
+    return Result::Ok();
+  }
+
+ private:
+  void OnSkeleton(Node& node, const msg::HumanSkeleton& s) {
+    const auto start = std::chrono::steady_clock::now();
+    frame_.body_id = s.body_id;
+    frame_.stamp = msg::ToSeconds(s.header.stamp);
+    frame_.joints.resize(s.joints.size());
+    for (std::size_t j = 0; j < s.joints.size(); ++j) {
+      frame_.joints[j].name = s.joints[j].name;
+      frame_.joints[j].position = {s.joints[j].position.x, s.joints[j].position.y, s.joints[j].position.z};
+    }
+    const FrameResult r = estimator_->Update(frame_, &mixture_);
+    if (!r.accepted()) {
+      const std::string kind = ToString(r.status);
+      const uint64_t n = ++rejected_[kind];
+      ++rejected_total_;
+      if (n == 1) node.log().warn("skeleton of body {} rejected ({}): {}; further '{}' rejections are only counted",
+                                  s.body_id, kind, r.reason, kind);
+      node.SetDiagnosticValue("last_rejected_frame", r.reason);
+      UpdateDiagnostics(node);
+      return;
+    }
+    ++accepted_;
+    Publish(node, s);
+    if (accepted_ % 30 == 1) UpdateDiagnostics(node);
+    node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+
+  void Publish(Node& node, const msg::HumanSkeleton& s) {
+    belief_.header = s.header;
+    belief_.body_id = s.body_id;
+    belief_.probabilities.resize(mixture_.actions.size());
+    prediction_.header = s.header;
+    prediction_.body_id = s.body_id;
+    for (std::size_t c = 0; c < mixture_.actions.size(); ++c) {
+      const intent::ActionHypothesis& h = mixture_.actions[c];
+      belief_.probabilities[c] = h.probability;
+      msg::ActionPrediction& a = prediction_.actions[c];
+      a.probability = h.probability;
+      a.joints.resize(h.joints.size());
+      for (std::size_t k = 0; k < h.joints.size(); ++k) {  // both step-major
+        const intent::JointGaussian& g = h.joints[k];
+        a.joints[k].mean = {g.mean.x(), g.mean.y(), g.mean.z()};
+        for (int r = 0; r < 3; ++r) {
+          for (int q = 0; q < 3; ++q) a.joints[k].covariance[3 * r + q] = g.covariance(r, q);
+        }
+      }
+    }
+    std::string err;
+    if (!belief_writer_->Write(belief_, &err) && !warned_write_) {
+      node.log().error("action belief not published: {}", err);
+      warned_write_ = true;
+    }
+    if (!prediction_writer_->Write(prediction_, &err) && !warned_write_) {
+      node.log().error("prediction not published: {}", err);
+      warned_write_ = true;
+    }
+  }
+
+  void UpdateDiagnostics(Node& node) {
+    node.SetDiagnosticValue("frames_accepted", std::to_string(accepted_));
+    node.SetDiagnosticValue("frames_rejected", std::to_string(rejected_total_));
+    for (const auto& [kind, n] : rejected_) node.SetDiagnosticValue("frames_rejected/" + kind, std::to_string(n));
+    node.SetDiagnosticValue("bodies", std::to_string(estimator_->num_bodies()));
+  }
+
+  IntentEstimatorParams params_;
+  std::shared_ptr<const intent::IntentModel> model_;
+  std::unique_ptr<IntentEstimator> estimator_;
+  dds::Writer<msg::ActionBelief>* belief_writer_ = nullptr;
+  dds::Writer<msg::HumanPrediction>* prediction_writer_ = nullptr;
+  SkeletonFrame frame_;               // reused
+  intent::MixturePrediction mixture_; // reused
+  msg::ActionBelief belief_;          // reused
+  msg::HumanPrediction prediction_;   // reused
+  std::map<std::string, uint64_t> rejected_;
+  uint64_t rejected_total_ = 0;
+  uint64_t accepted_ = 0;
+  bool warned_write_ = false;
+  int timer_ = 0;
+};
+
+}  // namespace
+}  // namespace iplan::intent_service
+
+int main(int argc, char** argv) {
+  return iplan::framework::RunService(
+      argc, argv,
+      {"intent", "publishes the action belief and the predicted human motion for every tracked skeleton"},
+      [] { return std::make_unique<iplan::intent_service::IntentService>(); });
+}

@@ -1,0 +1,264 @@
+#include "../core/intent_estimator.h"
+
+#include <cmath>
+#include <limits>
+#include <random>
+
+#include <gtest/gtest.h>
+
+namespace iplan::intent_service {
+namespace {
+
+using intent::IntentModel;
+using intent::MixturePrediction;
+
+const std::vector<std::string> kJoints = {"wrist_l", "wrist_r", "elbow_l", "elbow_r", "shoulder_l", "shoulder_r"};
+
+// Rest pose (3 J), metres, a person 2 m in front of the sensor.
+Eigen::VectorXd Rest() {
+  return (Eigen::VectorXd(18) << -0.2, -0.4, 2, 0.2, -0.4, 2, -0.2, -0.1, 2, 0.2, -0.1, 2, -0.2, 0.2, 2, 0.2,
+          0.2, 2)
+      .finished();
+}
+
+// Pose of action a (0: raise left wrist, 1: raise right wrist, 2: still) at time t.
+Eigen::VectorXd Pose(int a, double t, double speed = 0.6) {
+  Eigen::VectorXd p = Rest();
+  const double lift = std::min(0.6, speed * t);
+  if (a == 0) p(1) += lift;
+  if (a == 1) p(4) += lift;
+  return p;
+}
+
+// A small seeded toy training set: 3 actions x 2 subjects x 3 repetitions at 30 Hz.
+intent::SkeletonDataset ToyData() {
+  std::mt19937 rng(7);
+  std::normal_distribution<double> noise(0.0, 0.004);
+  intent::SkeletonDataset d;
+  d.joint_names = kJoints;
+  const char* actions[3] = {"raise_left", "raise_right", "still"};
+  int id = 0;
+  for (const char* subject : {"p1", "p2"}) {
+    for (int a = 0; a < 3; ++a) {
+      for (int rep = 0; rep < 3; ++rep) {
+        intent::SkeletonSequence s;
+        s.id = "seq" + std::to_string(id++);
+        s.subject = subject;
+        s.action = actions[a];
+        const int n = 45;
+        s.time = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / 30.0);
+        s.positions.resize(n, 18);
+        for (int i = 0; i < n; ++i) {
+          Eigen::VectorXd p = Pose(a, s.time(i), 0.5 + 0.1 * rep);
+          for (int k = 0; k < 18; ++k) p(k) += noise(rng);
+          s.positions.row(i) = p.transpose();
+        }
+        d.sequences.push_back(std::move(s));
+      }
+    }
+  }
+  return d;
+}
+
+SkeletonFrame Frame(std::uint32_t body, double stamp, const Eigen::VectorXd& p,
+                    const std::vector<std::string>& names = kJoints) {
+  SkeletonFrame f;
+  f.body_id = body;
+  f.stamp = stamp;
+  for (std::size_t j = 0; j < names.size(); ++j) f.joints.push_back({names[j], p.segment<3>(3 * j)});
+  return f;
+}
+
+class IntentEstimatorTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    intent::IntentModelConfig c;
+    c.joints = intent::DefaultJointConfig(kJoints);
+    c.rate = 15.0;
+    c.window = 6;
+    c.horizon = 4;
+    intent::TrainParams p;
+    p.sigma_factors = {1.0};
+    p.lambdas = {1e-3};
+    p.pseudo_inputs = 6;
+    p.gp_iterations = 15;
+    p.max_forecast_windows = 60;
+    model_ = std::make_shared<const IntentModel>(intent::TrainIntentModel(ToyData(), c, p));
+  }
+  static void TearDownTestSuite() { model_.reset(); }
+  static std::shared_ptr<const IntentModel> model_;
+};
+std::shared_ptr<const IntentModel> IntentEstimatorTest::model_;
+
+// Model joint order may differ from kJoints: reorder a kJoints pose into a model-order row.
+Eigen::RowVectorXd ModelRow(const IntentModel& m, const Eigen::VectorXd& p) {
+  const auto idx = intent::JointIndices(kJoints, m.config.joints.joints);
+  Eigen::RowVectorXd row(3 * idx.size());
+  for (std::size_t j = 0; j < idx.size(); ++j) row.segment<3>(3 * j) = p.segment<3>(3 * idx[j]).transpose();
+  return row;
+}
+
+void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b, double tol) {
+  ASSERT_EQ(a.actions.size(), b.actions.size());
+  for (std::size_t c = 0; c < a.actions.size(); ++c) {
+    EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
+    ASSERT_EQ(a.actions[c].joints.size(), b.actions[c].joints.size());
+    for (std::size_t k = 0; k < a.actions[c].joints.size(); ++k) {
+      EXPECT_LE((a.actions[c].joints[k].mean - b.actions[c].joints[k].mean).norm(), tol);
+    }
+  }
+}
+
+TEST_F(IntentEstimatorTest, FramesAtTheModelRateGiveTheLibraryPredictionOfTheSameWindow) {
+  IntentEstimator est(model_, {});
+  const int T = model_->config.window;
+  const double dt = 1.0 / model_->config.rate;
+  Eigen::MatrixXd rows(0, 18);
+  MixturePrediction got, want;
+  for (int i = 0; i < T + 4; ++i) {
+    const double t = 1000.0 + i * dt;
+    const Eigen::VectorXd p = Pose(1, i * dt);
+    ASSERT_TRUE(est.Update(Frame(3, t, p), &got).accepted());
+    rows.conservativeResize(rows.rows() + 1, Eigen::NoChange);
+    rows.row(rows.rows() - 1) = ModelRow(*model_, p);
+    intent::PredictIntent(*model_, rows, &want);  // pads / takes the last T rows itself
+    ExpectSamePrediction(got, want, 1e-9);
+  }
+  EXPECT_EQ(got.horizon, model_->config.horizon);
+  EXPECT_EQ(got.num_joints, 6);
+  EXPECT_EQ(model_->actions[got.MostLikely()], "raise_right");
+}
+
+TEST_F(IntentEstimatorTest, FasterFramesAreResampledToTheModelRate) {
+  // 40 Hz frames of a linear motion: resampling must give exactly the poses
+  // at the model-rate grid ending at the newest stamp.
+  IntentEstimator est(model_, {});
+  const double dt = 1.0 / model_->config.rate;
+  const Eigen::VectorXd velocity = Eigen::VectorXd::LinSpaced(18, -0.2, 0.3);
+  auto pose = [&](double t) -> Eigen::VectorXd { return Rest() + velocity * t; };
+  MixturePrediction got, want;
+  double t = 0;
+  for (int i = 0; i < 30; ++i) {
+    t = i / 40.0;
+    ASSERT_TRUE(est.Update(Frame(1, 50.0 + t, pose(t)), &got).accepted());
+  }
+  Eigen::MatrixXd grid(model_->config.window, 18);
+  for (int r = 0; r < grid.rows(); ++r) grid.row(r) = ModelRow(*model_, pose(t - (grid.rows() - 1 - r) * dt));
+  intent::PredictIntent(*model_, grid, &want);
+  ExpectSamePrediction(got, want, 1e-9);
+  double sum = 0;
+  for (const auto& h : got.actions) sum += h.probability;
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+}
+
+TEST_F(IntentEstimatorTest, ClassifiesARaisedLeftWristFromA30HzStream) {
+  IntentEstimator est(model_, {});
+  MixturePrediction got;
+  for (int i = 0; i < 40; ++i) ASSERT_TRUE(est.Update(Frame(2, i / 30.0, Pose(0, i / 30.0)), &got).accepted());
+  EXPECT_EQ(model_->actions[got.MostLikely()], "raise_left");
+  IntentEstimator still(model_, {});
+  for (int i = 0; i < 40; ++i) ASSERT_TRUE(still.Update(Frame(2, i / 30.0, Pose(2, i / 30.0)), &got).accepted());
+  EXPECT_EQ(model_->actions[got.MostLikely()], "still");
+}
+
+TEST_F(IntentEstimatorTest, BadFramesAreRejectedWithAReasonAndChangeNothing) {
+  IntentEstimator est(model_, {});
+  MixturePrediction out;
+  ASSERT_TRUE(est.Update(Frame(1, 10.0, Rest()), &out).accepted());
+  const MixturePrediction before = out;
+
+  SkeletonFrame missing = Frame(1, 10.1, Rest());
+  missing.joints.erase(missing.joints.begin() + 1);  // wrist_r
+  FrameResult r = est.Update(missing, &out);
+  EXPECT_EQ(r.status, FrameStatus::kMissingJoint);
+  EXPECT_NE(r.reason.find("wrist_r"), std::string::npos) << r.reason;
+
+  SkeletonFrame nan = Frame(1, 10.1, Rest());
+  nan.joints[3].position.y() = std::numeric_limits<double>::quiet_NaN();
+  r = est.Update(nan, &out);
+  EXPECT_EQ(r.status, FrameStatus::kMissingJoint);
+  EXPECT_NE(r.reason.find("'elbow_r' not detected"), std::string::npos) << r.reason;
+
+  SkeletonFrame zero = Frame(1, 10.1, Rest());
+  zero.joints[0].position.setZero();
+  EXPECT_EQ(est.Update(zero, &out).status, FrameStatus::kMissingJoint);
+
+  SkeletonFrame dup = Frame(1, 10.1, Rest());
+  dup.joints.push_back(dup.joints[2]);
+  r = est.Update(dup, &out);
+  EXPECT_EQ(r.status, FrameStatus::kDuplicateJoint);
+  EXPECT_NE(r.reason.find("elbow_l"), std::string::npos);
+
+  std::vector<std::string> wrong = kJoints;
+  for (auto& n : wrong) n = "kinect_" + n;
+  r = est.Update(Frame(1, 10.1, Rest(), wrong), &out);
+  EXPECT_EQ(r.status, FrameStatus::kMissingJoint);
+  EXPECT_NE(r.reason.find("shoulder_l"), std::string::npos) << r.reason;
+
+  SkeletonFrame empty;
+  empty.body_id = 1;
+  empty.stamp = 10.1;
+  EXPECT_EQ(est.Update(empty, &out).status, FrameStatus::kMissingJoint);
+
+  EXPECT_EQ(est.Update(Frame(1, 10.0, Rest()), &out).status, FrameStatus::kStampNotIncreasing);
+  EXPECT_EQ(est.Update(Frame(1, 9.0, Rest()), &out).status, FrameStatus::kStampNotIncreasing);
+  EXPECT_EQ(est.Update(Frame(1, std::nan(""), Rest()), &out).status, FrameStatus::kStampNotIncreasing);
+
+  EXPECT_EQ(est.buffered_frames(1), 1);
+  EXPECT_EQ(est.num_bodies(), 1);
+  ExpectSamePrediction(out, before, 0.0);  // output untouched by rejected frames
+
+  // Extra joints the model does not know are ignored; order does not matter.
+  SkeletonFrame extra = Frame(1, 10.1, Rest());
+  std::swap(extra.joints[0], extra.joints[5]);
+  extra.joints.push_back({"knee_l", Eigen::Vector3d(0, -1, 2)});
+  EXPECT_TRUE(est.Update(extra, &out).accepted());
+  EXPECT_EQ(est.buffered_frames(1), 2);
+}
+
+TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
+  IntentEstimatorParams p;
+  p.body_timeout = 0.5;
+  p.max_gap = 0.3;
+  p.max_bodies = 2;
+  IntentEstimator est(model_, p);
+  MixturePrediction out;
+  ASSERT_TRUE(est.Update(Frame(1, 1.0, Rest()), &out).accepted());
+  ASSERT_TRUE(est.Update(Frame(2, 0.9, Rest()), &out).accepted());  // own stamp history
+  EXPECT_EQ(est.Update(Frame(3, 1.1, Rest()), &out).status, FrameStatus::kTooManyBodies);
+  ASSERT_TRUE(est.Update(Frame(1, 1.05, Rest()), &out).accepted());
+  EXPECT_EQ(est.buffered_frames(1), 2);
+  EXPECT_EQ(est.DropStale(1.3), 0);
+  EXPECT_EQ(est.DropStale(1.45), 1);  // body 2 last seen at 0.9
+  EXPECT_EQ(est.buffered_frames(2), 0);
+  ASSERT_TRUE(est.Update(Frame(3, 1.5, Rest()), &out).accepted());
+  // Body 1 comes back after a gap longer than max_gap: its history restarts.
+  ASSERT_TRUE(est.Update(Frame(1, 1.5, Rest()), &out).accepted());
+  EXPECT_EQ(est.buffered_frames(1), 1);
+  // A frame of body 3 two timeouts later drops body 1 (not seen since 1.5 s).
+  ASSERT_TRUE(est.Update(Frame(3, 2.6, Rest()), &out).accepted());
+  EXPECT_EQ(est.num_bodies(), 1);
+  EXPECT_EQ(est.buffered_frames(3), 1);
+}
+
+TEST_F(IntentEstimatorTest, HistoryIsBoundedByTheWindowSpan) {
+  IntentEstimator est(model_, {});
+  MixturePrediction out;
+  for (int i = 0; i < 300; ++i) ASSERT_TRUE(est.Update(Frame(1, i / 30.0, Rest()), &out).accepted());
+  const double span = (model_->config.window - 1) / model_->config.rate;
+  EXPECT_LE(est.buffered_frames(1), static_cast<int>(std::ceil(span * 30)) + 2);
+}
+
+TEST(IntentEstimatorParamsTest, InvalidParamsAreNamed) {
+  IntentEstimatorParams p;
+  EXPECT_EQ(p.Validate(), "");
+  p.body_timeout = 0;
+  EXPECT_NE(p.Validate().find("body_timeout"), std::string::npos);
+  p = {};
+  p.max_bodies = 0;
+  EXPECT_NE(p.Validate().find("max_bodies"), std::string::npos);
+  EXPECT_THROW(IntentEstimator(nullptr, {}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace iplan::intent_service

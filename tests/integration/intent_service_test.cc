@@ -1,0 +1,439 @@
+// The intent service as a real process: a small model is trained here on
+// Florence 3D (two subjects), iplan-perception replays recorded sequences of
+// another subject (fastdds) into iplan-intent (cyclonedds), and this process
+// checks that every skeleton gets a belief and a prediction with consistent
+// stamps, sizes and valid Gaussians. Garbage skeletons are rejected and
+// counted without output and without a crash; a model that does not match
+// the configuration is refused at start (exit code 2).
+#include <signal.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <limits>
+#include <map>
+#include <set>
+
+#include <Eigen/Eigenvalues>
+#include <gtest/gtest.h>
+
+#include "iplan/dds/participant.h"
+#include "iplan/framework/node.h"
+#include "iplan/intent/intent_model.h"
+#include "iplan/intent/model_io.h"
+#include "iplan/intent/skeleton_data.h"
+#include "iplan/msg/time.h"
+#include "test_paths.h"
+
+namespace iplan::testing {
+namespace {
+
+using namespace std::chrono_literals;
+namespace fs = std::filesystem;
+
+const std::string kCsv = std::string(IPLAN_SHARED_DIR) + "/data/florence3d.csv";
+const std::string kSkeletonTopic = framework::topics::HumanSkeleton().name;
+// Played sequences (subject s02, not in the training set).
+const std::vector<std::string> kPlayed = {"florence_a01_s02_e01", "florence_a04_s02_e01", "florence_a06_s02_e01",
+                                          "florence_a08_s02_e02", "florence_a09_s02_e02"};
+const Eigen::Vector3d kSensorInWorld(0.5, -0.2, 0.1);  // replay transform: translation only, m
+
+class IntentServiceTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    dir_ = new std::string(::testing::TempDir() + "/iplan-intent-svc-" + std::to_string(getpid()));
+    fs::create_directories(*dir_);
+    // Florence names the hands wrist_*; the replay's joint_map publishes them
+    // as hand_* (the names of the default skeleton), so train with those names.
+    intent::SkeletonDataset all = intent::LoadSkeletonCsv(kCsv);
+    for (auto& n : all.joint_names) {
+      if (n == "wrist_l") n = "hand_l";
+      if (n == "wrist_r") n = "hand_r";
+    }
+    played_ = new intent::SkeletonDataset(intent::SelectSubjects(all, {"s02"}));
+    intent::IntentModelConfig c;
+    c.joints = intent::DefaultJointConfig(all.joint_names);
+    c.rate = 15.0;
+    c.window = 8;
+    c.horizon = 6;
+    intent::TrainParams p;
+    p.sigma_factors = {1.0};
+    p.lambdas = {1e-3};
+    p.pseudo_inputs = 8;
+    p.gp_iterations = 20;
+    p.max_forecast_windows = 80;
+    model_ = new intent::IntentModel(intent::TrainIntentModel(intent::SelectSubjects(all, {"s01", "s03"}), c, p));
+    intent::SaveIntentModel(*model_, *dir_ + "/florence.model");
+  }
+  static void TearDownTestSuite() {
+    fs::remove_all(*dir_);
+    delete model_;
+    delete played_;
+    delete dir_;
+  }
+
+  static std::string Write(const std::string& name, const std::string& content) {
+    const std::string path = *dir_ + "/" + name;
+    std::ofstream(path) << content;
+    return path;
+  }
+  // An intent configuration next to the model (relative model path).
+  static std::string IntentConfig(const std::string& name, const std::vector<std::string>& joints, double rate,
+                                  const std::string& model = "florence.model") {
+    std::string list;
+    for (const auto& j : joints) list += (list.empty() ? "" : ", ") + j;
+    return Write(name, "node:\n  diagnostics_period: 0.2\nintent:\n  model: " + model + "\n  joints: [" + list +
+                           "]\n  rate_hz: " + std::to_string(rate) + "\n  body_timeout: 1.0\n");
+  }
+
+  static std::string* dir_;
+  static intent::IntentModel* model_;
+  static intent::SkeletonDataset* played_;
+};
+std::string* IntentServiceTest::dir_ = nullptr;
+intent::IntentModel* IntentServiceTest::model_ = nullptr;
+intent::SkeletonDataset* IntentServiceTest::played_ = nullptr;
+
+// Latest diagnostics values of one service.
+struct Diagnostics {
+  std::map<std::string, std::map<std::string, std::string>> values;  // service -> key -> value
+  std::map<std::string, std::string> state;
+  void Subscribe(framework::Node& node) {
+    node.Subscribe(framework::topics::Diagnostics(),
+                   std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
+                       [this](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
+                         for (const auto& s : a.status) {
+                           state[s.name] = s.message;
+                           for (const auto& kv : s.values) values[s.name][kv.key] = kv.value;
+                         }
+                       }));
+  }
+  std::string Get(const std::string& svc, const std::string& key) const {
+    const auto it = values.find(svc);
+    if (it == values.end()) return "";
+    const auto kv = it->second.find(key);
+    return kv == it->second.end() ? "" : kv->second;
+  }
+};
+
+template <class F>
+bool SpinUntil(framework::Node& node, std::chrono::seconds timeout, F&& done) {
+  const auto end = std::chrono::steady_clock::now() + timeout;
+  while (!done()) {
+    if (std::chrono::steady_clock::now() > end) return false;
+    node.SpinOnce(20ms);
+  }
+  return true;
+}
+
+void SpinFor(framework::Node& node, std::chrono::milliseconds d) {
+  const auto end = std::chrono::steady_clock::now() + d;
+  while (std::chrono::steady_clock::now() < end) node.SpinOnce(10ms);
+}
+
+std::unique_ptr<dds::Participant> MakeParticipant(dds::Vendor vendor, int domain) {
+  dds::ParticipantOptions o;
+  o.vendor = vendor;
+  o.domain_id = domain;
+  o.name = "intent_service_test";
+  return dds::Participant::Create(o);
+}
+
+framework::NodeOptions Quiet() {
+  framework::NodeOptions o;
+  o.diagnostics_period = 0;
+  return o;
+}
+
+TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) {
+  const int domain = UniqueDomain(11);
+  auto participant = MakeParticipant(dds::Vendor::kCyclone, domain);
+  framework::Node node("observer", *participant, Quiet());
+  Diagnostics diag;
+  diag.Subscribe(node);
+  std::map<int64_t, msg::HumanSkeleton> skeletons;  // by stamp (ns)
+  std::map<int64_t, msg::ActionBelief> beliefs;
+  std::map<int64_t, msg::HumanPrediction> predictions;
+  int duplicate_outputs = 0;
+  node.Subscribe(framework::topics::HumanSkeleton(),
+                 std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanSkeleton& s, const dds::SampleInfo&) {
+                       skeletons[msg::ToNanoseconds(s.header.stamp)] = s;
+                     }));
+  node.Subscribe(framework::topics::ActionBelief(),
+                 std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
+                     [&](const msg::ActionBelief& b, const dds::SampleInfo&) {
+                       duplicate_outputs += beliefs.count(msg::ToNanoseconds(b.header.stamp));
+                       beliefs[msg::ToNanoseconds(b.header.stamp)] = b;
+                     }));
+  node.Subscribe(framework::topics::HumanPrediction(),
+                 std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanPrediction& p, const dds::SampleInfo&) {
+                       duplicate_outputs += predictions.count(msg::ToNanoseconds(p.header.stamp));
+                       predictions[msg::ToNanoseconds(p.header.stamp)] = p;
+                     }));
+
+  const std::vector<std::string>& joints = model_->config.joints.joints;
+  Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",
+                  "cyclonedds", "--domain", std::to_string(domain)});
+  ASSERT_TRUE(SpinUntil(node, 30s, [&] { return diag.state["intent"] == "active"; })) << intent.Stderr();
+
+  std::string seqs;
+  for (const auto& s : kPlayed) seqs += (seqs.empty() ? "" : ", ") + s;
+  const std::string perception_yaml = Write(
+      "perception.yaml",
+      "node:\n  diagnostics_period: 0.2\nperception:\n  provider: replay\n  frame_id: world\n  replay:\n"
+      "    file: " + kCsv + "\n    sequences: [" + seqs + "]\n    loop: false\n    rate: 1.0\n    pause: 0.3\n"
+      "    start_delay: 2.0\n    joint_map:\n      wrist_l: hand_l\n      wrist_r: hand_r\n"
+      "    transform:\n      translation: [0.5, -0.2, 0.1]\n      yaw: 0\n");
+  Process perception({BinPath("iplan-perception"), "--config", perception_yaml, "--dds", "fastdds", "--domain",
+                      std::to_string(domain)});
+  ASSERT_TRUE(SpinUntil(node, 60s, [&] { return diag.Get("perception", "replay_finished") == "true"; }))
+      << perception.Stderr();
+  SpinFor(node, 1500ms);  // last outputs and diagnostics
+
+  // Every played frame was published (all Florence joints are detected).
+  int frames = 0;
+  for (const auto& s : played_->sequences) {
+    if (std::find(kPlayed.begin(), kPlayed.end(), s.id) != kPlayed.end()) frames += static_cast<int>(s.time.size());
+  }
+  EXPECT_EQ(diag.Get("perception", "published"), std::to_string(frames));
+  ASSERT_GE(static_cast<int>(skeletons.size()), frames - 2) << "observer missed skeletons";
+  EXPECT_EQ(duplicate_outputs, 0);
+
+  // The first frame of the first sequence: renamed joints, moved into W.
+  const msg::HumanSkeleton& first = skeletons.begin()->second;
+  EXPECT_EQ(first.body_id, 1u);
+  const auto& seq0 = *std::find_if(played_->sequences.begin(), played_->sequences.end(),
+                                   [](const intent::SkeletonSequence& s) { return s.id == kPlayed[0]; });
+  const int hand_r = intent::JointIndices(played_->joint_names, {"hand_r"})[0];
+  bool found_hand = false;
+  for (const auto& j : first.joints) {
+    if (j.name != "hand_r") continue;
+    found_hand = true;
+    const Eigen::Vector3d p_W(j.position.x, j.position.y, j.position.z);
+    const Eigen::Vector3d p_S = seq0.positions.row(0).segment<3>(3 * hand_r).transpose();
+    EXPECT_LT((p_W - (p_S + kSensorInWorld)).norm(), 1e-9);
+  }
+  EXPECT_TRUE(found_hand);
+
+  // A belief and a prediction for (nearly) every skeleton, same stamp and body.
+  int matched = 0, checked_steps = 0;
+  for (const auto& [stamp, s] : skeletons) {
+    const auto b = beliefs.find(stamp);
+    const auto p = predictions.find(stamp);
+    if (b == beliefs.end() || p == predictions.end()) continue;
+    ++matched;
+    EXPECT_EQ(b->second.body_id, s.body_id);
+    EXPECT_EQ(p->second.body_id, s.body_id);
+    EXPECT_EQ(b->second.header.frame_id, "world");
+    ASSERT_EQ(b->second.actions, model_->actions);
+    ASSERT_EQ(b->second.probabilities.size(), model_->actions.size());
+    double sum = 0;
+    for (double q : b->second.probabilities) {
+      EXPECT_GE(q, 0.0);
+      EXPECT_LE(q, 1.0);
+      sum += q;
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-9);
+    const msg::HumanPrediction& pred = p->second;
+    EXPECT_DOUBLE_EQ(pred.time_step, 1.0 / 15.0);
+    ASSERT_EQ(pred.num_steps, 6u);
+    ASSERT_EQ(pred.joint_names, joints);
+    ASSERT_EQ(pred.actions.size(), model_->actions.size());
+    // Probability-weighted mean of step 0 for each joint, to compare with the skeleton.
+    std::vector<Eigen::Vector3d> step0(joints.size(), Eigen::Vector3d::Zero());
+    for (std::size_t c = 0; c < pred.actions.size(); ++c) {
+      const auto& a = pred.actions[c];
+      EXPECT_EQ(a.action, model_->actions[c]);
+      EXPECT_EQ(a.probability, b->second.probabilities[c]);
+      ASSERT_EQ(a.joints.size(), 6u * joints.size());
+      for (std::size_t k = 0; k < a.joints.size(); ++k) {
+        const auto& g = a.joints[k];
+        const Eigen::Vector3d mean(g.mean.x, g.mean.y, g.mean.z);
+        ASSERT_TRUE(mean.allFinite());
+        Eigen::Matrix3d cov;
+        for (int r = 0; r < 3; ++r) {
+          for (int q = 0; q < 3; ++q) cov(r, q) = g.covariance[static_cast<std::size_t>(3 * r + q)];
+        }
+        ASSERT_TRUE(cov.allFinite());
+        EXPECT_LT((cov - cov.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues().minCoeff(), 0.0);
+        if (k < joints.size()) step0[k] += a.probability * mean;
+      }
+    }
+    // One step (67 ms) ahead the person is still near where they were.
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      for (const auto& sj : s.joints) {
+        if (sj.name != joints[j]) continue;
+        EXPECT_LT((step0[j] - Eigen::Vector3d(sj.position.x, sj.position.y, sj.position.z)).norm(), 0.25)
+            << joints[j] << " at stamp " << stamp;
+        ++checked_steps;
+      }
+    }
+  }
+  EXPECT_GE(matched, static_cast<int>(skeletons.size()) - 2) << "skeletons without a belief and prediction";
+  std::cout << frames << " frames replayed, " << skeletons.size() << " skeletons seen, " << matched
+            << " with a belief and a prediction" << std::endl;
+  EXPECT_EQ(checked_steps, matched * static_cast<int>(joints.size()));
+  // Every output belongs to a published skeleton (the observer may have
+  // missed a few of those, never more than the count above allows).
+  int unknown_stamps = 0;
+  for (const auto& [stamp, b] : beliefs) unknown_stamps += skeletons.count(stamp) ? 0 : 1;
+  EXPECT_LE(unknown_stamps, frames - static_cast<int>(skeletons.size()));
+
+  // Within a body, stamps keep the recorded spacing (scaled by rate 1).
+  std::map<uint32_t, std::vector<int64_t>> by_body;
+  for (const auto& [stamp, s] : skeletons) by_body[s.body_id].push_back(stamp);
+  EXPECT_EQ(by_body.size(), kPlayed.size());
+  const auto& body1 = by_body[1];
+  ASSERT_EQ(body1.size(), static_cast<std::size_t>(seq0.time.size()));
+  EXPECT_NEAR((body1.back() - body1.front()) * 1e-9, seq0.time(seq0.time.size() - 1) - seq0.time(0), 1e-6);
+
+  EXPECT_EQ(diag.Get("intent", "frames_rejected"), "0");
+  EXPECT_GE(std::stoi(diag.Get("intent", "frames_accepted")), matched);
+  EXPECT_EQ(diag.Get("intent", "rejected/" + kSkeletonTopic), "0");
+  EXPECT_FALSE(diag.Get("intent", "cycle_time_p99_s").empty());
+
+  perception.Signal(SIGTERM);
+  intent.Signal(SIGTERM);
+  EXPECT_EQ(perception.Wait(10s), 0) << perception.Stderr();
+  EXPECT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+}
+
+msg::HumanSkeleton Skeleton(uint32_t body, const std::vector<std::string>& names, const msg::Time& stamp) {
+  msg::HumanSkeleton s;
+  s.header.stamp = stamp;
+  s.header.frame_id = "world";
+  s.body_id = body;
+  s.confidence = 1.0;
+  for (std::size_t j = 0; j < names.size(); ++j) {
+    msg::HumanJoint joint;
+    joint.name = names[j];
+    joint.position.x = 1.0 + 0.01 * static_cast<double>(j);
+    joint.position.y = 0.1 * static_cast<double>(j % 3);
+    joint.position.z = 1.0 + 0.05 * static_cast<double>(j);
+    joint.confidence = 1.0;
+    s.joints.push_back(joint);
+  }
+  return s;
+}
+
+TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
+  const int domain = UniqueDomain(12);
+  auto participant = MakeParticipant(dds::Vendor::kFastDds, domain);
+  framework::Node node("garbage", *participant, Quiet());
+  Diagnostics diag;
+  diag.Subscribe(node);
+  std::multiset<uint32_t> belief_bodies, prediction_bodies;
+  node.Subscribe(framework::topics::ActionBelief(),
+                 std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
+                     [&](const msg::ActionBelief& b, const dds::SampleInfo&) { belief_bodies.insert(b.body_id); }));
+  node.Subscribe(framework::topics::HumanPrediction(),
+                 std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanPrediction& p, const dds::SampleInfo&) {
+                       prediction_bodies.insert(p.body_id);
+                     }));
+  const auto topic = framework::topics::HumanSkeleton();
+  dds::Writer<msg::HumanSkeleton> a(*participant, topic.name, topic.qos);
+  dds::Writer<msg::HumanSkeleton> b(*participant, topic.name, topic.qos);
+
+  const std::vector<std::string>& joints = model_->config.joints.joints;
+  Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",
+                  "cyclonedds", "--domain", std::to_string(domain)});
+  ASSERT_TRUE(SpinUntil(node, 30s, [&] {
+    return diag.state["intent"] == "active" && a.MatchedReaders() > 0 && b.MatchedReaders() > 0;
+  })) << intent.Stderr();
+  SpinFor(node, 500ms);
+
+  auto send = [&](dds::Writer<msg::HumanSkeleton>& w, const msg::HumanSkeleton& s) {
+    ASSERT_TRUE(w.Write(s));
+    SpinFor(node, 60ms);
+  };
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < 3; ++i) send(a, Skeleton(500, joints, msg::Now()));  // good: 3 outputs
+
+  msg::HumanSkeleton bad = Skeleton(501, joints, msg::Now());
+  bad.joints[2].position.y = nan;  // boundary check: non-finite
+  send(a, bad);
+  bad = Skeleton(502, {}, msg::Now());  // boundary check: no joints
+  send(a, bad);
+  bad = Skeleton(503, joints, msg::Now());
+  bad.joints.push_back(bad.joints[0]);  // boundary check: duplicate joint name
+  send(a, bad);
+  std::vector<std::string> wrong = joints;
+  for (auto& n : wrong) n = "openpose_" + n;
+  send(a, Skeleton(504, wrong, msg::Now()));  // core: no model joint
+  bad = Skeleton(505, joints, msg::Now());
+  bad.joints.pop_back();  // core: one model joint missing
+  send(a, bad);
+  bad = Skeleton(506, joints, msg::Now());
+  bad.joints[1].position = {};  // core: (0, 0, 0) is "not detected"
+  send(a, bad);
+  const msg::Time last_good_stamp = msg::Now();
+  send(a, Skeleton(500, joints, last_good_stamp));  // good: output 4
+  // Backwards stamp on the same writer: boundary check.
+  send(a, Skeleton(507, joints, msg::TimeFromSeconds(msg::ToSeconds(msg::Now()) - 1.0)));
+  // Another writer (first stamp of its own is accepted by the boundary check)
+  // repeats body 500 at an older stamp: the core rejects it.
+  send(b, Skeleton(500, joints, msg::TimeFromSeconds(msg::ToSeconds(last_good_stamp) - 0.5)));
+  SpinFor(node, 1000ms);
+
+  EXPECT_TRUE(intent.Running()) << intent.Stderr();
+  EXPECT_EQ(belief_bodies, std::multiset<uint32_t>({500, 500, 500, 500}));
+  EXPECT_EQ(prediction_bodies, std::multiset<uint32_t>({500, 500, 500, 500}));
+  EXPECT_EQ(diag.Get("intent", "rejected/" + kSkeletonTopic), "4");  // nan, empty, duplicate, backwards
+  EXPECT_EQ(diag.Get("intent", "frames_rejected/missing_joint"), "3");
+  EXPECT_EQ(diag.Get("intent", "frames_rejected/stamp_not_increasing"), "1");
+  EXPECT_EQ(diag.Get("intent", "frames_rejected"), "4");
+  EXPECT_EQ(diag.Get("intent", "frames_accepted"), "4");
+  EXPECT_NE(diag.Get("intent", "last_rejected_frame").find("not after body 500"), std::string::npos)
+      << diag.Get("intent", "last_rejected_frame");
+
+  // Still serving after the garbage.
+  send(a, Skeleton(500, joints, msg::Now()));
+  SpinFor(node, 500ms);
+  EXPECT_EQ(belief_bodies.count(500), 5u);
+
+  intent.Signal(SIGTERM);
+  ASSERT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+  // Each kind of core rejection is logged once, then only counted.
+  const std::string err = intent.Stderr();
+  auto count = [&](const std::string& text) {
+    int n = 0;
+    for (std::size_t at = err.find(text); at != std::string::npos; at = err.find(text, at + 1)) ++n;
+    return n;
+  };
+  EXPECT_EQ(count("rejected (missing_joint)"), 1) << err;
+  EXPECT_EQ(count("rejected (stamp_not_increasing)"), 1) << err;
+}
+
+TEST_F(IntentServiceTest, AModelThatDoesNotMatchTheConfigurationIsRefused) {
+  struct Case {
+    std::string config;
+    std::string expected;
+  };
+  std::vector<std::string> other = model_->config.joints.joints;
+  other.back() = "hand_right";
+  const std::vector<Case> cases = {
+      {IntentConfig("joints.yaml", other, 15.0), "do not match the configured joints [" },
+      {IntentConfig("rate.yaml", model_->config.joints.joints, 30.0),
+       "model rate 15 Hz does not match the configured rate 30 Hz"},
+      {IntentConfig("missing.yaml", model_->config.joints.joints, 15.0, "nothing_here.model"), "cannot open"},
+      {Write("nomodel.yaml", "intent:\n  joints: [a]\n  rate_hz: 15\n"), "key 'intent.model'"},
+  };
+  for (const Case& c : cases) {
+    Process p({BinPath("iplan-intent"), "--config", c.config, "--domain", std::to_string(UniqueDomain(13))});
+    const auto rc = p.Wait(30s);
+    ASSERT_TRUE(rc.has_value()) << c.config << ": service did not exit";
+    EXPECT_EQ(*rc, 2) << p.Stderr();
+    EXPECT_NE(p.Stderr().find(c.config), std::string::npos) << p.Stderr();
+    EXPECT_NE(p.Stderr().find(c.expected), std::string::npos) << p.Stderr();
+  }
+}
+
+}  // namespace
+}  // namespace iplan::testing
