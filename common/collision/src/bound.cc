@@ -132,8 +132,12 @@ PairBound EvaluatePairBound(const FactorizedGaussian& g, const Eigen::Vector3d& 
     const bool need[1] = {true};
     SolveSecularLanes<1>(d, s, inv_s, dist, Rs, need, lambda, &out.iterations);
     out.lambda = lambda[0];
-    Eigen::Vector3d y;
-    for (int i = 0; i < 3; ++i) y[i] = dv[i] / (1.0 + out.lambda * g.eigenvalues[i]);
+    // y_i = d_i / a_i with a_i = 1 + lambda s_i, from one division.
+    const double a0 = 1.0 + out.lambda * g.eigenvalues[0];
+    const double a1 = 1.0 + out.lambda * g.eigenvalues[1];
+    const double a2 = 1.0 + out.lambda * g.eigenvalues[2];
+    const double r = 1.0 / (a0 * a1 * a2);
+    const Eigen::Vector3d y(dv[0] * a1 * a2 * r, dv[1] * a0 * a2 * r, dv[2] * a0 * a1 * r);
     out.x_max = b + g.eigenvectors * y;
     const double dd[3] = {dv[0], dv[1], dv[2]};
     const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};

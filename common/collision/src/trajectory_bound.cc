@@ -55,10 +55,12 @@ bool HumanPrediction::SetSphere(int action, int step, int sphere,
   FactorizedGaussian g;
   if (!FactorizeGaussian(mean, cov, &g)) return false;
   gaussians_[Index(action, step, sphere)] = g;
+  summaries_up_to_date_ = false;
   return true;
 }
 
 void HumanPrediction::UpdateSummaries() {
+  summaries_up_to_date_ = true;
   probability_sum_ = 0.0;
   for (double p : probabilities_) probability_sum_ += p;
   for (int t = 0; t < num_steps_; ++t) {
@@ -186,6 +188,7 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
                              TrajectoryBoundWorkspace* workspace,
                              std::vector<WaypointBound>* out) {
   IPLAN_COLLISION_DEMAND(workspace != nullptr && out != nullptr);
+  IPLAN_COLLISION_DEMAND(prediction.summaries_up_to_date());
   const int S = trajectory.num_spheres();
   const int H = prediction.num_spheres();
   const int W = trajectory.num_waypoints();

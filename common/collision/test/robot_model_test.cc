@@ -315,6 +315,65 @@ joints:
   ExpectThrowsWith([&] { LoadRobotModelFromUrdf(kUrdf, opt); }, "locked joint 'nope'");
 }
 
+// Any serial arm: continuous and prismatic joints, a fixed tool frame, box
+// and cylinder collision shapes, checked against hand-derived kinematics.
+TEST(RobotModelTest, ToyArmFromUrdf) {
+  const std::string path = WriteTemp("toy.urdf", R"(<robot name="toy">
+  <link name="base"/>
+  <link name="l1"><collision><origin xyz="0.25 0 0" rpy="0 1.5707963267948966 0"/>
+    <geometry><cylinder radius="0.05" length="0.5"/></geometry></collision></link>
+  <link name="l2"><collision><origin xyz="0.1 0 0"/>
+    <geometry><box size="0.2 0.1 0.1"/></geometry></collision></link>
+  <link name="tool"/>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/>
+    <origin xyz="0 0 0.1"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="prismatic"><parent link="l1"/><child link="l2"/>
+    <origin xyz="0.5 0 0"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="0.3" velocity="0.5" effort="10"/></joint>
+  <joint name="j3" type="fixed"><parent link="l2"/><child link="tool"/>
+    <origin xyz="0.2 0 0"/></joint>
+</robot>)");
+  const RobotModel m = LoadRobotModelFromUrdf(path);
+  ASSERT_EQ(m.nq, 2);
+  EXPECT_EQ(m.link_names.front(), "base");
+  const JointLimits& l1 = m.joints[m.q_joints[0]].limits;
+  const JointLimits& l2 = m.joints[m.q_joints[1]].limits;
+  EXPECT_TRUE(std::isinf(l1.lower) && std::isinf(l1.upper));
+  EXPECT_EQ(l2.lower, 0.0);
+  EXPECT_EQ(l2.upper, 0.3);
+  EXPECT_EQ(l2.velocity, 0.5);
+  EXPECT_EQ(l2.acceleration, RobotModelOptions{}.default_acceleration);
+  ASSERT_EQ(m.cover_report.size(), 2u);
+  EXPECT_EQ(m.cover_report[0].cover.shape, "cylinder");
+  EXPECT_EQ(m.cover_report[1].cover.shape, "box");
+  RobotData d(m);
+  std::mt19937_64 rng(37);
+  std::uniform_real_distribution<double> u01(0.0, 1.0);
+  for (int trial = 0; trial < 100; ++trial) {
+    const double q1 = 10.0 * (u01(rng) - 0.5), q2 = 0.3 * u01(rng);
+    CalcForwardKinematics(m, Eigen::Vector2d(q1, q2), &d);
+    const Eigen::Vector3d expected =
+        Eigen::Vector3d(0, 0, 0.1) + (0.5 + q2 + 0.2) * Eigen::Vector3d(std::cos(q1), std::sin(q1), 0);
+    EXPECT_LE((d.X_WL[m.FindLink("tool")].translation() - expected).norm(), 1e-12);
+    // The spheres cover the rod (cylinder along x of l1) and the box of l2.
+    std::vector<Sphere> spheres;
+    for (size_t i = 0; i < m.spheres.size(); ++i) {
+      spheres.push_back({d.p_WS.col(static_cast<Eigen::Index>(i)), m.spheres[i].radius});
+    }
+    const Eigen::Isometry3d& X_W1 = d.X_WL[m.FindLink("l1")];
+    const Eigen::Isometry3d& X_W2 = d.X_WL[m.FindLink("l2")];
+    Eigen::Isometry3d X_1C = Eigen::Isometry3d::Identity();
+    X_1C.translation() = Eigen::Vector3d(0.25, 0, 0);
+    X_1C.linear() = Eigen::AngleAxisd(kPi / 2, Eigen::Vector3d::UnitY()).toRotationMatrix();
+    for (const auto& p : SampleCylinder(0.05, 0.5, 50, &rng)) {
+      ASSERT_TRUE(Covered(spheres, X_W1 * X_1C * p, 1e-12));
+    }
+    for (const auto& p : SampleBox(Eigen::Vector3d(0.1, 0.05, 0.05), 50, &rng)) {
+      ASSERT_TRUE(Covered(spheres, X_W2 * (p + Eigen::Vector3d(0.1, 0, 0)), 1e-12));
+    }
+  }
+}
+
 TEST(RobotModelTest, ForwardKinematicsDoesNotAllocate) {
   const RobotModel yaml = LoadRobotModelFromYaml(kYaml);
   RobotData data(yaml);

@@ -174,6 +174,23 @@ TEST(TrajectoryBoundTest, EvaluationDoesNotAllocate) {
   EXPECT_GT(counted, 0);
 }
 
+TEST(TrajectoryBoundDeathTest, StaleSummariesAbort) {
+  std::mt19937_64 rng(8);
+  Problem p = RandomProblem(&rng, 2, 3, 2, 3, 3);
+  TrajectoryBoundWorkspace ws(3, 2);
+  std::vector<WaypointBound> out(3);
+  EXPECT_TRUE(p.prediction.summaries_up_to_date());
+  // Moving a sphere without refreshing the summaries would make pruning unsound.
+  p.prediction.SetSphere(0, 0, 0, Eigen::Vector3d(0.1, 0.0, 0.3), RandomCovariance(&rng));
+  EXPECT_FALSE(p.prediction.summaries_up_to_date());
+  EXPECT_DEATH(EvaluateTrajectoryBound(p.prediction, p.trajectory, {}, &ws, &out),
+               "summaries_up_to_date");
+  p.prediction.UpdateSummaries();
+  EvaluateTrajectoryBound(p.prediction, p.trajectory, {}, &ws, &out);
+  p.prediction.set_action_probability(1, 0.5);
+  EXPECT_FALSE(p.prediction.summaries_up_to_date());
+}
+
 TEST(TrajectoryBoundTest, RejectsBadConstruction) {
   EXPECT_THROW(HumanPrediction(0, 1, {0.1}), std::invalid_argument);
   try {

@@ -54,7 +54,10 @@ class HumanPrediction {
 
   /// Sets p(action) (>= 0; the probabilities should sum to at most 1, the
   /// bound is for the mixture as given). Does not allocate.
-  void set_action_probability(int action, double p) { probabilities_[action] = p; }
+  void set_action_probability(int action, double p) {
+    probabilities_[action] = p;
+    summaries_up_to_date_ = false;
+  }
 
   /// Factorises and stores the Gaussian of a sphere's centre. Does not
   /// allocate. @returns false if `cov` is not finite and positive definite
@@ -76,6 +79,10 @@ class HumanPrediction {
   }
   /// Sum of the action probabilities (valid after UpdateSummaries).
   double probability_sum() const { return probability_sum_; }
+  /// False after any SetSphere / set_action_probability until
+  /// UpdateSummaries; EvaluateTrajectoryBound refuses stale summaries (the
+  /// pruning would not be sound).
+  bool summaries_up_to_date() const { return summaries_up_to_date_; }
 
  private:
   int Index(int action, int step, int sphere) const {
@@ -89,6 +96,7 @@ class HumanPrediction {
   std::vector<FactorizedGaussian> gaussians_;
   std::vector<Summary> summaries_;
   double probability_sum_ = 1.0;
+  bool summaries_up_to_date_ = false;
 };
 
 /// Robot sphere centres along a trajectory (world frame W, m).
@@ -150,7 +158,8 @@ struct TrajectoryBoundWorkspace {
 ///                    prediction.num_spheres() pairs; must not be null.
 /// @param out         must already have size trajectory.num_waypoints()
 ///                    (resized if not, which allocates once).
-/// Aborts (our bug / caller contract) on size mismatch or bad step index.
+/// Aborts (our bug / caller contract) on size mismatch, bad step index or
+/// stale prediction summaries.
 /// Thread-safe for distinct workspaces/outputs; does not allocate when `out`
 /// has the right size.
 void EvaluateTrajectoryBound(const HumanPrediction& prediction,
