@@ -25,6 +25,11 @@ function(iplan_add_test name)
     set(ARG_TIMEOUT 300)
   endif()
   set_tests_properties(${name} PROPERTIES LABELS "${ARG_LABELS}" TIMEOUT ${ARG_TIMEOUT})
+  # Multi-process tests measure timing (liveliness, deadlines) on a 2-core
+  # machine: run them alone, never beside another test.
+  if("integration" IN_LIST ARG_LABELS)
+    set_tests_properties(${name} PROPERTIES RUN_SERIAL TRUE)
+  endif()
 endfunction()
 
 function(iplan_add_benchmark name)

@@ -1,0 +1,216 @@
+// A Node is what a service sees of the system: typed publishers and
+// subscriptions on catalogue topics, timers, one executor thread, and the
+// diagnostics every service publishes.
+//
+// Every received message passes a boundary check before the callback sees
+// it: non-finite numbers, inconsistent sizes (msg::Check) and stamps that go
+// backwards for the same writer are rejected, counted per topic, logged once
+// (then every 100th), and reported in diagnostics. A callback that throws is
+// logged and counted; it never takes the service down.
+//
+// Threading: all callbacks and timers run on the thread that calls
+// SpinOnce()/SpinUntil(); the core of a service therefore needs no locks.
+#pragma once
+
+#include <chrono>
+#include <cstdint>
+#include <deque>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <spdlog/logger.h>
+
+#include "iplan/dds/participant.h"
+#include "iplan/framework/topics.h"
+#include "iplan/msg/check.h"
+#include "iplan/msg/time.h"
+
+namespace iplan::framework {
+
+struct NodeOptions {
+  double diagnostics_period = 1.0;  ///< s between diagnostics messages; 0: none
+  std::string hardware_id;          ///< default: the host name
+};
+
+/// Counters of one subscribed topic.
+struct TopicStats {
+  uint64_t received = 0;         ///< accepted and handed to the callback
+  uint64_t rejected = 0;         ///< failed the boundary check
+  uint64_t callback_errors = 0;  ///< callback threw
+  uint64_t deadline_misses = 0;
+  uint64_t liveliness_lost = 0;
+  uint64_t incompatible_qos = 0;
+  int alive_writers = 0;
+  std::string last_rejection;
+};
+
+struct SubscribeOptions {
+  /// Reject a message whose header stamp is older than the previous accepted
+  /// one from the same writer.
+  bool check_stamps = true;
+};
+
+class Node {
+ public:
+  /// Throws std::runtime_error when the diagnostics writer cannot be created.
+  Node(std::string name, dds::Participant& participant, NodeOptions options = {});
+  ~Node();
+  Node(const Node&) = delete;
+  Node& operator=(const Node&) = delete;
+
+  /// A writer for `topic`, owned by the node. Call from the executor thread
+  /// or before spinning. Throws std::runtime_error on vendor errors.
+  template <class T>
+  dds::Writer<T>& Advertise(const Topic<T>& topic);
+
+  /// Calls `on_message` for every accepted message on `topic`.
+  template <class T>
+  void Subscribe(const Topic<T>& topic,
+                 std::function<void(const T&, const dds::SampleInfo&)> on_message,
+                 SubscribeOptions options = {});
+
+  /// Called for every deadline, liveliness and matching event of every
+  /// subscription (after the node has counted and logged it).
+  void OnReaderEvent(std::function<void(const std::string& topic, const dds::ReaderEvent&)> cb) {
+    on_event_ = std::move(cb);
+  }
+
+  /// Runs `cb` every `period` (first call one period from now). Returns an id.
+  int AddTimer(std::chrono::nanoseconds period, std::function<void()> cb);
+  void CancelTimer(int id);
+
+  /// Waits at most `max_wait` for messages, events or a due timer, and runs
+  /// what is ready.
+  void SpinOnce(std::chrono::nanoseconds max_wait);
+  /// Spins until `stop()` is true (checked at least every 50 ms); calls
+  /// `on_idle` after every SpinOnce (e.g. systemd watchdog).
+  void SpinUntil(const std::function<bool()>& stop, const std::function<void()>& on_idle = nullptr);
+
+  /// Processing time of one cycle of the service's main loop, s.
+  void RecordCycleTime(double seconds);
+  /// Lifecycle state shown in diagnostics ("configured", "active", ...).
+  void SetState(const std::string& state, uint8_t level = msg::DiagnosticStatus::OK);
+  /// Adds a service-specific value to every diagnostics message.
+  void SetDiagnosticValue(const std::string& key, const std::string& value);
+  /// Publishes diagnostics now (also done every diagnostics_period).
+  void PublishDiagnostics();
+  msg::DiagnosticArray MakeDiagnostics() const;
+
+  /// Counters of a subscribed topic (zeros when not subscribed).
+  TopicStats stats(const std::string& topic) const;
+  spdlog::logger& log() { return *log_; }
+  const std::string& name() const { return name_; }
+  dds::Participant& participant() { return participant_; }
+
+ private:
+  struct SubscriptionBase {
+    virtual ~SubscriptionBase() = default;
+    virtual void Dispatch(Node& node) = 0;
+    std::unique_ptr<dds::AnyReader> reader;
+    TopicStats stats;
+    SubscribeOptions options;
+    std::map<uint64_t, int64_t> last_stamp_ns;  // per writer
+  };
+  template <class T>
+  struct Subscription;
+  struct Timer {
+    std::chrono::nanoseconds period;
+    std::chrono::steady_clock::time_point next;
+    std::function<void()> cb;
+  };
+
+  void HandleEvents(SubscriptionBase& sub);
+  void Reject(SubscriptionBase& sub, const std::string& why);
+  /// True when the stamp is acceptable for this writer (and records it).
+  bool AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns);
+  template <class F>
+  void RunGuarded(SubscriptionBase* sub, const char* what, F&& f);
+  void RunTimers();
+
+  std::string name_;
+  dds::Participant& participant_;
+  NodeOptions options_;
+  std::shared_ptr<spdlog::logger> log_;
+  std::map<std::string, std::unique_ptr<dds::AnyWriter>> writers_;
+  std::vector<std::unique_ptr<SubscriptionBase>> subscriptions_;
+  std::map<const dds::AnyReader*, SubscriptionBase*> by_reader_;
+  std::map<int, Timer> timers_;
+  int next_timer_id_ = 1;
+  std::function<void(const std::string&, const dds::ReaderEvent&)> on_event_;
+  std::vector<dds::AnyReader*> ready_;
+  // Diagnostics state.
+  std::string state_ = "unconfigured";
+  uint8_t level_ = msg::DiagnosticStatus::OK;
+  std::map<std::string, std::string> extra_values_;
+  std::deque<double> cycle_times_;
+  dds::Writer<msg::DiagnosticArray>* diagnostics_writer_ = nullptr;
+};
+
+// ---------------------------------------------------------------------------
+
+template <class T>
+dds::Writer<T>& Node::Advertise(const Topic<T>& topic) {
+  auto it = writers_.find(topic.name);
+  if (it == writers_.end()) {
+    it = writers_.emplace(topic.name, std::make_unique<dds::Writer<T>>(participant_, topic.name, topic.qos)).first;
+  }
+  return static_cast<dds::Writer<T>&>(*it->second);
+}
+
+template <class T>
+struct Node::Subscription : Node::SubscriptionBase {
+  std::function<void(const T&, const dds::SampleInfo&)> on_message;
+  T msg;  // reused buffer
+  void Dispatch(Node& node) override {
+    auto* r = static_cast<dds::Reader<T>*>(reader.get());
+    dds::SampleInfo info;
+    for (;;) {
+      bool took = false;
+      try {
+        took = r->Take(&msg, &info);
+      } catch (const std::exception& e) {
+        node.Reject(*this, std::string("cannot convert sample: ") + e.what());
+        continue;
+      }
+      if (!took) break;
+      if (auto why = msg::Check(msg)) {
+        node.Reject(*this, *why);
+        continue;
+      }
+      if constexpr (msg::HasHeader<T>::value) {
+        if (options.check_stamps &&
+            !node.AcceptStamp(*this, info.writer_id, msg::ToNanoseconds(msg.header.stamp))) {
+          continue;
+        }
+      }
+      ++stats.received;
+      node.RunGuarded(this, "callback", [&] { on_message(msg, info); });
+    }
+  }
+};
+
+template <class T>
+void Node::Subscribe(const Topic<T>& topic, std::function<void(const T&, const dds::SampleInfo&)> on_message,
+                     SubscribeOptions options) {
+  auto sub = std::make_unique<Subscription<T>>();
+  sub->on_message = std::move(on_message);
+  sub->options = options;
+  sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos);
+  by_reader_[sub->reader.get()] = sub.get();
+  subscriptions_.push_back(std::move(sub));
+}
+
+template <class F>
+void Node::RunGuarded(SubscriptionBase* sub, const char* what, F&& f) {
+  try {
+    f();
+  } catch (const std::exception& e) {
+    if (sub) ++sub->stats.callback_errors;
+    log_->error("{} {} threw: {}", sub ? sub->reader->topic() : std::string("timer"), what, e.what());
+  }
+}
+
+}  // namespace iplan::framework

@@ -1,0 +1,62 @@
+// The topics of an iplan cell: name, type and QoS of each, in one place so
+// that both sides of every topic agree (docs/topics.md is the prose version).
+// Names follow ROS 2: the "rt/" prefix on the wire; ROS 2 tools see them as
+// /joint_states, /iplan/human/skeleton, ...
+#pragma once
+
+#include <chrono>
+#include <string>
+#include <vector>
+
+#include "iplan/dds/qos.h"
+#include "iplan/msg/types.h"
+
+namespace iplan::framework {
+
+/// A topic of type T with the QoS both its writers and readers use.
+template <class T>
+struct Topic {
+  std::string name;  ///< DDS topic name, e.g. "rt/iplan/human/skeleton"
+  dds::QosProfile qos;
+};
+
+/// Untyped description for tools and docs.
+struct TopicDescription {
+  std::string name;
+  std::string type;  ///< DDS type name
+  dds::QosProfile qos;
+  std::string description;
+};
+
+namespace topics {
+
+/// Tracked human skeletons from perception (30 Hz nominal).
+Topic<msg::HumanSkeleton> HumanSkeleton();
+/// The simulated person's true pose (simulation only; contact counting).
+Topic<msg::HumanSkeleton> HumanTruth();
+/// Obstacle point cloud from perception.
+Topic<msg::PointCloud2> Obstacles();
+/// p(action | motion) from intent, one per skeleton.
+Topic<msg::ActionBelief> ActionBelief();
+/// Predicted human motion mixture from intent, one per skeleton.
+Topic<msg::HumanPrediction> HumanPrediction();
+/// Robot joint state from the robot (or simulator).
+Topic<msg::JointState> JointStates();
+/// The robot trajectory being executed (latched; replaced every cycle).
+Topic<msg::JointTrajectory> RobotTrajectory();
+/// Task commands from the supervisor to the trajectory optimiser.
+Topic<msg::TaskCommand> TaskCommand();
+/// Task outcomes from the trajectory optimiser.
+Topic<msg::TaskOutcome> TaskOutcome();
+/// Collision risk of the executing trajectory.
+Topic<msg::CollisionRisk> CollisionRisk();
+/// Protective stop / resume (latched).
+Topic<msg::SafetyCommand> SafetyCommand();
+/// Per-service diagnostics (ROS 2 /diagnostics).
+Topic<msg::DiagnosticArray> Diagnostics();
+
+/// Every topic above, in that order.
+std::vector<TopicDescription> All();
+
+}  // namespace topics
+}  // namespace iplan::framework

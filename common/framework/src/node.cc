@@ -1,0 +1,222 @@
+#include "iplan/framework/node.h"
+
+#include <unistd.h>
+
+#include <algorithm>
+#include <cstdio>
+
+#include <spdlog/sinks/stdout_color_sinks.h>
+#include <spdlog/spdlog.h>
+
+namespace iplan::framework {
+namespace {
+
+std::string HostName() {
+  char buf[256] = {0};
+  if (gethostname(buf, sizeof(buf) - 1) != 0) return "unknown";
+  return buf;
+}
+
+std::string Fmt(double v) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.6g", v);
+  return buf;
+}
+
+}  // namespace
+
+Node::Node(std::string name, dds::Participant& participant, NodeOptions options)
+    : name_(std::move(name)), participant_(participant), options_(std::move(options)) {
+  log_ = spdlog::get(name_);
+  if (!log_) log_ = spdlog::stderr_color_mt(name_);
+  if (options_.hardware_id.empty()) options_.hardware_id = HostName();
+  if (options_.diagnostics_period > 0) {
+    diagnostics_writer_ = &Advertise(topics::Diagnostics());
+    AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(options_.diagnostics_period * 1e9)),
+             [this] { PublishDiagnostics(); });
+  }
+}
+
+Node::~Node() {
+  // Readers detach from the participant's wait set before it goes away.
+  subscriptions_.clear();
+  writers_.clear();
+}
+
+int Node::AddTimer(std::chrono::nanoseconds period, std::function<void()> cb) {
+  const int id = next_timer_id_++;
+  timers_[id] = Timer{period, std::chrono::steady_clock::now() + period, std::move(cb)};
+  return id;
+}
+
+void Node::CancelTimer(int id) { timers_.erase(id); }
+
+void Node::RunTimers() {
+  const auto now = std::chrono::steady_clock::now();
+  // Copy the ids: a timer callback may add or cancel timers.
+  std::vector<int> due;
+  for (auto& [id, t] : timers_) {
+    if (t.next <= now) due.push_back(id);
+  }
+  for (int id : due) {
+    auto it = timers_.find(id);
+    if (it == timers_.end()) continue;
+    // Keep the phase; skip missed periods instead of bursting.
+    Timer& t = it->second;
+    t.next += t.period;
+    if (t.next < now) t.next = now + t.period;
+    auto cb = t.cb;
+    RunGuarded(nullptr, "timer", cb);
+  }
+}
+
+void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
+  auto wait = max_wait;
+  const auto now = std::chrono::steady_clock::now();
+  for (const auto& [id, t] : timers_) {
+    wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(t.next - now, std::chrono::nanoseconds(0)));
+  }
+  if (wait.count() > 0 || !subscriptions_.empty()) {
+    participant_.Wait(std::max(wait, std::chrono::nanoseconds(1)), &ready_);
+  }
+  for (dds::AnyReader* r : ready_) {
+    auto it = by_reader_.find(r);
+    if (it == by_reader_.end()) continue;
+    HandleEvents(*it->second);
+    it->second->Dispatch(*this);
+  }
+  RunTimers();
+}
+
+void Node::SpinUntil(const std::function<bool()>& stop, const std::function<void()>& on_idle) {
+  while (!stop()) {
+    SpinOnce(std::chrono::milliseconds(50));
+    if (on_idle) on_idle();
+  }
+}
+
+void Node::HandleEvents(SubscriptionBase& sub) {
+  for (const dds::ReaderEvent& e : sub.reader->TakeEvents()) {
+    const std::string& topic = sub.reader->topic();
+    switch (e.kind) {
+      case dds::EventKind::kDeadlineMissed:
+        sub.stats.deadline_misses += static_cast<uint64_t>(e.count_change);
+        if (sub.stats.deadline_misses == static_cast<uint64_t>(e.count_change) || sub.stats.deadline_misses % 100 == 0) {
+          log_->warn("{}: deadline missed ({} so far)", topic, sub.stats.deadline_misses);
+        }
+        break;
+      case dds::EventKind::kLivelinessLost:
+        sub.stats.liveliness_lost += static_cast<uint64_t>(e.count_change);
+        sub.stats.alive_writers = e.current;
+        log_->warn("{}: a writer lost liveliness ({} alive)", topic, e.current);
+        break;
+      case dds::EventKind::kLivelinessRegained:
+        sub.stats.alive_writers = e.current;
+        log_->info("{}: writer alive ({} alive)", topic, e.current);
+        break;
+      case dds::EventKind::kIncompatibleQos:
+        sub.stats.incompatible_qos += static_cast<uint64_t>(e.count_change);
+        log_->error("{}: a writer offers incompatible QoS (policy id {})", topic, e.current);
+        break;
+      case dds::EventKind::kMatched:
+      case dds::EventKind::kUnmatched:
+        log_->debug("{}: {} ({} matched)", topic, dds::ToString(e.kind), e.current);
+        break;
+    }
+    if (on_event_) {
+      auto cb = on_event_;
+      RunGuarded(&sub, "event callback", [&] { cb(topic, e); });
+    }
+  }
+}
+
+void Node::Reject(SubscriptionBase& sub, const std::string& why) {
+  ++sub.stats.rejected;
+  sub.stats.last_rejection = why;
+  if (sub.stats.rejected == 1 || sub.stats.rejected % 100 == 0) {
+    log_->warn("{}: rejected message ({} so far): {}", sub.reader->topic(), sub.stats.rejected, why);
+  }
+}
+
+bool Node::AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns) {
+  auto [it, inserted] = sub.last_stamp_ns.emplace(writer, stamp_ns);
+  if (inserted) return true;
+  if (stamp_ns < it->second) {
+    Reject(sub, "stamp went backwards by " + Fmt((it->second - stamp_ns) * 1e-9) + " s");
+    return false;
+  }
+  it->second = stamp_ns;
+  return true;
+}
+
+void Node::RecordCycleTime(double seconds) {
+  cycle_times_.push_back(seconds);
+  if (cycle_times_.size() > 1000) cycle_times_.pop_front();
+}
+
+void Node::SetState(const std::string& state, uint8_t level) {
+  state_ = state;
+  level_ = level;
+}
+
+void Node::SetDiagnosticValue(const std::string& key, const std::string& value) { extra_values_[key] = value; }
+
+TopicStats Node::stats(const std::string& topic) const {
+  for (const auto& s : subscriptions_) {
+    if (s->reader->topic() == topic) return s->stats;
+  }
+  return {};
+}
+
+msg::DiagnosticArray Node::MakeDiagnostics() const {
+  msg::DiagnosticArray a;
+  a.header.stamp = msg::Now();
+  msg::DiagnosticStatus s;
+  s.name = name_;
+  s.hardware_id = options_.hardware_id;
+  s.message = state_;
+  s.level = level_;
+  auto add = [&s](const std::string& k, const std::string& v) { s.values.push_back({k, v}); };
+  add("state", state_);
+  uint64_t rejected = 0, misses = 0, lost = 0, errors = 0;
+  for (const auto& sub : subscriptions_) {
+    rejected += sub->stats.rejected;
+    misses += sub->stats.deadline_misses;
+    lost += sub->stats.liveliness_lost;
+    errors += sub->stats.callback_errors;
+  }
+  if (!cycle_times_.empty()) {
+    std::vector<double> v(cycle_times_.begin(), cycle_times_.end());
+    std::sort(v.begin(), v.end());
+    add("cycle_time_last_s", Fmt(cycle_times_.back()));
+    add("cycle_time_p50_s", Fmt(v[v.size() / 2]));
+    add("cycle_time_p99_s", Fmt(v[std::min(v.size() - 1, v.size() * 99 / 100)]));
+    add("cycle_time_max_s", Fmt(v.back()));
+  }
+  add("deadline_misses", std::to_string(misses));
+  add("liveliness_lost", std::to_string(lost));
+  add("rejected_messages", std::to_string(rejected));
+  add("callback_errors", std::to_string(errors));
+  for (const auto& sub : subscriptions_) {
+    const std::string& t = sub->reader->topic();
+    add("received/" + t, std::to_string(sub->stats.received));
+    add("rejected/" + t, std::to_string(sub->stats.rejected));
+    add("deadline_misses/" + t, std::to_string(sub->stats.deadline_misses));
+    add("liveliness_lost/" + t, std::to_string(sub->stats.liveliness_lost));
+    if (!sub->stats.last_rejection.empty()) add("last_rejection/" + t, sub->stats.last_rejection);
+  }
+  for (const auto& [k, v] : extra_values_) add(k, v);
+  if (s.level == msg::DiagnosticStatus::OK && (rejected > 0 || misses > 0 || lost > 0 || errors > 0)) {
+    s.level = msg::DiagnosticStatus::WARN;
+  }
+  a.status.push_back(std::move(s));
+  return a;
+}
+
+void Node::PublishDiagnostics() {
+  if (!diagnostics_writer_) return;
+  std::string err;
+  if (!diagnostics_writer_->Write(MakeDiagnostics(), &err)) log_->warn("diagnostics not published: {}", err);
+}
+
+}  // namespace iplan::framework

@@ -1,0 +1,149 @@
+#include <csignal>
+#include <cstdlib>
+#include <fstream>
+#include <iostream>
+
+#include <CLI/CLI.hpp>
+#include <spdlog/spdlog.h>
+
+#include "iplan/framework/service.h"
+#include "iplan/framework/systemd.h"
+
+namespace iplan::framework {
+namespace {
+
+volatile std::sig_atomic_t g_stop = 0;
+
+void OnSignal(int) { g_stop = 1; }
+
+bool FileExists(const std::string& p) { return std::ifstream(p).good(); }
+
+}  // namespace
+
+std::string DefaultConfigFile(const std::string& service_name) {
+  std::vector<std::string> dirs;
+  if (const char* d = std::getenv("IPLAN_CONFIG_DIR"); d && *d) dirs.emplace_back(d);
+  dirs.emplace_back(IPLAN_INSTALL_CONFIG_DIR);
+  dirs.emplace_back(IPLAN_SOURCE_CONFIG_DIR);
+  for (const auto& d : dirs) {
+    const std::string f = d + "/" + service_name + ".yaml";
+    if (FileExists(f)) return f;
+  }
+  return "";
+}
+
+int RunService(int argc, char** argv, const ServiceInfo& info,
+               const std::function<std::unique_ptr<Service>()>& make) {
+  CLI::App app{"iplan-" + info.name + ": " + info.description +
+               "\n\nA service of the iplan cell. It reads its settings from a YAML file "
+               "(section '" + info.name + "', framework settings in section 'node'), talks "
+               "DDS on the chosen vendor and domain, publishes diagnostics on /diagnostics, "
+               "and stops cleanly on SIGINT or SIGTERM. Exit codes: 0 stopped, 1 runtime "
+               "error, 2 bad configuration."};
+  std::string config_file = DefaultConfigFile(info.name);
+  std::string vendor_text;
+  int domain = -1;
+  std::string log_level = "info";
+  bool check_only = false;
+  app.add_option("-c,--config", config_file, "YAML configuration file")
+      ->capture_default_str();
+  app.add_option("--dds", vendor_text,
+                 "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
+  app.add_option("--domain", domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
+  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
+      ->capture_default_str();
+  app.add_flag("--check-config", check_only, "validate the configuration file and exit");
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int rc = app.exit(e);
+    return rc == 0 ? kExitOk : kExitConfigError;
+  }
+  spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
+
+  dds::ParticipantOptions popts;
+  try {
+    popts.vendor = vendor_text.empty() ? dds::DefaultVendor() : dds::ParseVendor(vendor_text);
+    popts.domain_id = domain >= 0 ? domain : dds::DefaultDomain();
+  } catch (const std::exception& e) {
+    std::cerr << "iplan-" << info.name << ": " << e.what() << "\n";
+    return kExitConfigError;
+  }
+  popts.name = "iplan-" + info.name;
+
+  std::unique_ptr<ConfigSection> config;
+  NodeOptions nopts;
+  try {
+    config = std::make_unique<ConfigSection>(
+        config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
+                            : ConfigSection::Load(config_file));
+    ConfigSection node_section = config->Section("node");
+    node_section.Read("diagnostics_period", &nopts.diagnostics_period, NonNegative<double>());
+    node_section.Read("hardware_id", &nopts.hardware_id);
+  } catch (const ConfigError& e) {
+    std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
+    return kExitConfigError;
+  }
+
+  std::signal(SIGINT, OnSignal);
+  std::signal(SIGTERM, OnSignal);
+
+  std::unique_ptr<dds::Participant> participant;
+  std::unique_ptr<Node> node;
+  std::unique_ptr<Service> service;
+  try {
+    participant = dds::Participant::Create(popts);
+    node = std::make_unique<Node>(info.name, *participant, nopts);
+    service = make();
+    node->log().info("configuring from {} on {} domain {}", config_file.empty() ? "(defaults)" : config_file,
+                     dds::ToString(popts.vendor), popts.domain_id);
+    ConfigSection section = config->Section(info.name);
+    Result r = service->OnConfigure(section, *node);
+    try {
+      config->Finish();
+    } catch (const ConfigError& e) {
+      std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
+      return kExitConfigError;
+    }
+    if (!r.ok) {
+      std::cerr << "iplan-" << info.name << ": configure failed: " << r.reason << "\n";
+      return kExitConfigError;
+    }
+    node->SetState("configured");
+    if (check_only) {
+      std::cout << config_file << ": configuration is valid\n";
+      return kExitOk;
+    }
+    r = service->OnActivate(*node);
+    if (!r.ok) {
+      node->log().error("activate failed: {}", r.reason);
+      service->OnCleanup(*node);
+      return kExitRuntimeError;
+    }
+    node->SetState("active");
+    node->PublishDiagnostics();
+    systemd::NotifyReady("active");
+    node->log().info("active");
+    systemd::Watchdog watchdog;
+    node->SpinUntil([] { return g_stop != 0; }, [&watchdog] { watchdog.Tick(); });
+    systemd::NotifyStopping();
+    node->log().info("stopping");
+    r = service->OnDeactivate(*node);
+    if (!r.ok) node->log().warn("deactivate: {}", r.reason);
+    node->SetState("inactive");
+    node->PublishDiagnostics();
+    r = service->OnCleanup(*node);
+    if (!r.ok) node->log().warn("cleanup: {}", r.reason);
+    service.reset();
+    node.reset();
+    participant.reset();
+    return kExitOk;
+  } catch (const std::exception& e) {
+    std::cerr << "iplan-" << info.name << ": error: " << e.what() << "\n";
+    return kExitRuntimeError;
+  }
+}
+
+}  // namespace iplan::framework

@@ -1,0 +1,72 @@
+#include "iplan/framework/topics.h"
+
+namespace iplan::framework::topics {
+namespace {
+using std::chrono::milliseconds;
+using Q = dds::QosProfile;
+}  // namespace
+
+Topic<msg::HumanSkeleton> HumanSkeleton() {
+  return {"rt/iplan/human/skeleton", Q::SensorStream(milliseconds(150), milliseconds(300))};
+}
+Topic<msg::HumanSkeleton> HumanTruth() {
+  return {"rt/iplan/sim/human_truth", Q::SensorStream(milliseconds(150), milliseconds(300))};
+}
+Topic<msg::PointCloud2> Obstacles() {
+  return {"rt/iplan/obstacles", Q::SensorStream(milliseconds(1000), milliseconds(1000))};
+}
+Topic<msg::ActionBelief> ActionBelief() {
+  return {"rt/iplan/human/action_belief", Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
+Topic<msg::HumanPrediction> HumanPrediction() {
+  return {"rt/iplan/human/prediction", Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
+Topic<msg::JointState> JointStates() {
+  return {"rt/joint_states", Q::SensorStream(milliseconds(100), milliseconds(300))};
+}
+Topic<msg::JointTrajectory> RobotTrajectory() {
+  return {"rt/iplan/robot/trajectory", Q::LatchedState(milliseconds(300), milliseconds(300))};
+}
+Topic<msg::TaskCommand> TaskCommand() {
+  return {"rt/iplan/task/command", Q::Command(milliseconds(1000))};
+}
+Topic<msg::TaskOutcome> TaskOutcome() {
+  return {"rt/iplan/task/outcome", Q::Command(milliseconds(1000))};
+}
+Topic<msg::CollisionRisk> CollisionRisk() {
+  return {"rt/iplan/collision_risk", Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
+Topic<msg::SafetyCommand> SafetyCommand() {
+  return {"rt/iplan/safety/command", Q::LatchedState(milliseconds(0), milliseconds(1000))};
+}
+Topic<msg::DiagnosticArray> Diagnostics() {
+  Q q = Q::Command(milliseconds(3000));
+  q.name = "status";
+  return {"rt/diagnostics", q};
+}
+
+namespace {
+template <class T>
+TopicDescription Describe(const Topic<T>& t, const char* what) {
+  return {t.name, msg::TypeName<T>::kDds, t.qos, what};
+}
+}  // namespace
+
+std::vector<TopicDescription> All() {
+  return {
+      Describe(HumanSkeleton(), "tracked human skeletons (perception)"),
+      Describe(HumanTruth(), "true pose of the simulated person (simulation only)"),
+      Describe(Obstacles(), "obstacle point cloud (perception)"),
+      Describe(ActionBelief(), "probability of each human action (intent)"),
+      Describe(HumanPrediction(), "predicted human motion, Gaussian mixture over actions (intent)"),
+      Describe(JointStates(), "robot joint state (robot or simulator)"),
+      Describe(RobotTrajectory(), "trajectory the robot executes (trajectory optimisation)"),
+      Describe(TaskCommand(), "robot task commands (supervisor)"),
+      Describe(TaskOutcome(), "robot task outcomes (trajectory optimisation)"),
+      Describe(CollisionRisk(), "collision bound and separation monitoring (collision risk)"),
+      Describe(SafetyCommand(), "protective stop / resume (supervisor, collision risk)"),
+      Describe(Diagnostics(), "per-service diagnostics (every service)"),
+  };
+}
+
+}  // namespace iplan::framework::topics

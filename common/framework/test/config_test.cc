@@ -1,0 +1,94 @@
+// Strict configuration: unknown and mistyped keys are errors naming the key
+// and the file; values are validated; defaults stay when keys are absent.
+#include <gtest/gtest.h>
+
+#include "iplan/framework/config.h"
+
+namespace iplan::framework {
+namespace {
+
+std::string FinishError(ConfigSection& c) {
+  try {
+    c.Finish();
+  } catch (const ConfigError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(Config, ReadsValuesAndKeepsDefaults) {
+  auto c = ConfigSection::FromString("svc:\n  rate_hz: 30\n  name: cam\n  flags: [1.5, 2]\n", "svc.yaml");
+  auto s = c.Section("svc");
+  double rate = 1;
+  std::string name;
+  std::vector<double> flags;
+  bool enabled = true;
+  EXPECT_TRUE(s.Read("rate_hz", &rate, Positive<double>()));
+  EXPECT_TRUE(s.Read("name", &name));
+  EXPECT_TRUE(s.Read("flags", &flags));
+  EXPECT_FALSE(s.Read("enabled", &enabled));
+  EXPECT_EQ(rate, 30);
+  EXPECT_EQ(name, "cam");
+  EXPECT_EQ(flags, (std::vector<double>{1.5, 2}));
+  EXPECT_TRUE(enabled);
+  EXPECT_EQ(FinishError(c), "");
+}
+
+TEST(Config, UnknownKeyIsNamedWithFile) {
+  auto c = ConfigSection::FromString("svc:\n  rate_hz: 30\n  rat_hz: 31\nother: 1\n", "cfg/svc.yaml");
+  auto s = c.Section("svc");
+  double rate = 1;
+  s.Read("rate_hz", &rate);
+  const std::string err = FinishError(c);
+  EXPECT_NE(err.find("cfg/svc.yaml: unknown key 'svc.rat_hz'"), std::string::npos) << err;
+  EXPECT_NE(err.find("cfg/svc.yaml: unknown key 'other'"), std::string::npos) << err;
+}
+
+TEST(Config, MistypedValueIsNamed) {
+  auto c = ConfigSection::FromString("svc:\n  rate_hz: fast\n  count: 1.5\n  on: maybe\n", "svc.yaml");
+  auto s = c.Section("svc");
+  double rate = 1;
+  int count = 0;
+  bool on = false;
+  EXPECT_FALSE(s.Read("rate_hz", &rate));
+  EXPECT_FALSE(s.Read("count", &count));
+  EXPECT_FALSE(s.Read("on", &on));
+  EXPECT_EQ(rate, 1);  // unchanged on error
+  const std::string err = FinishError(c);
+  EXPECT_NE(err.find("svc.yaml: key 'svc.rate_hz': expected a finite number, got 'fast'"), std::string::npos) << err;
+  EXPECT_NE(err.find("key 'svc.count': expected an integer, got '1.5'"), std::string::npos) << err;
+  EXPECT_NE(err.find("key 'svc.on': expected true or false, got 'maybe'"), std::string::npos) << err;
+}
+
+TEST(Config, CheckFailureAndMissingRequired) {
+  auto c = ConfigSection::FromString("svc:\n  rate_hz: -3\n  mode: warp\n", "svc.yaml");
+  auto s = c.Section("svc");
+  double rate = 1;
+  std::string mode, path;
+  s.Read("rate_hz", &rate, Positive<double>());
+  s.Read("mode", &mode, OneOf({"replay", "synthetic"}));
+  s.Require("path", &path);
+  const std::string err = FinishError(c);
+  EXPECT_NE(err.find("key 'svc.rate_hz': must be > 0 (got '-3')"), std::string::npos) << err;
+  EXPECT_NE(err.find("key 'svc.mode': must be one of: replay synthetic"), std::string::npos) << err;
+  EXPECT_NE(err.find("key 'svc.path': is required but missing"), std::string::npos) << err;
+}
+
+TEST(Config, SectionThatIsNotAMapping) {
+  auto c = ConfigSection::FromString("svc: 3\n", "svc.yaml");
+  c.Section("svc");
+  EXPECT_NE(FinishError(c).find("key 'svc': expected a mapping, got '3'"), std::string::npos);
+}
+
+TEST(Config, SyntaxErrorNamesLine) {
+  try {
+    ConfigSection::FromString("svc:\n  a: [1, 2\n", "bad.yaml");
+    FAIL();
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("bad.yaml: line"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(ConfigSection::Load("/nonexistent/x.yaml"), ConfigError);
+}
+
+}  // namespace
+}  // namespace iplan::framework

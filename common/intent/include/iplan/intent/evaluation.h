@@ -1,0 +1,65 @@
+// Evaluation of an intent model on recorded sequences: early-prediction
+// accuracy, confusion matrix, forecast error against constant-position and
+// constant-velocity baselines on the same windows, 95 % ellipsoid coverage
+// and inference time.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/intent/intent_model.h"
+#include "iplan/intent/skeleton_data.h"
+
+namespace iplan::intent {
+
+struct EvalParams {
+  /// Observed fractions of each sequence for the accuracy curve, in (0, 1].
+  std::vector<double> fractions{0.2, 0.4, 0.6, 0.8, 1.0};
+  int forecast_stride = 1;  ///< Frames between evaluated forecast windows (>= 1).
+  double max_gap = 0.6;     ///< s, as in TrainParams.
+};
+
+struct EvalReport {
+  std::vector<std::string> actions;  ///< (C) model actions.
+  int num_sequences = 0;             ///< Classified tracks.
+  std::vector<double> fractions;     ///< Observed fractions.
+  std::vector<double> accuracy;      ///< Per fraction, share of tracks whose most
+                                     ///< probable action is the true one.
+  std::vector<double> mean_true_probability;  ///< Per fraction, mean p(true action).
+  Eigen::MatrixXi confusion;         ///< (C, C) at the last fraction: row true, column predicted.
+  int num_forecast_windows = 0;      ///< Windows with a full recorded future.
+  std::vector<double> horizon_s;     ///< (D) seconds ahead of each future step.
+  std::vector<double> error_model;   ///< (D) m, mean joint error of the mixture mean.
+  std::vector<double> error_const_position;  ///< (D) m, baseline: hold current pose.
+  std::vector<double> error_const_velocity;  ///< (D) m, baseline: extrapolate last-frame velocity.
+  double coverage95 = 0.0;           ///< Share of true future joints inside the
+                                     ///< moment-matched mixture's 95 % ellipsoid.
+  double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame).
+  double inference_p99_ms = 0.0;
+  int num_inference_calls = 0;
+};
+
+/// Evaluates `model` on every sequence of `data`. Accuracy: for each track
+/// and fraction f the model sees the first ceil(f n) frames (last T of them).
+/// Forecasts: every window (stride `forecast_stride`) whose true future of
+/// `horizon` frames is recorded. Throws std::invalid_argument when the data
+/// lack a model joint or contain an action the model does not know.
+EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& data,
+                               const EvalParams& params);
+
+/// Machine-readable report: top-level "accuracy" ({"0.2": ..., "1.0": ...}),
+/// "error_m" ({"<horizon s>": {"model", "const_position", "const_velocity"}}),
+/// "coverage95", "inference_ms" ({"p50", "p99"}), plus "confusion",
+/// "actions", "num_sequences", "num_forecast_windows".
+std::string EvalReportToJson(const EvalReport& report);
+
+/// Human-readable multi-line report.
+std::string EvalReportToText(const EvalReport& report);
+
+/// Formats a number as used for the JSON keys: up to 3 significant digits,
+/// always with a decimal point ("0.2", "1.0", "0.0667").
+std::string FormatKey(double value);
+
+}  // namespace iplan::intent

@@ -1,0 +1,108 @@
+// Features of METHOD section 2 computed from a window of skeleton frames.
+//
+// A window is the last T frames of a track at the model rate, as a (T, 3 J)
+// matrix of joint positions in the world (sensor) frame W, oldest row first.
+// If fewer than T frames have been observed the window is padded at the front
+// by repeating the oldest observed frame (the person is taken to have been
+// still before tracking started).
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+namespace iplan::intent {
+
+/// Which joints the model uses and how the torso and hands are defined.
+struct JointConfig {
+  /// Model joints, in output order (J names). Every name must exist in the data.
+  std::vector<std::string> joints;
+  /// The torso reference point is the mean of these joints (names from
+  /// `joints`), e.g. {"torso"} or {"shoulder_l", "shoulder_r"}.
+  std::vector<std::string> torso;
+  /// Hand joints (names from `joints`) used for hand-object distances; may be
+  /// empty.
+  std::vector<std::string> hands;
+  /// Task object positions p_WO (metres, frame W). May be empty: datasets
+  /// without objects simply have no hand-object features.
+  std::vector<Eigen::Vector3d> objects;
+
+  /// Returns an empty string when valid, otherwise what is wrong (empty joint
+  /// list, duplicate joint, torso/hand name not among `joints`, no torso).
+  std::string Validate() const;
+};
+
+/// Options of the per-frame classifier features.
+struct FrameFeatureOptions {
+  /// Weight of the torso-motion block relative to the posture block (>= 0).
+  double torso_motion_weight = 1.0;
+  /// If true and both shoulder_l and shoulder_r are model joints, posture and
+  /// torso motion are divided by the window's mean shoulder width and
+  /// multiplied by 0.35 m (a typical adult width), removing body-size
+  /// differences between people while keeping the unit metres.
+  bool normalise_body_size = false;
+};
+
+/// Picks the default upper-body joint set (METHOD 1: head, neck, torso,
+/// shoulder/elbow/hand left and right) from the joints a dataset provides,
+/// accepting the usual aliases: neck = shoulder_center, torso = spine, hand =
+/// wrist when there is no hand joint. Joints the dataset lacks are left out;
+/// when there is no torso joint the torso is the mean of the shoulders.
+/// Hands are hand_l/hand_r, else wrist_l/wrist_r, when present.
+/// Throws std::invalid_argument when fewer than two default joints or no
+/// torso reference can be found.
+JointConfig DefaultJointConfig(const std::vector<std::string>& available);
+
+/// Index helpers derived from a validated JointConfig.
+class FeatureLayout {
+ public:
+  /// Throws std::invalid_argument with JointConfig::Validate()'s message.
+  explicit FeatureLayout(const JointConfig& config,
+                         const FrameFeatureOptions& options = FrameFeatureOptions{});
+
+  int num_joints() const { return num_joints_; }
+  /// Per-frame classifier feature size: 3 J + 3 + (hands x objects).
+  int frame_feature_size() const { return 3 * num_joints_ + 3 + num_object_features(); }
+  /// Forecaster input size: 3 J (current pose relative to torso) + 3 J
+  /// (joint velocity relative to torso) + 3 (torso velocity) + 3 (torso
+  /// displacement over the window) + hands x objects.
+  int forecast_input_size() const { return 6 * num_joints_ + 6 + num_object_features(); }
+  int num_object_features() const {
+    return static_cast<int>(hand_index_.size() * objects_.size());
+  }
+
+  /// Torso reference p_WT of one frame row (3 J) in metres, frame W.
+  Eigen::Vector3d Torso(const Eigen::Ref<const Eigen::RowVectorXd>& frame) const;
+
+  /// Per-frame classifier features of a padded window (T, 3 J): for each row s,
+  /// joints relative to that row's torso (3 J), that row's torso relative to
+  /// the torso of the newest row (3), distances of each hand to each object
+  /// (hands x objects). The torso block is scaled by
+  /// options.torso_motion_weight; see FrameFeatureOptions for the body-size
+  /// normalisation. Returns (T, frame_feature_size()), metres.
+  Eigen::MatrixXd FrameFeatures(const Eigen::MatrixXd& window) const;
+
+  /// Forecaster input vector of a padded window (T, 3 J) at `rate` Hz (see
+  /// forecast_input_size() for the layout); velocities (m/s) are finite
+  /// differences over `velocity_frames` frames (clamped to T - 1, >= 1).
+  Eigen::VectorXd ForecastInput(const Eigen::MatrixXd& window, double rate,
+                                int velocity_frames) const;
+
+ private:
+  int num_joints_ = 0;
+  std::vector<int> torso_index_;
+  std::vector<int> hand_index_;
+  std::vector<Eigen::Vector3d> objects_;
+  FrameFeatureOptions options_;
+  int shoulder_l_ = -1;
+  int shoulder_r_ = -1;
+};
+
+/// Returns the padded window of length T ending at row `end` (inclusive) of
+/// `positions` (n, 3 J): rows end-T+1..end, rows before 0 replaced by row 0.
+/// Requires 0 <= end < n and T >= 1 (asserted by the caller; throws
+/// std::out_of_range otherwise).
+Eigen::MatrixXd WindowEndingAt(const Eigen::MatrixXd& positions, int end, int T);
+
+}  // namespace iplan::intent

@@ -1,0 +1,166 @@
+// The intent model: action classification (IVM with a DTW kernel, METHOD 2)
+// and per-action future-motion forecasting (SPGP, METHOD 3), combined into a
+// Gaussian mixture over actions.
+//
+// Frames: W is the world (sensor) frame of the skeleton input; all positions
+// are metres in W, all times seconds. A "window" is the last frames of one
+// person at the model rate, a (n, 3 J) matrix, oldest row first, joint j in
+// columns 3j..3j+2, joints in IntentModelConfig::joints.joints order.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/intent/features.h"
+#include "iplan/intent/ivm.h"
+#include "iplan/intent/skeleton_data.h"
+#include "iplan/intent/sparse_gp.h"
+
+namespace iplan::intent {
+
+/// What a model is built for; stored in the model file and checked on load.
+struct IntentModelConfig {
+  JointConfig joints;             ///< Joint set, torso reference, hands, objects.
+  double rate = 15.0;             ///< Model frame rate, Hz (> 0).
+  int window = 15;                ///< T: frames per window (>= 2).
+  int horizon = 15;               ///< D: future frames predicted (>= 1).
+  int velocity_frames = 2;        ///< Finite-difference span for velocities (>= 1).
+  int dtw_band = 3;               ///< Sakoe-Chiba band half-width, frames (>= 0).
+  FrameFeatureOptions features;   ///< Classifier frame-feature options.
+  double sensor_noise_std = 0.01; ///< m, isotropic, added to every predicted covariance.
+
+  /// Empty string when valid, else the offending field and value.
+  std::string Validate() const;
+};
+
+/// Training options (not needed at run time).
+struct TrainParams {
+  double max_gap = 0.6;  ///< s: longer recording gaps split a sequence.
+  /// Early prediction: classifier training samples are the windows ending at
+  /// these fractions of each training sequence (in (0, 1]).
+  std::vector<double> prefix_fractions{0.2, 0.4, 0.6, 0.8, 1.0};
+  /// Kernel widths tried in cross-validation, as multiples of the median DTW
+  /// distance between training windows.
+  std::vector<double> sigma_factors{0.5, 1.0, 2.0};
+  /// IVM regularisers tried in cross-validation.
+  std::vector<double> lambdas{1e-4, 1e-3, 1e-2};
+  IvmParams ivm;  ///< IVM options; `lambda` is replaced by the CV choice.
+  int pseudo_inputs = 20;          ///< M per action.
+  int forecast_stride = 2;         ///< Frames between forecaster training windows.
+  int max_forecast_windows = 600;  ///< Per action, seeded random subset beyond this.
+  /// Actions with fewer full-horizon windows than this also use windows whose
+  /// future runs past the end of the recording, holding the last pose (short
+  /// clips such as Florence 3D).
+  int min_forecast_windows = 20;
+  int gp_iterations = 150;         ///< L-BFGS iterations per action.
+  std::uint64_t seed = 1;
+
+  /// Empty string when valid, else the offending field and value.
+  std::string Validate() const;
+};
+
+/// Classifier part of a model.
+struct ActionClassifier {
+  double sigma = 1.0;                          ///< DTW kernel width, m.
+  std::vector<Eigen::MatrixXd> import_windows; ///< (q) each (F, T): frame features as columns.
+  IvmModel ivm;                                ///< q import samples, C classes.
+};
+
+/// Forecaster of one action: standardisation plus the SPGP.
+/// Outputs p = (k * J + j) * 3 + axis: displacement of joint j at future step
+/// k + 1 from its current position, m, frame W.
+struct ActionForecaster {
+  Eigen::VectorXd input_mean, input_scale;    ///< (D_in)
+  Eigen::VectorXd output_mean, output_scale;  ///< (horizon * 3 J)
+  SparseGp gp;
+  int num_training_windows = 0;
+};
+
+/// A trained model. Plain data, immutable once trained or loaded; const use
+/// from several threads is safe.
+struct IntentModel {
+  IntentModelConfig config;
+  std::vector<std::string> actions;            ///< (C) action labels.
+  ActionClassifier classifier;
+  std::vector<ActionForecaster> forecasters;   ///< (C), same order as actions.
+};
+
+/// A Gaussian for one joint at one future step: mean p_WJ (m) and covariance
+/// (m^2), frame W.
+struct JointGaussian {
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
+/// One mixture component.
+struct ActionHypothesis {
+  std::string action;
+  double probability = 0.0;  ///< p(action | window)
+  /// (horizon * J): Gaussian of joint j at future step k (k = 0: one frame
+  /// ahead) at index k * J + j.
+  std::vector<JointGaussian> joints;
+};
+
+/// The prediction for one window: a Gaussian mixture over actions.
+struct MixturePrediction {
+  double dt = 0.0;  ///< s between future steps (1 / rate).
+  int horizon = 0;
+  int num_joints = 0;
+  std::vector<ActionHypothesis> actions;  ///< (C), probabilities sum to 1.
+
+  const JointGaussian& At(int action, int step, int joint) const {
+    return actions[action].joints[step * num_joints + joint];
+  }
+  /// Moment-matched single Gaussian of the mixture for (step, joint):
+  /// mean = sum p_c mu_c, covariance = sum p_c (Sigma_c + mu_c mu_c^T) - mean mean^T.
+  JointGaussian Combined(int step, int joint) const;
+  /// Index of the most probable action.
+  int MostLikely() const;
+};
+
+/// Summary of a training run (for the CLI).
+struct TrainReport {
+  int num_classifier_samples = 0;
+  int num_import_vectors = 0;
+  double median_dtw = 0.0;
+  double sigma = 0.0;
+  double lambda = 0.0;
+  /// One row per (sigma, lambda) tried: sigma, lambda, CV mean log-loss, CV accuracy.
+  std::vector<std::array<double, 4>> cv_table;
+  std::vector<int> forecast_windows;  ///< Per action.
+  std::vector<bool> forecast_padded;  ///< Per action: held-last-pose futures used.
+  double seconds_classifier = 0.0;
+  double seconds_forecaster = 0.0;
+};
+
+/// Trains a model on `data` (its subjects are the cross-validation folds).
+/// Throws std::invalid_argument for invalid config/params, joints missing from
+/// the data, or fewer than two actions. Deterministic for a given seed.
+/// Single-threaded.
+IntentModel TrainIntentModel(const SkeletonDataset& data,
+                             const IntentModelConfig& config,
+                             const TrainParams& params,
+                             TrainReport* report = nullptr);
+
+/// Resamples every sequence of `data` to the model joints and rate.
+/// Throws std::invalid_argument when a model joint is missing from the data.
+std::vector<Track> MakeTracks(const SkeletonDataset& data,
+                              const IntentModelConfig& config, double max_gap);
+
+/// Class probabilities (C) for a window (n >= 1 rows, 3 J columns, frame W);
+/// windows shorter than T are padded at the front, longer ones use the last T
+/// rows. Throws std::invalid_argument on a wrong column count, no rows or
+/// non-finite values. Thread-safe.
+Eigen::VectorXd ClassifyWindow(const IntentModel& model, const Eigen::MatrixXd& window);
+
+/// Full prediction (classification + per-action forecast) for a window (as
+/// in ClassifyWindow). Reuses the storage in `out`. Throws as ClassifyWindow.
+/// Thread-safe.
+void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
+                   MixturePrediction* out);
+
+}  // namespace iplan::intent

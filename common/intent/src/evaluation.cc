@@ -1,0 +1,207 @@
+#include "iplan/intent/evaluation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+#include <nlohmann/json.hpp>
+
+namespace iplan::intent {
+namespace {
+
+// Chi-square quantile with 3 degrees of freedom at 0.95.
+constexpr double kChi2Dof3P95 = 7.815;
+
+double Percentile(std::vector<double> v, double q) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const double pos = q * (v.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
+}
+
+}  // namespace
+
+std::string FormatKey(double value) {
+  std::ostringstream os;
+  os << std::setprecision(3) << value;
+  std::string s = os.str();
+  if (s.find('.') == std::string::npos && s.find('e') == std::string::npos) s += ".0";
+  return s;
+}
+
+EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& data,
+                               const EvalParams& params) {
+  if (params.fractions.empty() || params.forecast_stride < 1) {
+    throw std::invalid_argument("EvalParams: need fractions and forecast_stride >= 1");
+  }
+  const std::vector<Track> tracks = MakeTracks(data, model.config, params.max_gap);
+  std::map<std::string, int> action_id;
+  for (size_t c = 0; c < model.actions.size(); ++c) action_id[model.actions[c]] = static_cast<int>(c);
+  for (const Track& t : tracks) {
+    if (action_id.count(t.action) == 0) {
+      throw std::invalid_argument("evaluation data contain action '" + t.action +
+                                  "' (sequence " + t.sequence_id +
+                                  ") that the model was not trained on");
+    }
+  }
+  const int C = static_cast<int>(model.actions.size());
+  const int J = static_cast<int>(model.config.joints.joints.size());
+  const int H = model.config.horizon;
+  const int T = model.config.window;
+  const double rate = model.config.rate;
+
+  EvalReport r;
+  r.actions = model.actions;
+  r.fractions = params.fractions;
+  r.accuracy.assign(params.fractions.size(), 0.0);
+  r.mean_true_probability.assign(params.fractions.size(), 0.0);
+  r.confusion = Eigen::MatrixXi::Zero(C, C);
+  r.num_sequences = static_cast<int>(tracks.size());
+  std::vector<double> times_ms;
+  MixturePrediction pred;
+  auto timed_predict = [&](const Eigen::MatrixXd& window) {
+    const auto t0 = std::chrono::steady_clock::now();
+    PredictIntent(model, window, &pred);
+    times_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  };
+
+  for (const Track& t : tracks) {
+    const int n = static_cast<int>(t.positions.rows());
+    const int truth = action_id.at(t.action);
+    for (size_t fi = 0; fi < params.fractions.size(); ++fi) {
+      const int end = std::max(1, static_cast<int>(std::ceil(params.fractions[fi] * n - 1e-9))) - 1;
+      timed_predict(WindowEndingAt(t.positions, end, T));
+      const int guess = pred.MostLikely();
+      if (guess == truth) r.accuracy[fi] += 1.0;
+      r.mean_true_probability[fi] += pred.actions[truth].probability;
+      if (fi + 1 == params.fractions.size()) r.confusion(truth, guess) += 1;
+    }
+  }
+  for (size_t fi = 0; fi < params.fractions.size(); ++fi) {
+    r.accuracy[fi] /= std::max(1, r.num_sequences);
+    r.mean_true_probability[fi] /= std::max(1, r.num_sequences);
+  }
+
+  // Forecasts.
+  r.horizon_s.resize(H);
+  for (int k = 0; k < H; ++k) r.horizon_s[k] = (k + 1) / rate;
+  std::vector<double> em(H, 0.0), ep(H, 0.0), ev(H, 0.0);
+  long inside = 0, total = 0;
+  for (const Track& t : tracks) {
+    const int n = static_cast<int>(t.positions.rows());
+    for (int e = 0; e + H <= n - 1; e += params.forecast_stride) {
+      const Eigen::MatrixXd window = WindowEndingAt(t.positions, e, T);
+      timed_predict(window);
+      ++r.num_forecast_windows;
+      const Eigen::RowVectorXd now = t.positions.row(e);
+      const Eigen::RowVectorXd vel =
+          e > 0 ? Eigen::RowVectorXd((t.positions.row(e) - t.positions.row(e - 1)) * rate)
+                : Eigen::RowVectorXd::Zero(3 * J);
+      for (int k = 0; k < H; ++k) {
+        const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
+        for (int j = 0; j < J; ++j) {
+          const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
+          const JointGaussian g = pred.Combined(k, j);
+          const Eigen::Vector3d err = p_true - g.mean;
+          em[k] += err.norm();
+          ep[k] += (p_true - now.segment<3>(3 * j).transpose()).norm();
+          ev[k] += (p_true - (now.segment<3>(3 * j) + vel.segment<3>(3 * j) * (k + 1) / rate)
+                                 .transpose()).norm();
+          const double d2 = err.dot(g.covariance.ldlt().solve(err));
+          if (d2 <= kChi2Dof3P95) ++inside;
+          ++total;
+        }
+      }
+    }
+  }
+  const double denom = std::max(1.0, static_cast<double>(r.num_forecast_windows) * J);
+  for (int k = 0; k < H; ++k) {
+    r.error_model.push_back(em[k] / denom);
+    r.error_const_position.push_back(ep[k] / denom);
+    r.error_const_velocity.push_back(ev[k] / denom);
+  }
+  r.coverage95 = total > 0 ? static_cast<double>(inside) / total : 0.0;
+  r.inference_p50_ms = Percentile(times_ms, 0.5);
+  r.inference_p99_ms = Percentile(times_ms, 0.99);
+  r.num_inference_calls = static_cast<int>(times_ms.size());
+  return r;
+}
+
+std::string EvalReportToJson(const EvalReport& r) {
+  nlohmann::ordered_json j;
+  for (size_t i = 0; i < r.fractions.size(); ++i) j["accuracy"][FormatKey(r.fractions[i])] = r.accuracy[i];
+  for (size_t i = 0; i < r.fractions.size(); ++i) {
+    j["mean_true_probability"][FormatKey(r.fractions[i])] = r.mean_true_probability[i];
+  }
+  j["error_m"] = nlohmann::ordered_json::object();
+  if (r.num_forecast_windows > 0) {
+    for (size_t k = 0; k < r.horizon_s.size(); ++k) {
+      j["error_m"][FormatKey(r.horizon_s[k])] = {{"model", r.error_model[k]},
+                                                 {"const_position", r.error_const_position[k]},
+                                                 {"const_velocity", r.error_const_velocity[k]}};
+    }
+    j["coverage95"] = r.coverage95;
+  } else {
+    j["coverage95"] = nullptr;
+  }
+  j["inference_ms"] = {{"p50", r.inference_p50_ms}, {"p99", r.inference_p99_ms}};
+  j["actions"] = r.actions;
+  std::vector<std::vector<int>> conf(r.confusion.rows());
+  for (Eigen::Index a = 0; a < r.confusion.rows(); ++a) {
+    for (Eigen::Index b = 0; b < r.confusion.cols(); ++b) conf[a].push_back(r.confusion(a, b));
+  }
+  j["confusion"] = conf;
+  j["num_sequences"] = r.num_sequences;
+  j["num_forecast_windows"] = r.num_forecast_windows;
+  j["num_inference_calls"] = r.num_inference_calls;
+  return j.dump(2);
+}
+
+std::string EvalReportToText(const EvalReport& r) {
+  std::ostringstream os;
+  os << std::fixed;
+  os << "sequences: " << r.num_sequences << "\n";
+  os << "accuracy by observed fraction (mean p(true action)):\n";
+  for (size_t i = 0; i < r.fractions.size(); ++i) {
+    os << "  " << std::setw(4) << std::setprecision(0) << 100.0 * r.fractions[i] << " %: "
+       << std::setprecision(1) << std::setw(5) << 100.0 * r.accuracy[i] << " %  ("
+       << std::setprecision(3) << r.mean_true_probability[i] << ")\n";
+  }
+  os << "confusion matrix at " << std::setprecision(0) << 100.0 * r.fractions.back()
+     << " % observed (row: true, column: predicted):\n";
+  size_t width = 6;
+  for (const std::string& a : r.actions) width = std::max(width, a.size() + 1);
+  for (Eigen::Index a = 0; a < r.confusion.rows(); ++a) {
+    os << "  " << std::left << std::setw(static_cast<int>(width)) << r.actions[a] << std::right;
+    for (Eigen::Index b = 0; b < r.confusion.cols(); ++b) os << std::setw(4) << r.confusion(a, b);
+    os << "\n";
+  }
+  if (r.num_forecast_windows > 0) {
+    os << "forecast windows: " << r.num_forecast_windows << "\n";
+    os << "mean joint position error [m] by horizon:\n";
+    os << "  horizon_s   model  const_pos  const_vel  model/const_vel\n";
+    for (size_t k = 0; k < r.horizon_s.size(); ++k) {
+      os << "  " << std::setprecision(3) << std::setw(9) << r.horizon_s[k] << std::setw(8)
+         << r.error_model[k] << std::setw(11) << r.error_const_position[k] << std::setw(11)
+         << r.error_const_velocity[k] << std::setw(12) << std::setprecision(2)
+         << r.error_model[k] / std::max(r.error_const_velocity[k], 1e-12) << "\n";
+    }
+    os << "95 % ellipsoid coverage: " << std::setprecision(1) << 100.0 * r.coverage95 << " %\n";
+  } else {
+    os << "forecast windows: 0 (no sequence has a recorded future of the full horizon)\n";
+  }
+  os << "inference per frame: p50 " << std::setprecision(3) << r.inference_p50_ms
+     << " ms, p99 " << r.inference_p99_ms << " ms (" << r.num_inference_calls << " calls)\n";
+  return os.str();
+}
+
+}  // namespace iplan::intent

@@ -1,0 +1,177 @@
+#include "iplan/intent/features.h"
+
+#include <algorithm>
+#include <set>
+#include <stdexcept>
+
+namespace iplan::intent {
+namespace {
+
+int IndexOf(const std::vector<std::string>& names, const std::string& n) {
+  for (size_t i = 0; i < names.size(); ++i) {
+    if (names[i] == n) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+bool Has(const std::vector<std::string>& names, const std::string& n) {
+  return IndexOf(names, n) >= 0;
+}
+
+}  // namespace
+
+std::string JointConfig::Validate() const {
+  if (joints.empty()) return "joint list is empty";
+  std::set<std::string> unique;
+  for (const std::string& j : joints) {
+    if (!unique.insert(j).second) return "joint '" + j + "' listed twice";
+  }
+  if (torso.empty()) return "no torso reference joint given";
+  for (const std::string& t : torso) {
+    if (!Has(joints, t)) return "torso joint '" + t + "' is not a model joint";
+  }
+  for (const std::string& h : hands) {
+    if (!Has(joints, h)) return "hand joint '" + h + "' is not a model joint";
+  }
+  for (const Eigen::Vector3d& o : objects) {
+    if (!o.allFinite()) return "task object position is not finite";
+  }
+  return "";
+}
+
+JointConfig DefaultJointConfig(const std::vector<std::string>& available) {
+  JointConfig c;
+  auto pick = [&](std::initializer_list<const char*> aliases) -> std::string {
+    for (const char* a : aliases) {
+      if (Has(available, a)) return a;
+    }
+    return "";
+  };
+  const std::string head = pick({"head"});
+  const std::string neck = pick({"neck", "shoulder_center"});
+  const std::string torso = pick({"torso", "spine"});
+  const std::string hand_l = pick({"hand_l", "wrist_l"});
+  const std::string hand_r = pick({"hand_r", "wrist_r"});
+  for (const std::string& j :
+       {head, neck, torso, std::string(pick({"shoulder_l"})),
+        std::string(pick({"elbow_l"})), hand_l,
+        std::string(pick({"shoulder_r"})), std::string(pick({"elbow_r"})),
+        hand_r}) {
+    if (!j.empty()) c.joints.push_back(j);
+  }
+  if (c.joints.size() < 2) {
+    throw std::invalid_argument(
+        "DefaultJointConfig: the data has fewer than two of the default "
+        "upper-body joints (head, neck, torso, shoulder/elbow/hand l/r)");
+  }
+  if (!torso.empty()) {
+    c.torso = {torso};
+  } else if (Has(c.joints, "shoulder_l") && Has(c.joints, "shoulder_r")) {
+    c.torso = {"shoulder_l", "shoulder_r"};
+  } else {
+    throw std::invalid_argument(
+        "DefaultJointConfig: no torso joint and no pair of shoulders to "
+        "define the torso reference");
+  }
+  if (!hand_l.empty()) c.hands.push_back(hand_l);
+  if (!hand_r.empty()) c.hands.push_back(hand_r);
+  return c;
+}
+
+FeatureLayout::FeatureLayout(const JointConfig& config, const FrameFeatureOptions& options)
+    : options_(options) {
+  const std::string error = config.Validate();
+  if (!error.empty()) throw std::invalid_argument("JointConfig: " + error);
+  num_joints_ = static_cast<int>(config.joints.size());
+  for (const std::string& t : config.torso) torso_index_.push_back(IndexOf(config.joints, t));
+  for (const std::string& h : config.hands) hand_index_.push_back(IndexOf(config.joints, h));
+  objects_ = config.objects;
+  shoulder_l_ = IndexOf(config.joints, "shoulder_l");
+  shoulder_r_ = IndexOf(config.joints, "shoulder_r");
+}
+
+Eigen::Vector3d FeatureLayout::Torso(
+    const Eigen::Ref<const Eigen::RowVectorXd>& frame) const {
+  Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  for (int t : torso_index_) p += frame.segment<3>(3 * t).transpose();
+  return p / static_cast<double>(torso_index_.size());
+}
+
+Eigen::MatrixXd FeatureLayout::FrameFeatures(const Eigen::MatrixXd& window) const {
+  const int T = static_cast<int>(window.rows());
+  const int J = num_joints_;
+  Eigen::MatrixXd f(T, frame_feature_size());
+  const Eigen::Vector3d torso_now = Torso(window.row(T - 1));
+  double scale = 1.0;
+  if (options_.normalise_body_size && shoulder_l_ >= 0 && shoulder_r_ >= 0) {
+    double width = 0.0;
+    for (int s = 0; s < T; ++s) {
+      width += (window.block<1, 3>(s, 3 * shoulder_l_) - window.block<1, 3>(s, 3 * shoulder_r_)).norm();
+    }
+    width /= T;
+    if (width > 1e-3) scale = 0.35 / width;
+  }
+  for (int s = 0; s < T; ++s) {
+    const Eigen::Vector3d torso = Torso(window.row(s));
+    for (int j = 0; j < J; ++j) {
+      f.block<1, 3>(s, 3 * j) = scale * (window.block<1, 3>(s, 3 * j) - torso.transpose());
+    }
+    f.block<1, 3>(s, 3 * J) =
+        (options_.torso_motion_weight * scale) * (torso - torso_now).transpose();
+    int c = 3 * J + 3;
+    for (int h : hand_index_) {
+      for (const Eigen::Vector3d& o : objects_) {
+        f(s, c++) = (window.block<1, 3>(s, 3 * h).transpose() - o).norm();
+      }
+    }
+  }
+  return f;
+}
+
+Eigen::VectorXd FeatureLayout::ForecastInput(const Eigen::MatrixXd& window,
+                                             double rate,
+                                             int velocity_frames) const {
+  const int T = static_cast<int>(window.rows());
+  const int J = num_joints_;
+  const int k = std::max(1, std::min(velocity_frames, T - 1));
+  const int now = T - 1;
+  const int past = std::max(0, now - k);
+  const double dt = (now - past) > 0 ? (now - past) / rate : 1.0 / rate;
+  Eigen::VectorXd x(forecast_input_size());
+  const Eigen::Vector3d torso_now = Torso(window.row(now));
+  const Eigen::Vector3d torso_past = Torso(window.row(past));
+  const Eigen::Vector3d torso_first = Torso(window.row(0));
+  for (int j = 0; j < J; ++j) {
+    const Eigen::Vector3d rel_now =
+        window.block<1, 3>(now, 3 * j).transpose() - torso_now;
+    const Eigen::Vector3d rel_past =
+        window.block<1, 3>(past, 3 * j).transpose() - torso_past;
+    x.segment<3>(3 * j) = rel_now;
+    x.segment<3>(3 * J + 3 * j) = (rel_now - rel_past) / dt;
+  }
+  x.segment<3>(6 * J) = (torso_now - torso_past) / dt;
+  x.segment<3>(6 * J + 3) = torso_now - torso_first;
+  int c = 6 * J + 6;
+  for (int h : hand_index_) {
+    for (const Eigen::Vector3d& o : objects_) {
+      x(c++) = (window.block<1, 3>(now, 3 * h).transpose() - o).norm();
+    }
+  }
+  return x;
+}
+
+Eigen::MatrixXd WindowEndingAt(const Eigen::MatrixXd& positions, int end, int T) {
+  if (T < 1 || end < 0 || end >= positions.rows()) {
+    throw std::out_of_range("WindowEndingAt: end " + std::to_string(end) +
+                            " outside [0, " + std::to_string(positions.rows()) +
+                            ") or T " + std::to_string(T) + " < 1");
+  }
+  Eigen::MatrixXd w(T, positions.cols());
+  for (int s = 0; s < T; ++s) {
+    const int r = std::max(0, end - (T - 1) + s);
+    w.row(s) = positions.row(r);
+  }
+  return w;
+}
+
+}  // namespace iplan::intent

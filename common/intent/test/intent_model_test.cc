@@ -1,0 +1,195 @@
+#include "iplan/intent/intent_model.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <random>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "iplan/intent/evaluation.h"
+#include "iplan/intent/model_io.h"
+
+namespace iplan::intent {
+namespace {
+
+// Three synthetic actions on an arms-only skeleton (like assembly.csv):
+// raise the left wrist, raise the right wrist, or stay still.
+SkeletonDataset MakeDataset(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> noise(0.0, 0.005);
+  SkeletonDataset d;
+  d.joint_names = {"wrist_l", "wrist_r", "elbow_l", "elbow_r", "shoulder_l", "shoulder_r"};
+  const Eigen::VectorXd rest = (Eigen::VectorXd(18) << -0.2, -0.4, 2, 0.2, -0.4, 2, -0.2, -0.1, 2,
+                                0.2, -0.1, 2, -0.2, 0.2, 2, 0.2, 0.2, 2).finished();
+  const char* actions[3] = {"raise_left", "raise_right", "still"};
+  int id = 0;
+  for (const char* subject : {"p1", "p2"}) {
+    for (int a = 0; a < 3; ++a) {
+      for (int rep = 0; rep < 4; ++rep) {
+        SkeletonSequence s;
+        s.id = "seq" + std::to_string(id++);
+        s.subject = subject;
+        s.action = actions[a];
+        const int n = 60;
+        s.time = Eigen::VectorXd::LinSpaced(n, 0.0, (n - 1) / 30.0);
+        s.positions.resize(n, 18);
+        const double speed = 0.5 + 0.1 * rep;
+        for (int i = 0; i < n; ++i) {
+          Eigen::VectorXd p = rest;
+          const double lift = std::min(0.6, speed * s.time(i));
+          if (a == 0) p(1) += lift;
+          if (a == 1) p(4) += lift;
+          for (int k = 0; k < 18; ++k) p(k) += noise(rng);
+          s.positions.row(i) = p.transpose();
+        }
+        d.sequences.push_back(std::move(s));
+      }
+    }
+  }
+  return d;
+}
+
+IntentModelConfig SmallConfig(const SkeletonDataset& d) {
+  IntentModelConfig c;
+  c.joints = DefaultJointConfig(d.joint_names);
+  c.rate = 15.0;
+  c.window = 8;
+  c.horizon = 5;
+  return c;
+}
+
+TrainParams SmallParams() {
+  TrainParams p;
+  p.sigma_factors = {0.5, 1.0};
+  p.lambdas = {1e-3};
+  p.pseudo_inputs = 8;
+  p.gp_iterations = 20;
+  p.max_forecast_windows = 80;
+  return p;
+}
+
+class IntentModelTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    data_ = new SkeletonDataset(MakeDataset(1));
+    model_ = new IntentModel(TrainIntentModel(*data_, SmallConfig(*data_), SmallParams()));
+  }
+  static void TearDownTestSuite() {
+    delete model_;
+    delete data_;
+  }
+  static std::string Path(const std::string& name) { return ::testing::TempDir() + "/" + name; }
+  static SkeletonDataset* data_;
+  static IntentModel* model_;
+};
+SkeletonDataset* IntentModelTest::data_ = nullptr;
+IntentModel* IntentModelTest::model_ = nullptr;
+
+TEST_F(IntentModelTest, ClassifiesAndForecastsHeldOutSequences) {
+  const SkeletonDataset test = MakeDataset(2);
+  const EvalReport r = EvaluateIntentModel(*model_, test, EvalParams{});
+  EXPECT_GE(r.accuracy.back(), 0.95);
+  ASSERT_GT(r.num_forecast_windows, 0);
+  // The lifting wrist moves at constant speed then stops: the model must beat
+  // holding the pose at the last horizon step.
+  EXPECT_LT(r.error_model.back(), r.error_const_position.back());
+  MixturePrediction pred;
+  PredictIntent(*model_, test.sequences[0].positions.topRows(3), &pred);
+  double sum = 0.0;
+  for (const ActionHypothesis& h : pred.actions) sum += h.probability;
+  EXPECT_NEAR(sum, 1.0, 1e-12);
+  EXPECT_EQ(pred.actions[0].joints.size(), 5u * 6u);
+  EXPECT_THROW(PredictIntent(*model_, Eigen::MatrixXd::Zero(3, 17), &pred), std::invalid_argument);
+}
+
+TEST_F(IntentModelTest, SaveLoadRoundTripsBitExactly) {
+  const std::string path = Path("model_roundtrip.bin");
+  SaveIntentModel(*model_, path);
+  const IntentModel loaded = LoadIntentModel(path);
+  EXPECT_EQ(SerializeIntentModel(loaded), SerializeIntentModel(*model_));
+  std::ifstream in(path, std::ios::binary);
+  std::stringstream ss;
+  ss << in.rdbuf();
+  EXPECT_EQ(ss.str(), SerializeIntentModel(*model_));
+  MixturePrediction a, b;
+  const Eigen::MatrixXd window = data_->sequences[5].positions.topRows(12);
+  PredictIntent(*model_, window, &a);
+  PredictIntent(loaded, window, &b);
+  for (size_t c = 0; c < a.actions.size(); ++c) {
+    EXPECT_EQ(a.actions[c].probability, b.actions[c].probability);
+    for (size_t k = 0; k < a.actions[c].joints.size(); ++k) {
+      EXPECT_EQ(a.actions[c].joints[k].mean, b.actions[c].joints[k].mean);
+      EXPECT_EQ(a.actions[c].joints[k].covariance, b.actions[c].joints[k].covariance);
+    }
+  }
+}
+
+void ExpectLoadFails(const std::string& path, const ModelExpectation& expected,
+                     const std::string& fragment) {
+  try {
+    LoadIntentModel(path, expected);
+    FAIL() << "loading " << path << " should fail with: " << fragment;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << "message: " << e.what();
+  }
+}
+
+TEST_F(IntentModelTest, CorruptAndMismatchedFilesAreRefused) {
+  const std::string good = SerializeIntentModel(*model_);
+  auto write = [](const std::string& path, const std::string& bytes) {
+    std::ofstream(path, std::ios::binary) << bytes;
+  };
+  std::string flipped = good;
+  flipped[flipped.size() / 2] ^= 0x10;
+  write(Path("flipped.bin"), flipped);
+  ExpectLoadFails(Path("flipped.bin"), {}, "checksum mismatch");
+
+  write(Path("truncated.bin"), good.substr(0, good.size() - 100));
+  ExpectLoadFails(Path("truncated.bin"), {}, "truncated");
+
+  write(Path("notamodel.bin"), "hello world, this is not a model file");
+  ExpectLoadFails(Path("notamodel.bin"), {}, "not an iplan intent model file");
+
+  std::string other_version = good;
+  other_version[8] = 99;  // version field follows the 8-byte magic
+  write(Path("version.bin"), other_version);
+  ExpectLoadFails(Path("version.bin"), {}, "format version 99, but this build reads version 1");
+
+  write(Path("good.bin"), good);
+  ModelExpectation joints;
+  joints.joints = {"wrist_l", "wrist_r"};
+  ExpectLoadFails(Path("good.bin"), joints, "do not match the configured joints [wrist_l,wrist_r]");
+  ModelExpectation rate;
+  rate.rate = 30.0;
+  ExpectLoadFails(Path("good.bin"), rate, "model rate 15 Hz does not match the configured rate 30 Hz");
+  ModelExpectation matching;
+  matching.joints = model_->config.joints.joints;
+  matching.rate = 15.0;
+  EXPECT_NO_THROW(LoadIntentModel(Path("good.bin"), matching));
+  ExpectLoadFails(Path("does_not_exist.bin"), {}, "cannot open");
+}
+
+TEST_F(IntentModelTest, EvalJsonHasTheDocumentedKeys) {
+  const EvalReport r = EvaluateIntentModel(*model_, MakeDataset(3), EvalParams{});
+  const std::string json = EvalReportToJson(r);
+  for (const char* key : {"\"accuracy\"", "\"0.2\"", "\"1.0\"", "\"error_m\"", "\"0.333\"",
+                          "\"const_velocity\"", "\"coverage95\"", "\"inference_ms\"", "\"p99\""}) {
+    EXPECT_NE(json.find(key), std::string::npos) << key << " missing in\n" << json;
+  }
+}
+
+TEST(IntentModelConfigTest, InvalidConfigurationIsNamed) {
+  IntentModelConfig c;
+  c.joints.joints = {"a"};
+  c.joints.torso = {"a"};
+  c.rate = -1.0;
+  EXPECT_NE(c.Validate().find("rate"), std::string::npos);
+  c.rate = 15.0;
+  c.window = 1;
+  EXPECT_NE(c.Validate().find("window 1"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace iplan::intent

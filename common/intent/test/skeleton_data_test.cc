@@ -1,0 +1,164 @@
+#include "iplan/intent/skeleton_data.h"
+
+#include <cmath>
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "iplan/intent/features.h"
+
+namespace iplan::intent {
+namespace {
+
+std::string WriteTemp(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + "/" + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+const char* kHeader = "sequence,subject,action,frame,time,a.x,a.y,a.z,b.x,b.y,b.z\n";
+
+TEST(SkeletonDataTest, LoadsSequencesInFileOrder) {
+  const std::string path = WriteTemp(
+      "ok.csv", std::string(kHeader) +
+                    "s1,p1,wave,0,0.0,0,0,0,1,1,1\n"
+                    "s1,p1,wave,1,0.1,1,0,0,2,1,1\n"
+                    "s2,p2,clap,0,0.0,5,5,5,6,6,6\n");
+  const SkeletonDataset d = LoadSkeletonCsv(path);
+  ASSERT_EQ(d.joint_names, (std::vector<std::string>{"a", "b"}));
+  ASSERT_EQ(d.sequences.size(), 2u);
+  EXPECT_EQ(d.sequences[0].id, "s1");
+  EXPECT_EQ(d.sequences[0].action, "wave");
+  EXPECT_EQ(d.sequences[0].positions.rows(), 2);
+  EXPECT_DOUBLE_EQ(d.sequences[0].positions(1, 0), 1.0);
+  EXPECT_DOUBLE_EQ(d.sequences[0].positions(1, 3), 2.0);
+  EXPECT_DOUBLE_EQ(d.sequences[1].time(0), 0.0);
+  EXPECT_EQ(SelectSubjects(d, {"p2"}).sequences.size(), 1u);
+}
+
+void ExpectLoadError(const std::string& body, const std::string& fragment) {
+  const std::string path = WriteTemp("bad.csv", body);
+  try {
+    LoadSkeletonCsv(path);
+    FAIL() << "no exception for: " << body;
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos)
+        << "message: " << e.what() << "\nexpected to contain: " << fragment;
+  }
+}
+
+TEST(SkeletonDataTest, MalformedRowsNameFileAndLine) {
+  ExpectLoadError(std::string(kHeader) + "s1,p1,wave,0,0.0,0,0,0,1,1\n", "bad.csv:2: row has 10 fields");
+  ExpectLoadError(std::string(kHeader) + "s1,p1,wave,0,0.0,0,0,0,1,1,1\ns1,p1,wave,1,0.1,0,x,0,1,1,1\n",
+                  "bad.csv:3: column 'a.y': 'x' is not a finite number");
+  ExpectLoadError(std::string(kHeader) + "s1,p1,wave,0,0.0,0,0,0,1,1,1\ns1,p1,wave,1,0.0,0,0,0,1,1,1\n",
+                  "bad.csv:3: time 0.0 does not increase");
+  ExpectLoadError(std::string(kHeader) +
+                      "s1,p1,wave,0,0.0,0,0,0,1,1,1\ns2,p1,wave,0,0.0,0,0,0,1,1,1\n"
+                      "s1,p1,wave,1,0.1,0,0,0,1,1,1\n",
+                  "bad.csv:4: rows of sequence 's1' are not contiguous");
+  ExpectLoadError("sequence,subject,action,frame,time,a.x,a.y,b.z\n", "bad.csv:1: column 'b.z' should be 'a.z'");
+  ExpectLoadError(std::string(kHeader) + "s1,p1,wave,0,nan,0,0,0,1,1,1\n", "'nan' is not a finite number");
+}
+
+TEST(SkeletonDataTest, UnknownSubjectAndJointAreNamed) {
+  const std::string path = WriteTemp("ok2.csv", std::string(kHeader) + "s1,p1,wave,0,0.0,0,0,0,1,1,1\n");
+  const SkeletonDataset d = LoadSkeletonCsv(path);
+  EXPECT_THROW(
+      {
+        try {
+          SelectSubjects(d, {"p7"});
+        } catch (const std::invalid_argument& e) {
+          EXPECT_NE(std::string(e.what()).find("subject 'p7'"), std::string::npos);
+          throw;
+        }
+      },
+      std::invalid_argument);
+  EXPECT_THROW(JointIndices(d.joint_names, {"hand"}), std::invalid_argument);
+}
+
+TEST(SkeletonDataTest, ResamplesLinearlyAndSplitsLongGaps) {
+  SkeletonSequence s;
+  s.id = "x";
+  s.time.resize(4);
+  s.time << 0.0, 0.1, 0.3, 1.5;  // gap of 0.2 s bridged, gap of 1.2 s splits
+  s.positions.resize(4, 3);
+  s.positions << 0, 0, 1, 1, 0, 1, 3, 0, 1, 9, 9, 9;
+  const std::vector<Track> tracks = ResampleSequence(s, {0}, 20.0, 0.5);
+  ASSERT_EQ(tracks.size(), 2u);
+  // 0 .. 0.3 s at 20 Hz: 7 samples, x = 10 t.
+  ASSERT_EQ(tracks[0].positions.rows(), 7);
+  for (int i = 0; i < 7; ++i) EXPECT_NEAR(tracks[0].positions(i, 0), 10.0 * i / 20.0, 1e-12);
+  EXPECT_EQ(tracks[1].positions.rows(), 1);
+  EXPECT_EQ(tracks[1].sequence_id, "x#1");
+  EXPECT_THROW(ResampleSequence(s, {0}, 0.0, 0.5), std::invalid_argument);
+}
+
+TEST(FeaturesTest, DefaultJointSetsPerDataset) {
+  const JointConfig flo = DefaultJointConfig({"head", "neck", "torso", "shoulder_l", "elbow_l", "wrist_l",
+                                              "shoulder_r", "elbow_r", "wrist_r", "hip_l"});
+  EXPECT_EQ(flo.joints.size(), 9u);
+  EXPECT_EQ(flo.torso, std::vector<std::string>{"torso"});
+  EXPECT_EQ(flo.hands, (std::vector<std::string>{"wrist_l", "wrist_r"}));
+  const JointConfig asm_ = DefaultJointConfig({"wrist_l", "wrist_r", "elbow_l", "elbow_r", "shoulder_l", "shoulder_r"});
+  EXPECT_EQ(asm_.joints.size(), 6u);
+  EXPECT_EQ(asm_.torso, (std::vector<std::string>{"shoulder_l", "shoulder_r"}));
+  EXPECT_THROW(DefaultJointConfig({"knee_l"}), std::invalid_argument);
+}
+
+TEST(FeaturesTest, FeaturesRelativeToTorsoAndObjects) {
+  JointConfig c;
+  c.joints = {"shoulder_l", "shoulder_r", "hand"};
+  c.torso = {"shoulder_l", "shoulder_r"};
+  c.hands = {"hand"};
+  c.objects = {Eigen::Vector3d(1.0, 0.0, 0.0)};
+  const FeatureLayout layout(c);
+  Eigen::MatrixXd w(2, 9);
+  w.row(0) << -0.2, 0, 0, 0.2, 0, 0, 0, 0.5, 0;
+  w.row(1) = w.row(0);
+  w.row(1).array() += 0.1;  // everything moves by (0.1, 0.1, 0.1)
+  const Eigen::MatrixXd f = layout.FrameFeatures(w);
+  ASSERT_EQ(f.cols(), 9 + 3 + 1);
+  EXPECT_NEAR(f(1, 6), 0.0, 1e-12);   // hand x relative to torso
+  EXPECT_NEAR(f(1, 7), 0.5, 1e-12);   // hand y relative to torso
+  EXPECT_NEAR(f(0, 9), -0.1, 1e-12);  // torso of row 0 relative to newest torso
+  EXPECT_NEAR(f(1, 12), (Eigen::Vector3d(0.1, 0.6, 0.1) - c.objects[0]).norm(), 1e-12);
+  const Eigen::VectorXd x = layout.ForecastInput(w, 10.0, 1);
+  EXPECT_NEAR(x(9 + 0), 0.0, 1e-12);  // joint velocity relative to torso
+  EXPECT_NEAR(x(18), 1.0, 1e-12);     // torso velocity 0.1 m per 0.1 s
+  JointConfig bad = c;
+  bad.torso = {"pelvis"};
+  EXPECT_NE(bad.Validate().find("torso joint 'pelvis'"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace iplan::intent
+
+namespace iplan::intent {
+namespace {
+
+TEST(SkeletonDataTest, UndetectedJointsAreDroppedFramesNotErrors) {
+  const std::string path = WriteTemp(
+      "missing.csv", std::string(kHeader) +
+                         "s1,p1,wave,0,0.0,0,0,1,1,1,1\n"
+                         "s1,p1,wave,1,0.1,nan,nan,nan,1,1,1\n"
+                         "s1,p1,wave,2,0.2,0,0,0,1,1,1\n"  // (0,0,0): not detected
+                         "s1,p1,wave,3,0.3,3,0,1,1,1,1\n");
+  const SkeletonDataset d = LoadSkeletonCsv(path);
+  EXPECT_TRUE(std::isnan(d.sequences[0].positions(1, 0)));
+  // Joint a: frames 1 and 2 are missing, 0 and 3 are interpolated across.
+  const std::vector<Track> a = ResampleSequence(d.sequences[0], {0}, 10.0, 0.5);
+  ASSERT_EQ(a.size(), 1u);
+  ASSERT_EQ(a[0].positions.rows(), 4);
+  EXPECT_NEAR(a[0].positions(1, 0), 1.0, 1e-12);
+  EXPECT_NEAR(a[0].positions(2, 0), 2.0, 1e-12);
+  // Joint b alone is complete.
+  EXPECT_EQ(ResampleSequence(d.sequences[0], {1}, 10.0, 0.5)[0].positions.rows(), 4);
+  // With a short max_gap the missing frames split the track.
+  EXPECT_EQ(ResampleSequence(d.sequences[0], {0, 1}, 10.0, 0.15).size(), 2u);
+}
+
+}  // namespace
+}  // namespace iplan::intent

@@ -1,0 +1,42 @@
+#!/usr/bin/env bash
+# Sets up iplan on a Debian 12 machine: installs every dependency from
+# Debian's packages (only what is missing), then configures and builds a
+# Release build in build/. Executables end up in build/bin/.
+#
+#   ./scripts/setup.sh            # install + build
+#   IPLAN_JOBS=1 ./scripts/setup.sh   # build with fewer parallel jobs
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+PACKAGES=(
+  build-essential cmake ninja-build pkg-config python3 git
+  # DDS: both vendors, their code generators and tools
+  libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools cyclonedds-dev cyclonedds-tools
+  # algorithms
+  libeigen3-dev libfcl-dev libccd-dev libceres-dev liburdfdom-dev
+  # infrastructure
+  libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libsystemd-dev systemd
+  # tests and benchmarks
+  libgtest-dev libgmock-dev libbenchmark-dev
+)
+
+missing=()
+for p in "${PACKAGES[@]}"; do
+  if ! dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed"; then
+    missing+=("$p")
+  fi
+done
+if ((${#missing[@]})); then
+  echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
+  SUDO=""
+  if [ "$(id -u)" -ne 0 ]; then SUDO="sudo"; fi
+  $SUDO apt-get update -q
+  $SUDO env DEBIAN_FRONTEND=noninteractive apt-get install -y -q --no-install-recommends "${missing[@]}"
+else
+  echo "setup: all Debian packages present"
+fi
+
+jobs="${IPLAN_JOBS:-$(nproc)}"
+cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
+cmake --build build -j "$jobs"
+echo "setup: done; executables in build/bin/"

@@ -1,0 +1,564 @@
+// dds_latency_bench: what the iplan DDS framework costs over the bare vendor
+// API, for a skeleton message and a 10-action prediction message, on both
+// vendors, in one run.
+//
+// Latency: ping-pong between two processes over loopback (same host, same
+// shipped loopback transport config); one-way = round trip / 2.
+//   raw        vendor-generated types, vendor API, a wait set; the echo side
+//              writes back the sample it took.
+//   framework  iplan::msg types through idds::Writer/Reader (conversion to and
+//              from vendor types), and on both sides a framework::Node whose
+//              subscription runs the boundary check before the callback.
+// Throughput: the sender writes as fast as the writer accepts for a fixed
+// time (reliable, keep last 100); the receiver counts what it delivers.
+//
+//   dds_latency_bench [--iterations N] [--runs R] [--json FILE]
+// (the echo/sink roles are the same binary started as child processes).
+#include <unistd.h>
+
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <thread>
+
+#include <CLI/CLI.hpp>
+#include <dds/dds.h>
+#include <fastdds/dds/core/condition/WaitSet.hpp>
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/publisher/qos/DataWriterQos.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/subscriber/qos/DataReaderQos.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+#include <nlohmann/json.hpp>
+#include <spdlog/spdlog.h>
+
+#include "cyclone_convert.h"
+#include "fastdds_convert.h"
+#include "iplan/core/process.h"
+#include "iplan/core/stats.h"
+#include "iplan/dds/participant.h"
+#include "iplan/framework/node.h"
+#include "iplan/msg/time.h"
+
+namespace msg = iplan::msg;
+namespace framework = iplan::framework;
+namespace core = iplan::core;
+namespace idds = iplan::dds;
+using Clock = std::chrono::steady_clock;
+using namespace std::chrono_literals;
+namespace fdds = eprosima::fastdds::dds;
+
+namespace {
+
+const std::string kConfigDir = IPLAN_SOURCE_DIR "/config/dds";
+
+msg::HumanSkeleton MakeSkeleton() {
+  msg::HumanSkeleton s;
+  s.header.frame_id = "world";
+  s.body_id = 1;
+  s.confidence = 1;
+  const char* names[] = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l", "shoulder_r", "elbow_r", "hand_r"};
+  for (int j = 0; j < 9; ++j) {
+    msg::HumanJoint h;
+    h.name = names[j];
+    h.position.x = 0.1 * j;
+    h.covariance = {1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4};
+    h.confidence = 1;
+    s.joints.push_back(h);
+  }
+  return s;
+}
+
+msg::HumanPrediction MakePrediction() {
+  msg::HumanPrediction p;
+  p.header.frame_id = "world";
+  p.body_id = 1;
+  p.time_step = 1.0 / 15;
+  p.num_steps = 15;
+  p.joint_names = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l", "shoulder_r", "elbow_r", "hand_r"};
+  for (int a = 0; a < 10; ++a) {
+    msg::ActionPrediction ap;
+    ap.action = "action_" + std::to_string(a);
+    ap.probability = 0.1;
+    ap.joints.resize(15 * 9);
+    for (auto& g : ap.joints) {
+      g.mean.x = 0.5;
+      g.covariance = {1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3};
+    }
+    p.actions.push_back(ap);
+  }
+  return p;
+}
+
+idds::QosProfile BenchQos(int depth) {
+  idds::QosProfile q = idds::QosProfile::Command(std::chrono::nanoseconds(0));
+  q.depth = depth;
+  return q;
+}
+
+// ---------------------------------------------------------------- raw Fast DDS
+struct RawFast {
+  fdds::DomainParticipant* participant = nullptr;
+  fdds::Publisher* pub = nullptr;
+  fdds::Subscriber* sub = nullptr;
+  fdds::DataWriter* writer = nullptr;
+  fdds::DataReader* reader = nullptr;
+  fdds::WaitSet waitset;
+  const idds::fastdds_gen::FastTypeOps* ops = nullptr;
+  void* sample = nullptr;
+
+  RawFast(int domain, const std::string& type, const std::string& out_topic, const std::string& in_topic, int depth) {
+    for (const auto& o : idds::fastdds_gen::AllFastTypes()) {
+      if (type == o.dds_name) ops = &o;
+    }
+    auto* f = fdds::DomainParticipantFactory::get_instance();
+    f->load_XML_profiles_file(kConfigDir + "/fastdds-loopback.xml");
+    participant = f->create_participant_with_profile(domain, "iplan_participant");
+    fdds::TypeSupport ts(ops->make_pubsub_type());
+    ts.register_type(participant);
+    auto* to = participant->create_topic(out_topic, type, fdds::TOPIC_QOS_DEFAULT);
+    auto* ti = participant->create_topic(in_topic, type, fdds::TOPIC_QOS_DEFAULT);
+    pub = participant->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
+    sub = participant->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
+    fdds::DataWriterQos wq = pub->get_default_datawriter_qos();
+    wq.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    wq.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    wq.history().depth = depth;
+    wq.reliable_writer_qos().times.heartbeatPeriod = eprosima::fastrtps::Duration_t(0, 100000000);
+    wq.data_sharing().off();
+    wq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    writer = pub->create_datawriter(to, wq);
+    fdds::DataReaderQos rq = sub->get_default_datareader_qos();
+    rq.reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+    rq.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    rq.history().depth = depth;
+    rq.data_sharing().off();
+    rq.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    reader = sub->create_datareader(ti, rq);
+    reader->get_statuscondition().set_enabled_statuses(fdds::StatusMask::data_available());
+    waitset.attach_condition(reader->get_statuscondition());
+    sample = ops->new_vendor();
+  }
+  ~RawFast() {
+    waitset.detach_condition(reader->get_statuscondition());
+    participant->delete_contained_entities();
+    fdds::DomainParticipantFactory::get_instance()->delete_participant(participant);
+    ops->delete_vendor(sample);
+  }
+  void Wait() {
+    fdds::ConditionSeq active;
+    waitset.wait(active, eprosima::fastrtps::Duration_t(1, 0));
+  }
+  bool Take() {
+    fdds::SampleInfo info;
+    return reader->take_next_sample(sample, &info) == eprosima::fastrtps::types::ReturnCode_t::RETCODE_OK &&
+           info.valid_data;
+  }
+  void Write() { writer->write(sample); }
+  bool Matched() {
+    fdds::PublicationMatchedStatus s;
+    writer->get_publication_matched_status(s);
+    fdds::SubscriptionMatchedStatus r;
+    reader->get_subscription_matched_status(r);
+    return s.current_count > 0 && r.current_count > 0;
+  }
+};
+
+// ---------------------------------------------------------------- raw Cyclone
+struct RawCyclone {
+  dds_entity_t participant, writer, reader, waitset;
+  const idds::cyclone_gen::CycloneTypeOps* ops = nullptr;
+  std::vector<std::max_align_t> own;
+  idds::cyclone_gen::Arena arena;
+  void* loaned[1] = {nullptr};
+  dds_sample_info_t info;
+
+  RawCyclone(int domain, const std::string& type, const std::string& out_topic, const std::string& in_topic, int depth) {
+    for (const auto& o : idds::cyclone_gen::AllCycloneTypes()) {
+      if (type == o.dds_name) ops = &o;
+    }
+    const std::string uri = "file://" + kConfigDir + "/cyclonedds-loopback.xml";
+    dds_create_domain(static_cast<dds_domainid_t>(domain), uri.c_str());
+    participant = dds_create_participant(static_cast<dds_domainid_t>(domain), nullptr, nullptr);
+    const dds_entity_t to = dds_create_topic(participant, ops->descriptor, out_topic.c_str(), nullptr, nullptr);
+    const dds_entity_t ti = dds_create_topic(participant, ops->descriptor, in_topic.c_str(), nullptr, nullptr);
+    dds_qos_t* q = dds_create_qos();
+    dds_qset_reliability(q, DDS_RELIABILITY_RELIABLE, DDS_MSECS(100));
+    dds_qset_history(q, DDS_HISTORY_KEEP_LAST, depth);
+    dds_data_representation_id_t x1 = DDS_DATA_REPRESENTATION_XCDR1;
+    dds_qset_data_representation(q, 1, &x1);
+    writer = dds_create_writer(participant, to, q, nullptr);
+    reader = dds_create_reader(participant, ti, q, nullptr);
+    dds_delete_qos(q);
+    dds_set_status_mask(reader, DDS_DATA_AVAILABLE_STATUS);
+    waitset = dds_create_waitset(participant);
+    dds_waitset_attach(waitset, reader, 1);
+    own.resize(ops->vendor_size / sizeof(std::max_align_t) + 1);
+  }
+  ~RawCyclone() { dds_delete(participant); }
+  void Fill(const void* plain) { ops->to_vendor(plain, own.data(), arena); }
+  void Wait() {
+    dds_attach_t xs[1];
+    dds_waitset_wait(waitset, xs, 1, DDS_SECS(1));
+  }
+  bool Take() {
+    uint32_t st;
+    dds_take_status(reader, &st, DDS_DATA_AVAILABLE_STATUS);
+    loaned[0] = nullptr;
+    const dds_return_t n = dds_take(reader, loaned, &info, 1, 1);
+    if (n <= 0) return false;
+    if (!info.valid_data) {
+      dds_return_loan(reader, loaned, n);
+      return false;
+    }
+    return true;
+  }
+  void WriteLoanedBackAndReturn() {
+    dds_write(writer, loaned[0]);
+    dds_return_loan(reader, loaned, 1);
+  }
+  void ReturnLoan() { dds_return_loan(reader, loaned, 1); }
+  void WriteOwn() { dds_write(writer, own.data()); }
+  bool Matched() {
+    dds_publication_matched_status_t s;
+    dds_get_publication_matched_status(writer, &s);
+    dds_subscription_matched_status_t r;
+    dds_get_subscription_matched_status(reader, &r);
+    return s.current_count > 0 && r.current_count > 0;
+  }
+};
+
+struct Case {
+  std::string impl;    // raw | framework
+  std::string vendor;  // fastdds | cyclonedds
+  std::string msg;     // skeleton | prediction
+};
+
+std::string TypeOf(const std::string& m) {
+  return m == "skeleton" ? msg::TypeName<msg::HumanSkeleton>::kDds : msg::TypeName<msg::HumanPrediction>::kDds;
+}
+
+// ------------------------------------------------------------------ echo role
+template <class T>
+int FrameworkEcho(idds::Vendor vendor, int domain, double seconds) {
+  idds::ParticipantOptions o;
+  o.vendor = vendor;
+  o.domain_id = domain;
+  auto p = idds::Participant::Create(o);
+  framework::NodeOptions no;
+  no.diagnostics_period = 0;
+  framework::Node node("echo", *p, no);
+  auto& w = node.Advertise(framework::Topic<T>{"rt/bench/pong", BenchQos(5)});
+  node.Subscribe(framework::Topic<T>{"rt/bench/ping", BenchQos(5)},
+                 std::function<void(const T&, const idds::SampleInfo&)>([&](const T& m, const idds::SampleInfo&) { w.Write(m); }),
+                 framework::SubscribeOptions{false});
+  std::cout << "ready" << std::endl;
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  while (Clock::now() < end) node.SpinOnce(100ms);
+  return 0;
+}
+
+int Echo(const Case& c, int domain, double seconds) {
+  spdlog::set_level(spdlog::level::warn);
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  if (c.impl == "framework") {
+    const auto v = idds::ParseVendor(c.vendor);
+    return c.msg == "skeleton" ? FrameworkEcho<msg::HumanSkeleton>(v, domain, seconds)
+                               : FrameworkEcho<msg::HumanPrediction>(v, domain, seconds);
+  }
+  if (c.vendor == "fastdds") {
+    RawFast r(domain, TypeOf(c.msg), "rt/bench/pong", "rt/bench/ping", 5);
+    std::cout << "ready" << std::endl;
+    while (Clock::now() < end) {
+      r.Wait();
+      while (r.Take()) r.Write();
+    }
+  } else {
+    RawCyclone r(domain, TypeOf(c.msg), "rt/bench/pong", "rt/bench/ping", 5);
+    std::cout << "ready" << std::endl;
+    while (Clock::now() < end) {
+      r.Wait();
+      while (r.Take()) r.WriteLoanedBackAndReturn();
+    }
+  }
+  return 0;
+}
+
+// ------------------------------------------------------------------ ping role
+// Returns one-way latencies in microseconds.
+template <class T>
+std::vector<double> FrameworkPing(idds::Vendor vendor, int domain, const T& m, int warmup, int n) {
+  idds::ParticipantOptions o;
+  o.vendor = vendor;
+  o.domain_id = domain;
+  auto p = idds::Participant::Create(o);
+  framework::NodeOptions no;
+  no.diagnostics_period = 0;
+  framework::Node node("ping", *p, no);
+  auto& w = node.Advertise(framework::Topic<T>{"rt/bench/ping", BenchQos(5)});
+  int got = 0;
+  node.Subscribe(framework::Topic<T>{"rt/bench/pong", BenchQos(5)},
+                 std::function<void(const T&, const idds::SampleInfo&)>([&](const T&, const idds::SampleInfo&) { ++got; }),
+                 framework::SubscribeOptions{false});
+  // Matched both ways: send until an echo comes back.
+  const auto deadline = Clock::now() + 20s;
+  while (got == 0 && Clock::now() < deadline) {
+    w.Write(m);
+    node.SpinOnce(50ms);
+  }
+  std::vector<double> us;
+  for (int i = 0; i < warmup + n; ++i) {
+    got = 0;
+    const auto t0 = Clock::now();
+    w.Write(m);
+    while (got == 0) node.SpinOnce(1s);
+    const double rtt = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+    if (i >= warmup) us.push_back(rtt / 2);
+  }
+  return us;
+}
+
+std::vector<double> Ping(const Case& c, int domain, int warmup, int n) {
+  const auto skeleton = MakeSkeleton();
+  const auto prediction = MakePrediction();
+  if (c.impl == "framework") {
+    const auto v = idds::ParseVendor(c.vendor);
+    return c.msg == "skeleton" ? FrameworkPing(v, domain, skeleton, warmup, n)
+                               : FrameworkPing(v, domain, prediction, warmup, n);
+  }
+  const void* plain = c.msg == "skeleton" ? static_cast<const void*>(&skeleton) : static_cast<const void*>(&prediction);
+  std::vector<double> us;
+  auto loop = [&](auto& r, auto write, auto take) {
+    const auto deadline = Clock::now() + 20s;
+    bool echoed = false;
+    while (!echoed && Clock::now() < deadline) {
+      write();
+      r.Wait();
+      while (take()) echoed = true;
+    }
+    for (int i = 0; i < warmup + n; ++i) {
+      const auto t0 = Clock::now();
+      write();
+      bool got = false;
+      while (!got) {
+        r.Wait();
+        while (take()) got = true;
+      }
+      const double rtt = std::chrono::duration<double, std::micro>(Clock::now() - t0).count();
+      if (i >= warmup) us.push_back(rtt / 2);
+    }
+  };
+  if (c.vendor == "fastdds") {
+    RawFast r(domain, TypeOf(c.msg), "rt/bench/ping", "rt/bench/pong", 5);
+    r.ops->to_vendor(plain, r.sample);
+    auto* out = r.ops->new_vendor();
+    r.ops->to_vendor(plain, out);
+    loop(r, [&] { r.writer->write(out); }, [&] { return r.Take(); });
+    r.ops->delete_vendor(out);
+  } else {
+    RawCyclone r(domain, TypeOf(c.msg), "rt/bench/ping", "rt/bench/pong", 5);
+    r.Fill(plain);
+    loop(r, [&] { r.WriteOwn(); }, [&] {
+      if (!r.Take()) return false;
+      r.ReturnLoan();
+      return true;
+    });
+  }
+  return us;
+}
+
+// ------------------------------------------------------------ throughput role
+// Sink: counts delivered messages; prints "rate <msgs/s> <count>" at the end.
+int Sink(const Case& c, int domain, double seconds) {
+  spdlog::set_level(spdlog::level::warn);
+  uint64_t count = 0;
+  Clock::time_point first{}, last{};
+  auto on = [&] {
+    if (count++ == 0) first = Clock::now();
+    last = Clock::now();
+  };
+  const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+  if (c.impl == "framework") {
+    idds::ParticipantOptions o;
+    o.vendor = idds::ParseVendor(c.vendor);
+    o.domain_id = domain;
+    auto p = idds::Participant::Create(o);
+    framework::NodeOptions no;
+    no.diagnostics_period = 0;
+    framework::Node node("sink", *p, no);
+    if (c.msg == "skeleton") {
+      node.Subscribe(framework::Topic<msg::HumanSkeleton>{"rt/bench/ping", BenchQos(100)},
+                     std::function<void(const msg::HumanSkeleton&, const idds::SampleInfo&)>(
+                         [&](const msg::HumanSkeleton&, const idds::SampleInfo&) { on(); }),
+                     framework::SubscribeOptions{false});
+    } else {
+      node.Subscribe(framework::Topic<msg::HumanPrediction>{"rt/bench/ping", BenchQos(100)},
+                     std::function<void(const msg::HumanPrediction&, const idds::SampleInfo&)>(
+                         [&](const msg::HumanPrediction&, const idds::SampleInfo&) { on(); }),
+                     framework::SubscribeOptions{false});
+    }
+    std::cout << "ready" << std::endl;
+    while (Clock::now() < end) node.SpinOnce(100ms);
+  } else if (c.vendor == "fastdds") {
+    RawFast r(domain, TypeOf(c.msg), "rt/bench/unused", "rt/bench/ping", 100);
+    std::cout << "ready" << std::endl;
+    while (Clock::now() < end) {
+      r.Wait();
+      while (r.Take()) on();
+    }
+  } else {
+    RawCyclone r(domain, TypeOf(c.msg), "rt/bench/unused", "rt/bench/ping", 100);
+    std::cout << "ready" << std::endl;
+    while (Clock::now() < end) {
+      r.Wait();
+      while (r.Take()) {
+        r.ReturnLoan();
+        on();
+      }
+    }
+  }
+  const double dt = std::chrono::duration<double>(last - first).count();
+  std::cout << "rate " << (count > 1 && dt > 0 ? (count - 1) / dt : 0.0) << " " << count << std::endl;
+  return 0;
+}
+
+// Source: writes for `seconds`; returns messages written.
+uint64_t Source(const Case& c, int domain, double seconds) {
+  const auto skeleton = MakeSkeleton();
+  const auto prediction = MakePrediction();
+  uint64_t n = 0;
+  auto run = [&](auto write, auto matched) {
+    const auto wait_end = Clock::now() + 20s;
+    while (!matched() && Clock::now() < wait_end) std::this_thread::sleep_for(10ms);
+    std::this_thread::sleep_for(200ms);
+    const auto end = Clock::now() + std::chrono::duration<double>(seconds);
+    while (Clock::now() < end) {
+      write();
+      ++n;
+    }
+  };
+  if (c.impl == "framework") {
+    idds::ParticipantOptions o;
+    o.vendor = idds::ParseVendor(c.vendor);
+    o.domain_id = domain;
+    auto p = idds::Participant::Create(o);
+    if (c.msg == "skeleton") {
+      idds::Writer<msg::HumanSkeleton> w(*p, "rt/bench/ping", BenchQos(100));
+      run([&] { w.Write(skeleton); }, [&] { return w.MatchedReaders() > 0; });
+      w.WaitForAcknowledgments(5s);
+    } else {
+      idds::Writer<msg::HumanPrediction> w(*p, "rt/bench/ping", BenchQos(100));
+      run([&] { w.Write(prediction); }, [&] { return w.MatchedReaders() > 0; });
+      w.WaitForAcknowledgments(5s);
+    }
+  } else {
+    const void* plain = c.msg == "skeleton" ? static_cast<const void*>(&skeleton) : static_cast<const void*>(&prediction);
+    if (c.vendor == "fastdds") {
+      RawFast r(domain, TypeOf(c.msg), "rt/bench/ping", "rt/bench/unused", 100);
+      r.ops->to_vendor(plain, r.sample);
+      run([&] { r.Write(); }, [&] {
+        fdds::PublicationMatchedStatus s;
+        r.writer->get_publication_matched_status(s);
+        return s.current_count > 0;
+      });
+      r.writer->wait_for_acknowledgments(eprosima::fastrtps::Duration_t(5, 0));
+    } else {
+      RawCyclone r(domain, TypeOf(c.msg), "rt/bench/ping", "rt/bench/unused", 100);
+      r.Fill(plain);
+      run([&] { r.WriteOwn(); }, [&] {
+        dds_publication_matched_status_t s;
+        dds_get_publication_matched_status(r.writer, &s);
+        return s.current_count > 0;
+      });
+      dds_wait_for_acks(r.writer, DDS_SECS(5));
+    }
+  }
+  return n;
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  CLI::App app{"dds_latency_bench: framework vs bare vendor latency and throughput"};
+  std::string role = "driver", impl, vendor, message, json_file;
+  int domain = 150, iterations = 2000, runs = 3;
+  double seconds = 60, throughput_seconds = 2;
+  app.add_option("--role", role)->check(CLI::IsMember({"driver", "echo", "sink"}));
+  app.add_option("--impl", impl);
+  app.add_option("--vendor", vendor);
+  app.add_option("--msg", message);
+  app.add_option("--domain", domain);
+  app.add_option("--seconds", seconds);
+  app.add_option("--iterations", iterations, "ping-pongs per run")->capture_default_str();
+  app.add_option("--runs", runs, "runs per case (median and spread are over runs)")->capture_default_str();
+  app.add_option("--throughput-seconds", throughput_seconds)->capture_default_str();
+  app.add_option("--json", json_file, "also write the results as JSON");
+  CLI11_PARSE(app, argc, argv);
+  if (role == "echo") return Echo({impl, vendor, message}, domain, seconds);
+  if (role == "sink") return Sink({impl, vendor, message}, domain, seconds);
+
+  spdlog::set_level(spdlog::level::warn);
+  const std::string self = core::ExecutableDir() + "/dds_latency_bench";
+  nlohmann::json results = nlohmann::json::array();
+  std::cout << "one-way latency = round trip / 2 over loopback, " << iterations << " ping-pongs x " << runs
+            << " runs; throughput over " << throughput_seconds << " s\n\n";
+  std::cout << std::left << std::setw(11) << "message" << std::setw(11) << "vendor" << std::setw(10) << "impl"
+            << std::setw(30) << "p50 us (median [min, max])" << std::setw(30) << "p99 us (median [min, max])"
+            << "throughput msg/s (median)\n";
+  int dom = domain;
+  for (const std::string m : {"skeleton", "prediction"}) {
+    for (const std::string v : {"cyclonedds", "fastdds"}) {
+      double raw_p50 = 0;
+      for (const std::string i : {"raw", "framework"}) {
+        const Case c{i, v, m};
+        std::vector<double> p50s, p99s, rates;
+        for (int r = 0; r < runs; ++r) {
+          {
+            const int d = dom++ % 200 + 1;
+            core::Process echo({self, "--role", "echo", "--impl", i, "--vendor", v, "--msg", m, "--domain",
+                                std::to_string(d), "--seconds", "120"});
+            echo.WaitForOutput("ready", 20s);
+            const auto s = core::Summarize(Ping(c, d, 200, iterations));
+            p50s.push_back(s.p50);
+            p99s.push_back(s.p99);
+          }
+          {
+            const int d = dom++ % 200 + 1;
+            core::Process sink({self, "--role", "sink", "--impl", i, "--vendor", v, "--msg", m, "--domain",
+                                std::to_string(d), "--seconds", std::to_string(throughput_seconds + 3)});
+            sink.WaitForOutput("ready", 20s);
+            Source(c, d, throughput_seconds);
+            sink.Wait(30s);
+            const std::string out = sink.Stdout();
+            const auto pos = out.find("rate ");
+            rates.push_back(pos == std::string::npos ? 0.0 : std::stod(out.substr(pos + 5)));
+          }
+        }
+        const auto a = core::Summarize(p50s), b = core::Summarize(p99s), t = core::Summarize(rates);
+        if (i == "raw") raw_p50 = a.p50;
+        std::ostringstream p50txt, p99txt;
+        p50txt << std::fixed << std::setprecision(1) << a.p50 << " [" << a.min << ", " << a.max << "]";
+        p99txt << std::fixed << std::setprecision(1) << b.p50 << " [" << b.min << ", " << b.max << "]";
+        std::cout << std::left << std::setw(11) << m << std::setw(11) << v << std::setw(10) << i << std::setw(30)
+                  << p50txt.str() << std::setw(30) << p99txt.str() << std::fixed << std::setprecision(0) << t.p50;
+        if (i == "framework" && raw_p50 > 0) {
+          std::cout << "   framework adds " << std::setprecision(1) << 100.0 * (a.p50 - raw_p50) / raw_p50
+                    << " % to the raw p50";
+        }
+        std::cout << std::endl;
+        results.push_back({{"message", m}, {"vendor", v}, {"impl", i}, {"p50_us_runs", p50s},
+                           {"p99_us_runs", p99s}, {"throughput_msgs_per_s_runs", rates}});
+      }
+    }
+  }
+  if (!json_file.empty()) std::ofstream(json_file) << results.dump(2) << "\n";
+  return 0;
+}

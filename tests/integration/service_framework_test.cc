@@ -1,0 +1,164 @@
+// A real service process (iplan-perception) through the framework: bad
+// configurations are refused with a message naming the key and the file;
+// the service publishes diagnostics, stops cleanly on SIGTERM, and tells
+// systemd it is ready and alive through NOTIFY_SOCKET.
+#include <signal.h>
+#include <sys/socket.h>
+#include <sys/un.h>
+#include <unistd.h>
+
+#include <chrono>
+#include <fstream>
+#include <thread>
+
+#include <gtest/gtest.h>
+
+#include "iplan/dds/participant.h"
+#include "iplan/framework/node.h"
+#include "test_paths.h"
+
+namespace iplan::testing {
+namespace {
+
+using namespace std::chrono_literals;
+
+std::string WriteTemp(const std::string& name, const std::string& content) {
+  const std::string path = "/tmp/iplan-svc-test-" + std::to_string(getpid()) + "-" + name;
+  std::ofstream(path) << content;
+  return path;
+}
+
+struct BadConfig {
+  std::string yaml;
+  std::string expected;
+};
+
+class RefusedConfig : public ::testing::TestWithParam<BadConfig> {};
+
+TEST_P(RefusedConfig, ExitsWithCode2NamingKeyAndFile) {
+  const std::string file = WriteTemp("bad.yaml", GetParam().yaml);
+  Process p({BinPath("iplan-perception"), "--config", file, "--domain", std::to_string(UniqueDomain(5))});
+  const auto rc = p.Wait(20s);
+  ASSERT_TRUE(rc.has_value()) << "service did not refuse the configuration";
+  EXPECT_EQ(*rc, 2);
+  EXPECT_NE(p.Stderr().find(file + ": " + GetParam().expected), std::string::npos) << p.Stderr();
+  std::remove(file.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, RefusedConfig,
+    ::testing::Values(BadConfig{"perception:\n  rat_hz: 30\n", "unknown key 'perception.rat_hz'"},
+                      BadConfig{"perception:\n  rate_hz: fast\n",
+                                "key 'perception.rate_hz': expected a finite number, got 'fast'"},
+                      BadConfig{"perception:\n  rate_hz: 0\n", "key 'perception.rate_hz': must be in"},
+                      BadConfig{"perception:\n  provider: kinect9\n",
+                                "key 'perception.provider': must be one of: synthetic"},
+                      BadConfig{"perception:\n  synthetic:\n    torso: [1, 2]\n",
+                                "key 'perception.synthetic.torso': must have 3 numbers"},
+                      BadConfig{"node:\n  diagnostics_period: -1\n", "key 'node.diagnostics_period': must be >= 0"},
+                      BadConfig{"perceptoin:\n  rate_hz: 30\n", "unknown key 'perceptoin'"}));
+
+TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
+  Process missing({BinPath("iplan-perception"), "--config", "/nonexistent/perception.yaml"});
+  ASSERT_EQ(missing.Wait(20s), 2);
+  EXPECT_NE(missing.Stderr().find("/nonexistent/perception.yaml: cannot open"), std::string::npos) << missing.Stderr();
+  Process vendor({BinPath("iplan-perception"), "--dds", "opendds"});
+  ASSERT_EQ(vendor.Wait(20s), 2);
+  EXPECT_NE(vendor.Stderr().find("unknown DDS vendor 'opendds'"), std::string::npos) << vendor.Stderr();
+  Process check({BinPath("iplan-perception"), "--check-config"});
+  ASSERT_EQ(check.Wait(20s), 0) << check.Stderr();
+  EXPECT_NE(check.Stdout().find("configuration is valid"), std::string::npos);
+}
+
+TEST(ServiceFramework, PublishesDiagnosticsAndStopsCleanlyOnSigterm) {
+  const int domain = UniqueDomain(6);
+  Process svc({BinPath("iplan-perception"), "--domain", std::to_string(domain), "--dds", "fastdds"});
+  dds::ParticipantOptions o;
+  o.vendor = dds::Vendor::kCyclone;
+  o.domain_id = domain;
+  auto p = dds::Participant::Create(o);
+  framework::NodeOptions no;
+  no.diagnostics_period = 0;
+  framework::Node node("observer", *p, no);
+  std::string state;
+  int skeletons = 0;
+  node.Subscribe(framework::topics::Diagnostics(),
+                 std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
+                     [&](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
+                       for (const auto& s : a.status) {
+                         if (s.name == "perception") state = s.message;
+                       }
+                     }));
+  node.Subscribe(framework::topics::HumanSkeleton(),
+                 std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanSkeleton& s, const dds::SampleInfo&) {
+                       ++skeletons;
+                       EXPECT_EQ(s.joints.size(), 9u);
+                     }));
+  const auto end = std::chrono::steady_clock::now() + 20s;
+  while ((state != "active" || skeletons < 30) && std::chrono::steady_clock::now() < end) node.SpinOnce(50ms);
+  EXPECT_EQ(state, "active");
+  EXPECT_GE(skeletons, 30);
+  svc.Signal(SIGTERM);
+  const auto rc = svc.Wait(10s);
+  ASSERT_TRUE(rc.has_value()) << "service did not stop on SIGTERM";
+  EXPECT_EQ(*rc, 0) << svc.Stderr();
+  EXPECT_NE(svc.Stderr().find("stopping"), std::string::npos);
+}
+
+TEST(ServiceFramework, NotifiesSystemdReadinessWatchdogAndStopping) {
+  const std::string sock_path = "/tmp/iplan-notify-" + std::to_string(getpid()) + ".sock";
+  ::unlink(sock_path.c_str());
+  const int fd = ::socket(AF_UNIX, SOCK_DGRAM | SOCK_CLOEXEC, 0);
+  ASSERT_GE(fd, 0);
+  sockaddr_un addr{};
+  addr.sun_family = AF_UNIX;
+  std::snprintf(addr.sun_path, sizeof(addr.sun_path), "%s", sock_path.c_str());
+  ASSERT_EQ(::bind(fd, reinterpret_cast<sockaddr*>(&addr), sizeof(addr)), 0);
+  timeval tv{0, 100000};
+  setsockopt(fd, SOL_SOCKET, SO_RCVTIMEO, &tv, sizeof(tv));
+
+  Process svc({BinPath("iplan-perception"), "--domain", std::to_string(UniqueDomain(7))},
+              {{"NOTIFY_SOCKET", sock_path}, {"WATCHDOG_USEC", "200000"}});
+  std::vector<std::pair<double, std::string>> messages;
+  const auto start = std::chrono::steady_clock::now();
+  bool stopped = false;
+  while (std::chrono::steady_clock::now() - start < 20s) {
+    char buf[512];
+    const ssize_t n = ::recv(fd, buf, sizeof(buf) - 1, 0);
+    const double t = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (n > 0) messages.emplace_back(t, std::string(buf, static_cast<std::size_t>(n)));
+    int watchdogs = 0;
+    bool ready = false;
+    for (const auto& [tm, m] : messages) {
+      ready = ready || m.find("READY=1") != std::string::npos;
+      if (m.find("WATCHDOG=1") != std::string::npos) ++watchdogs;
+    }
+    if (ready && watchdogs >= 5 && !stopped) {
+      svc.Signal(SIGTERM);
+      stopped = true;
+    }
+    if (stopped && !svc.Running()) break;
+  }
+  ::close(fd);
+  ::unlink(sock_path.c_str());
+  ASSERT_EQ(svc.Wait(5s), 0) << svc.Stderr();
+  double ready_at = -1;
+  std::vector<double> watchdog_at;
+  bool stopping = false;
+  for (const auto& [t, m] : messages) {
+    if (m.find("READY=1") != std::string::npos) ready_at = t;
+    if (m.find("WATCHDOG=1") != std::string::npos) watchdog_at.push_back(t);
+    if (m.find("STOPPING=1") != std::string::npos) stopping = true;
+  }
+  ASSERT_GE(ready_at, 0) << "no READY=1";
+  ASSERT_GE(watchdog_at.size(), 5u);
+  EXPECT_TRUE(stopping) << "no STOPPING=1";
+  // Keep-alives come at half the 200 ms interval: no gap may reach 200 ms.
+  for (std::size_t i = 1; i < watchdog_at.size(); ++i) {
+    EXPECT_LT(watchdog_at[i] - watchdog_at[i - 1], 0.2) << "watchdog gap at " << watchdog_at[i];
+  }
+}
+
+}  // namespace
+}  // namespace iplan::testing

@@ -1,0 +1,216 @@
+// `iplan intent train` and `iplan intent eval`: train an intent model
+// (IVM action classifier + per-action SPGP forecasters) on recorded skeleton
+// data and evaluate it. The work is done by iplan::intent; this file only
+// parses options and prints.
+#include <chrono>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "command_registry.h"
+#include "iplan/intent/evaluation.h"
+#include "iplan/intent/intent_model.h"
+#include "iplan/intent/model_io.h"
+#include "iplan/intent/skeleton_data.h"
+
+namespace iplan::cli {
+namespace {
+
+std::vector<std::string> SplitList(const std::string& text, char sep = ',') {
+  std::vector<std::string> out;
+  std::stringstream ss(text);
+  std::string item;
+  while (std::getline(ss, item, sep)) {
+    if (!item.empty()) out.push_back(item);
+  }
+  return out;
+}
+
+std::vector<double> ParseDoubles(const std::string& text, const std::string& option) {
+  std::vector<double> out;
+  for (const std::string& s : SplitList(text)) {
+    size_t used = 0;
+    double v = 0.0;
+    try {
+      v = std::stod(s, &used);
+    } catch (const std::exception&) {
+      used = 0;
+    }
+    if (used != s.size()) throw std::invalid_argument(option + ": '" + s + "' is not a number");
+    out.push_back(v);
+  }
+  return out;
+}
+
+// "x,y,z;x,y,z" -> object positions (m, world frame).
+std::vector<Eigen::Vector3d> ParseObjects(const std::string& text) {
+  std::vector<Eigen::Vector3d> out;
+  for (const std::string& o : SplitList(text, ';')) {
+    const std::vector<double> v = ParseDoubles(o, "--objects");
+    if (v.size() != 3) {
+      throw std::invalid_argument("--objects: '" + o + "' is not an x,y,z triple");
+    }
+    out.emplace_back(v[0], v[1], v[2]);
+  }
+  return out;
+}
+
+struct TrainOptions {
+  std::string data, subjects, out, joints, torso, hands, objects;
+  std::string sigma_factors, lambdas, prefixes;
+  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 1.0;
+  bool normalise_size = false;
+  double ivm_tolerance = 1e-3;
+  int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80;
+  int gp_iterations = 150, max_forecast_windows = 600, forecast_stride = 2;
+  std::uint64_t seed = 1;
+};
+
+struct EvalOptions {
+  std::string model, data, subjects;
+  bool json = false;
+  int stride = 1;
+};
+
+void RunTrain(const TrainOptions& o) {
+  using namespace iplan::intent;
+  const SkeletonDataset all = LoadSkeletonCsv(o.data);
+  const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
+  IntentModelConfig config;
+  config.joints = DefaultJointConfig(data.joint_names);
+  if (!o.joints.empty()) config.joints.joints = SplitList(o.joints);
+  if (!o.torso.empty()) config.joints.torso = SplitList(o.torso);
+  if (!o.hands.empty()) config.joints.hands = SplitList(o.hands == "none" ? "" : o.hands);
+  if (!o.objects.empty()) config.joints.objects = ParseObjects(o.objects);
+  config.rate = o.rate;
+  config.window = o.window;
+  config.horizon = o.horizon;
+  config.dtw_band = o.band;
+  config.sensor_noise_std = o.noise;
+  config.features.torso_motion_weight = o.torso_weight;
+  config.features.normalise_body_size = o.normalise_size;
+  TrainParams params;
+  params.max_gap = o.max_gap;
+  if (!o.sigma_factors.empty()) params.sigma_factors = ParseDoubles(o.sigma_factors, "--sigma-factors");
+  if (!o.lambdas.empty()) params.lambdas = ParseDoubles(o.lambdas, "--lambdas");
+  if (!o.prefixes.empty()) params.prefix_fractions = ParseDoubles(o.prefixes, "--prefixes");
+  params.ivm.max_import = o.max_import;
+  params.ivm.stop_tolerance = o.ivm_tolerance;
+  params.pseudo_inputs = o.pseudo_inputs;
+  params.gp_iterations = o.gp_iterations;
+  params.max_forecast_windows = o.max_forecast_windows;
+  params.forecast_stride = o.forecast_stride;
+  params.seed = o.seed;
+
+  const auto t0 = std::chrono::steady_clock::now();
+  TrainReport rep;
+  const IntentModel model = TrainIntentModel(data, config, params, &rep);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  SaveIntentModel(model, o.out);
+
+  std::cout << "trained on " << data.sequences.size() << " sequences of subjects " << o.subjects
+            << "\njoints:";
+  for (const std::string& j : config.joints.joints) std::cout << " " << j;
+  std::cout << "\ntorso:";
+  for (const std::string& j : config.joints.torso) std::cout << " " << j;
+  std::cout << "\nactions:";
+  for (const std::string& a : model.actions) std::cout << " " << a;
+  std::cout << "\nclassifier: " << rep.num_classifier_samples << " windows, median DTW "
+            << rep.median_dtw << " m\n  cross-validation (leave one subject out):\n"
+            << "    sigma_m  lambda   logloss  accuracy\n";
+  for (const auto& row : rep.cv_table) {
+    std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
+  }
+  std::cout << "  chosen sigma " << rep.sigma << " m, lambda " << rep.lambda << ", "
+            << rep.num_import_vectors << " import vectors, " << rep.seconds_classifier
+            << " s\nforecasters (" << params.pseudo_inputs << " pseudo-inputs each): windows per action:";
+  for (size_t c = 0; c < rep.forecast_windows.size(); ++c) {
+    std::cout << " " << rep.forecast_windows[c] << (rep.forecast_padded[c] ? "*" : "");
+  }
+  std::cout << (std::find(rep.forecast_padded.begin(), rep.forecast_padded.end(), true) !=
+                        rep.forecast_padded.end()
+                    ? "  (* short clips: futures past the recording end hold the last pose)"
+                    : "")
+            << "\n  " << rep.seconds_forecaster << " s\ntraining time: " << seconds
+            << " s\nmodel written to " << o.out << "\n";
+}
+
+void RunEval(const EvalOptions& o) {
+  using namespace iplan::intent;
+  const IntentModel model = LoadIntentModel(o.model);
+  const SkeletonDataset all = LoadSkeletonCsv(o.data);
+  const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
+  EvalParams params;
+  params.forecast_stride = o.stride;
+  const EvalReport report = EvaluateIntentModel(model, data, params);
+  if (o.json) {
+    std::cout << EvalReportToJson(report) << "\n";
+  } else {
+    std::cout << "model " << o.model << " on " << o.data << " (subjects " << o.subjects << ")\n"
+              << EvalReportToText(report);
+  }
+}
+
+template <typename F>
+void Guarded(const F& f) {
+  try {
+    f();
+    SetExitCode(0);
+  } catch (const std::exception& e) {
+    std::cerr << "iplan intent: error: " << e.what() << "\n";
+    SetExitCode(1);
+  }
+}
+
+const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
+  CLI::App* intent = app.add_subcommand(
+      "intent", "Human intent: train and evaluate the action classifier and motion forecaster");
+  intent->require_subcommand(1);
+
+  auto train_opts = std::make_shared<TrainOptions>();
+  CLI::App* train = intent->add_subcommand("train", "Train an intent model from a skeleton CSV");
+  TrainOptions& t = *train_opts;
+  train->add_option("--data", t.data, "Skeleton CSV (shared layout)")->required();
+  train->add_option("--subjects", t.subjects, "Training subjects, comma separated")->required();
+  train->add_option("--out", t.out, "Model file to write")->required();
+  train->add_option("--joints", t.joints, "Model joints (default: upper-body set found in the data)");
+  train->add_option("--torso", t.torso, "Joints whose mean is the torso reference");
+  train->add_option("--hands", t.hands, "Hand joints for object distances ('none' for none)");
+  train->add_option("--objects", t.objects, "Task objects 'x,y,z;x,y,z' (m, data frame)");
+  train->add_option("--rate", t.rate, "Model rate, Hz")->capture_default_str();
+  train->add_option("--window,-T", t.window, "Window length T, frames")->capture_default_str();
+  train->add_option("--horizon", t.horizon, "Forecast horizon, frames")->capture_default_str();
+  train->add_option("--pseudo-inputs,-M", t.pseudo_inputs, "SPGP pseudo-inputs per action")->capture_default_str();
+  train->add_option("--band", t.band, "DTW Sakoe-Chiba band, frames")->capture_default_str();
+  train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
+  train->add_option("--ivm-tolerance", t.ivm_tolerance, "IVM stopping: relative decrease over 3 additions")->capture_default_str();
+  train->add_option("--sigma-factors", t.sigma_factors, "CV kernel widths x median DTW (default 0.5,1,2)");
+  train->add_option("--lambdas", t.lambdas, "CV regularisers (default 1e-4,1e-3,1e-2)");
+  train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
+  train->add_option("--gp-iterations", t.gp_iterations, "L-BFGS iterations per action")->capture_default_str();
+  train->add_option("--max-forecast-windows", t.max_forecast_windows, "Forecaster windows per action")->capture_default_str();
+  train->add_option("--forecast-stride", t.forecast_stride, "Frames between forecaster windows")->capture_default_str();
+  train->add_option("--noise", t.noise, "Sensor noise std added to covariances, m")->capture_default_str();
+  train->add_option("--max-gap", t.max_gap, "Recording gaps longer than this split sequences, s")->capture_default_str();
+  train->add_option("--torso-weight", t.torso_weight, "Classifier weight of torso motion")->capture_default_str();
+  train->add_flag("--normalise-size", t.normalise_size, "Classifier features divided by shoulder width");
+  train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
+  train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
+
+  auto eval_opts = std::make_shared<EvalOptions>();
+  CLI::App* eval = intent->add_subcommand("eval", "Evaluate an intent model on a skeleton CSV");
+  EvalOptions& e = *eval_opts;
+  eval->add_option("--model", e.model, "Model file")->required();
+  eval->add_option("--data", e.data, "Skeleton CSV (shared layout)")->required();
+  eval->add_option("--subjects", e.subjects, "Test subjects, comma separated")->required();
+  eval->add_option("--stride", e.stride, "Frames between evaluated forecast windows")->capture_default_str();
+  eval->add_flag("--json", e.json, "Print the report as JSON");
+  eval->callback([eval_opts] { Guarded([&] { RunEval(*eval_opts); }); });
+});
+
+}  // namespace
+}  // namespace iplan::cli

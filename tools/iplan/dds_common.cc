@@ -1,0 +1,38 @@
+#include "dds_common.h"
+
+namespace iplan::cli {
+
+void AddDdsOptions(CLI::App* app, DdsOptions* o) {
+  app->add_option("--dds", o->vendor, "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
+  app->add_option("--domain", o->domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)")
+      ->check(CLI::Range(0, 232));
+}
+
+std::unique_ptr<dds::Participant> MakeParticipant(const DdsOptions& o, const std::string& name, bool track) {
+  dds::ParticipantOptions p;
+  p.vendor = o.vendor.empty() ? dds::DefaultVendor() : dds::ParseVendor(o.vendor);
+  p.domain_id = o.domain >= 0 ? o.domain : dds::DefaultDomain();
+  p.name = name;
+  p.track_endpoints = track;
+  return dds::Participant::Create(p);
+}
+
+std::string DdsTopicName(const std::string& name) {
+  if (name.rfind("rt/", 0) == 0) return name;
+  if (!name.empty() && name[0] == '/') return "rt" + name;
+  return "rt/" + name;
+}
+
+std::string RosTopicName(const std::string& dds_name) {
+  if (dds_name.rfind("rt/", 0) == 0) return dds_name.substr(2);
+  return dds_name;
+}
+
+std::optional<framework::TopicDescription> FindCatalogueTopic(const std::string& dds_name) {
+  for (const auto& t : framework::topics::All()) {
+    if (t.name == dds_name) return t;
+  }
+  return std::nullopt;
+}
+
+}  // namespace iplan::cli
