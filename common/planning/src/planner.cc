@@ -672,6 +672,10 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
   at.nq = nq;
   at.dt = P.dt;
   at.n = std::max(2, static_cast<int>(std::lround(P.horizon / P.dt)));
+  // A warm start longer than the horizon (it contains earlier waits) keeps
+  // its length, up to twice the horizon, so its remaining motion is not cut.
+  if (req.warm_start.cols() - 1 > at.n)
+    at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
   at.k = req.num_frozen;
   if (at.k >= at.n) bad("num_frozen = " + std::to_string(at.k) + " leaves no free waypoint in a horizon of " +
                         std::to_string(at.n) + " intervals");
