@@ -1,0 +1,172 @@
+// Planning benchmark (plain executable; figures printed, no assertions).
+//
+// 1. One-shot: >= 50 seeded table-top problems for the Panda in
+//    config/scenes/cell.yaml: start at the IK solution of one named pose
+//    (table, shelf height, above the bin; +-3 cm jitter), goal another pose
+//    (pose goal for even problems, joint goal for odd ones). Success within
+//    1 s, time to first feasible trajectory, final cost, for 8 optimisers and
+//    for 1 optimiser (multi-start gain).
+// 2. Replanning: a synthesised person (default 16-sphere upper body) standing
+//    across the table walks along it (torso y from -0.5 to +0.5 m over the
+//    run) while the prediction mixture has 10 reaching actions (hand to
+//    x = 0.78-0.84 m, y = -0.45..0.45 m, the person's half of the table) x 15 steps
+//    (0.1 s). Every cycle (m = 0.1 s) the previous trajectory is shifted by
+//    0.1 s and warm-starts the planner with the first 3 waypoints frozen.
+//    The cycle time is the wall time of Planner::Plan.
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <random>
+#include <vector>
+
+#include "../test/test_util.h"
+#include "iplan/collision/human_model.h"
+#include "iplan/planning/planner.h"
+
+using namespace iplan;
+using namespace iplan::planning;
+
+namespace {
+
+double Pct(std::vector<double> v, double p) {
+  if (v.empty()) return -1.0;
+  std::sort(v.begin(), v.end());
+  const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5));
+  return v[i];
+}
+
+struct Problem {
+  Eigen::VectorXd start;
+  Goal goal;
+  std::string name;
+};
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  const int num_problems = argc > 1 ? std::atoi(argv[1]) : 60;
+  const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
+  const collision::RobotModel robot = testing::LoadPanda();
+  PlannerParams params = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml");
+  Planner planner(robot, testing::LoadCell(), params);
+  Eigen::VectorXd ready(7);
+  ready << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+
+  // Problems.
+  const auto poses = testing::TableTopPoses();
+  std::mt19937_64 rng(2026);
+  std::uniform_int_distribution<int> pick(0, static_cast<int>(poses.size()) - 1);
+  std::uniform_real_distribution<double> jit(-0.03, 0.03), yaw(-0.3, 0.3);
+  std::vector<Problem> problems;
+  int ik_rejected = 0;
+  while (static_cast<int>(problems.size()) < num_problems) {
+    const int a = pick(rng), b = pick(rng);
+    if (a == b) continue;
+    const Eigen::Vector3d pa = poses[a].p + Eigen::Vector3d(jit(rng), jit(rng), jit(rng));
+    const Eigen::Vector3d pb = poses[b].p + Eigen::Vector3d(jit(rng), jit(rng), jit(rng));
+    const double ya = yaw(rng), yb = yaw(rng);
+    const IkResult s = planner.SolveIk(pa, testing::DownOrientation(ya), ready, problems.size());
+    if (!s.success || planner.CalcClearance(s.q) < 0.0) {
+      ++ik_rejected;
+      continue;
+    }
+    Problem pr;
+    pr.start = s.q;
+    pr.name = std::string(poses[a].name) + "->" + poses[b].name;
+    if (problems.size() % 2 == 0) {
+      pr.goal = Goal::Pose(pb, testing::DownOrientation(yb));
+    } else {
+      const IkResult g = planner.SolveIk(pb, testing::DownOrientation(yb), s.q, problems.size() + 7);
+      if (!g.success || planner.CalcClearance(g.q) < 0.0) {
+        ++ik_rejected;
+        continue;
+      }
+      pr.goal = Goal::Joint(g.q);
+    }
+    problems.push_back(pr);
+  }
+
+  std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
+              "%d worker threads, dt %.2f s, horizon %.1f s\n",
+              num_problems, ik_rejected, threads, params.dt, params.horizon);
+  for (int nopt : {8, 1}) {
+    int ok = 0, ok_1s = 0;
+    std::vector<double> t_first, t_total, cost;
+    for (std::size_t i = 0; i < problems.size(); ++i) {
+      PlanningRequest req;
+      req.start_q = problems[i].start;
+      req.goal = problems[i].goal;
+      const PlanningResult r = planner.Plan(req, nopt, std::min(threads, nopt), 1000 + i);
+      t_total.push_back(r.planning_time);
+      if (r.success) {
+        ++ok;
+        if (r.planning_time <= 1.0) ++ok_1s;
+        t_first.push_back(r.time_to_first_feasible);
+        cost.push_back(r.cost);
+      } else if (nopt == 8) {
+        std::printf("  failed %zu %s: %s (%s)\n", i, problems[i].name.c_str(), ToString(r.status),
+                    r.reason.c_str());
+      }
+    }
+    std::printf("one-shot, %d optimiser(s): success %d/%zu = %.1f %%, within 1 s %.1f %% (target >= 95 %%)\n",
+                nopt, ok, problems.size(), 100.0 * ok / problems.size(), 100.0 * ok_1s / problems.size());
+    std::printf("  time to first feasible: p50 %.1f ms, p99 %.1f ms; planning time p50 %.1f ms, p99 %.1f ms, max %.1f ms\n",
+                1e3 * Pct(t_first, 0.5), 1e3 * Pct(t_first, 0.99), 1e3 * Pct(t_total, 0.5),
+                1e3 * Pct(t_total, 0.99), 1e3 * Pct(t_total, 1.0));
+    std::printf("  final cost: p50 %.2f, p10 %.2f, p90 %.2f\n", Pct(cost, 0.5), Pct(cost, 0.1), Pct(cost, 0.9));
+  }
+
+  // Replanning cycles with a moving person.
+  const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
+  std::vector<Eigen::Vector3d> targets;
+  for (int c = 0; c < 10; ++c)
+    targets.emplace_back(0.78 + 0.03 * (c % 3), -0.45 + 0.1 * c, 0.20 + 0.02 * (c % 4));
+  // Replanning configuration: one wait per cycle (the next cycle replans
+  // anyway) and fewer iterations, since the warm start is already good.
+  PlannerParams replan_params = params;
+  replan_params.max_waits = 1;
+  replan_params.max_iterations = 30;
+  Planner replanner(robot, testing::LoadCell(), replan_params);
+  std::vector<double> cycle;
+  int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
+  const int cycles_per_task = 25;
+  for (std::size_t i = 0; i < problems.size() && tasks < 12; i += 5, ++tasks) {
+    PlanningRequest req;
+    req.start_q = problems[i].start;
+    req.goal = problems[i].goal;
+    PlanningResult prev;
+    bool task_ok = true;
+    for (int k = 0; k < cycles_per_task; ++k) {
+      const double y = -0.5 + 1.0 * k / (cycles_per_task - 1);
+      const collision::HumanPrediction pred = testing::MakeReachingPrediction(
+          body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
+      req.prediction = &pred;
+      req.prediction_dt = 0.1;
+      req.prediction_start = 0.0;
+      if (k > 0 && prev.positions.cols() > 1) {
+        req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
+        req.start_q = req.warm_start.col(0);
+        req.start_qdot = (prev.positions.col(2) - prev.positions.col(1)) / prev.dt;
+        req.num_frozen = 3;
+        req.goal = Goal::Joint(prev.goal_q);
+      }
+      const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
+      cycle.push_back(r.planning_time);
+      total_waits += r.num_waits;
+      if (!r.success) {
+        ++cycles_failed;
+        task_ok = false;
+        if (r.positions.cols() == 0) break;
+      }
+      prev = r;
+    }
+    tasks_ok += task_ok;
+  }
+  std::printf("replanning (max_waits 1, max_iterations 30): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
+              tasks, cycles_per_task, threads, body.num_spheres());
+  std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
+              1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
+  std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
+              cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+  return 0;
+}

@@ -1,0 +1,91 @@
+// Parameters of the ITOMP-style trajectory optimiser (METHOD.md section 5).
+// SI units: s, m, rad. Loaded strictly from YAML (config/planner.yaml).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace iplan::planning {
+
+/// Weights of the cost terms (dimensionless multipliers of the terms defined
+/// in planner.h; all >= 0).
+struct CostWeights {
+  double smoothness = 1.0;   ///< x sum_i dt ||a_i||^2 (a in rad/s^2)
+  double obstacle = 2000.0;  ///< x sum max(0, margin - d)^2 (d in m), per sphere/object
+  double dynamic = 1e4;      ///< x sum_i max(0, P_i - threshold)^2
+  double goal = 0.5;         ///< x sum_i dt ||q_i - q_goal||^2 (rad^2 s)
+  double limits = 50.0;      ///< x squared velocity/acceleration limit excess (normalised)
+};
+
+struct PlannerParams {
+  /// Waypoint spacing dt (s), > 0.
+  double dt = 0.1;
+  /// Planning horizon (s): n = round(horizon / dt) intervals, n + 1 waypoints.
+  double horizon = 3.0;
+  /// Safety level delta_CL in (0, 1): a waypoint is safe when its bound
+  /// P_i < 1 - delta_CL (METHOD 4).
+  double delta_cl = 0.95;
+  /// The dynamic cost starts at dynamic_activation * (1 - delta_CL) (in (0, 1]),
+  /// a margin below the threshold so that the optimiser keeps away from it.
+  double dynamic_activation = 0.5;
+  /// Number of parallel optimisers N (>= 1) and worker threads (0 = N,
+  /// capped at N). The result does not depend on the thread count.
+  int num_optimizers = 8;
+  int num_threads = 0;
+  /// Seed of optimiser o's generator: derived from (seed, o) only.
+  std::uint64_t seed = 1;
+  /// Gradient iterations per optimiser and attempt (>= 1).
+  int max_iterations = 60;
+  /// An optimiser stops early when feasible and the relative cost decrease of
+  /// an iteration is below this (>= 0).
+  double convergence_tolerance = 1e-4;
+  /// Step size of the covariant update x -= step * H^-1 grad, in (0, 1].
+  double step_size = 0.5;
+  /// Std-dev (rad) of the random via-point offset of optimisers 1..N-1.
+  double initial_perturbation = 0.5;
+  /// Static clearance: hinge margin of the obstacle cost (m, >= 0) and the
+  /// clearance a feasible trajectory must keep (m) at collision_check_substeps
+  /// linearly interpolated points per interval (>= 1).
+  double obstacle_margin = 0.05;
+  double min_clearance = 0.0;
+  int collision_check_substeps = 10;
+  /// Pairs (robot link, scene object) never checked, e.g. the base on the table.
+  std::vector<std::pair<std::string, std::string>> allowed_collisions = {
+      {"panda_link0", "table"}, {"panda_link1", "table"}};
+  /// Waits: duration of one inserted wait (s, multiple of dt after rounding,
+  /// >= dt) and the maximum number of waits before giving up (>= 0).
+  double wait_duration = 0.5;
+  int max_waits = 6;
+  /// Joint limits are shrunk by this margin (rad) for the optimiser (>= 0).
+  double position_margin = 1e-3;
+  /// Velocity/acceleration limits are scaled by this factor in (0, 1] for the
+  /// optimiser's penalty (the feasibility check uses the full limits).
+  double limit_scale = 0.9;
+  /// End effector for pose goals: link name and offset p_LE (m) in that link.
+  std::string end_effector_link = "panda_link8";
+  std::array<double, 3> end_effector_offset = {0.0, 0.0, 0.0};
+  /// Inverse kinematics (damped least squares): iterations, damping (m), and
+  /// tolerances on position (m) and orientation (rad); restarts from random
+  /// seeds (>= 0).
+  int ik_max_iterations = 200;
+  double ik_damping = 0.05;
+  double ik_position_tolerance = 1e-4;
+  double ik_orientation_tolerance = 1e-3;
+  int ik_restarts = 8;
+  CostWeights weights;
+
+  /// Empty string when valid, else the reason naming the field and value.
+  std::string Validate() const;
+};
+
+/// Loads PlannerParams from YAML; keys are the field names above, weights under
+/// `weights:`, allowed_collisions as a list of [link, object] pairs. Missing
+/// keys keep their defaults; unknown or mistyped keys are errors.
+/// @throws std::runtime_error naming the file, key and value (also when the
+///         result fails Validate()). Thread-safe; allocates.
+PlannerParams LoadPlannerParams(const std::string& path);
+
+}  // namespace iplan::planning

@@ -1,0 +1,73 @@
+#include <cstdio>
+#include <fstream>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "iplan/planning/planner_params.h"
+
+namespace iplan::planning {
+namespace {
+
+std::string Write(const std::string& name, const std::string& text) {
+  const std::string path = ::testing::TempDir() + name;
+  std::ofstream(path) << text;
+  return path;
+}
+
+TEST(PlannerParams, DefaultsAreValid) {
+  PlannerParams p;
+  EXPECT_EQ(p.Validate(), "");
+  EXPECT_EQ(p.num_optimizers, 8);
+  EXPECT_DOUBLE_EQ(p.horizon, 3.0);
+  EXPECT_DOUBLE_EQ(p.delta_cl, 0.95);
+}
+
+TEST(PlannerParams, ValidateNamesTheField) {
+  PlannerParams p;
+  p.delta_cl = 1.5;
+  EXPECT_NE(p.Validate().find("delta_cl"), std::string::npos);
+  p = PlannerParams{};
+  p.dt = -0.1;
+  EXPECT_NE(p.Validate().find("dt must be > 0, got -0.1"), std::string::npos);
+  p = PlannerParams{};
+  p.weights.obstacle = -1;
+  EXPECT_NE(p.Validate().find("weights.obstacle"), std::string::npos);
+}
+
+TEST(PlannerParams, LoadsTheRepositoryConfig) {
+  const PlannerParams p = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml");
+  EXPECT_EQ(p.Validate(), "");
+  EXPECT_EQ(p.num_optimizers, 8);
+}
+
+TEST(PlannerParams, LoadsValuesAndRejectsUnknownKeys) {
+  const auto good = Write("good.yaml", "dt: 0.05\nnum_optimizers: 4\nweights: {goal: 2.0}\n"
+                                       "allowed_collisions: [[panda_link0, table]]\n");
+  const PlannerParams p = LoadPlannerParams(good);
+  EXPECT_DOUBLE_EQ(p.dt, 0.05);
+  EXPECT_EQ(p.num_optimizers, 4);
+  EXPECT_DOUBLE_EQ(p.weights.goal, 2.0);
+  ASSERT_EQ(p.allowed_collisions.size(), 1u);
+  try {
+    LoadPlannerParams(Write("bad.yaml", "dtt: 0.05\n"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'dtt'"), std::string::npos) << e.what();
+  }
+  try {
+    LoadPlannerParams(Write("bad2.yaml", "num_optimizers: many\n"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("num_optimizers"), std::string::npos) << e.what();
+  }
+  try {
+    LoadPlannerParams(Write("bad3.yaml", "horizon: 0.01\n"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("horizon"), std::string::npos) << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace iplan::planning

@@ -1,0 +1,267 @@
+#include <cmath>
+#include <limits>
+#include <string>
+
+#include <gtest/gtest.h>
+
+#include "iplan/collision/human_model.h"
+#include "iplan/planning/planner.h"
+#include "test_util.h"
+
+namespace iplan::planning {
+namespace {
+
+using testing::DownOrientation;
+
+Eigen::VectorXd Ready() {
+  Eigen::VectorXd q(7);
+  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+  return q;
+}
+
+class PlannerTest : public ::testing::Test {
+ protected:
+  PlannerTest()
+      : robot_(testing::LoadPanda()),
+        scene_params_(testing::LoadCell()),
+        planner_(robot_, scene_params_, PlannerParams{}),
+        scene_(scene_params_),
+        body_(collision::HumanBodyParams::DefaultUpperBody()) {}
+
+  // Independent check with FCL of the static clearance at 10x the waypoint
+  // resolution (linear interpolation), allowed pairs excluded.
+  double FclClearance(const Eigen::MatrixXd& Q) const {
+    collision::RobotData d(robot_);
+    double best = std::numeric_limits<double>::infinity();
+    for (int i = 0; i < Q.cols(); ++i) {
+      for (int s = 0; s < (i + 1 < Q.cols() ? 10 : 1); ++s) {
+        const Eigen::VectorXd q =
+            i + 1 < Q.cols() ? Eigen::VectorXd(Q.col(i) + 0.1 * s * (Q.col(i + 1) - Q.col(i)))
+                             : Eigen::VectorXd(Q.col(i));
+        collision::CalcForwardKinematics(robot_, q, &d);
+        for (int o = 0; o < scene_.num_objects(); ++o)
+          for (int sp : planner_.CheckedSpheres(o))
+            best = std::min(best, scene_.CalcSignedDistance(o, d.p_WS.col(sp), robot_.spheres[sp].radius));
+      }
+    }
+    return best;
+  }
+
+  void ExpectValid(const PlanningResult& r, const Eigen::VectorXd& start) const {
+    ASSERT_TRUE(r.success) << r.reason;
+    ASSERT_EQ(r.positions.rows(), 7);
+    EXPECT_EQ(r.positions.col(0), start);  // start state kept exactly
+    EXPECT_EQ(CheckLimits(robot_, r.positions, r.dt, Eigen::VectorXd()), "");
+    EXPECT_GE(FclClearance(r.positions), -1e-9);
+    EXPECT_EQ(r.positions.col(r.positions.cols() - 1), r.goal_q);
+  }
+
+  collision::RobotModel robot_;
+  collision::SceneParams scene_params_;
+  Planner planner_;
+  collision::StaticScene scene_;
+  collision::HumanBodyModel body_;
+};
+
+TEST_F(PlannerTest, JointGoalIsValid) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  Eigen::VectorXd goal(7);
+  goal << 1.2, 0.3, 0.0, -1.7, 0.0, 2.0, 0.8;
+  req.goal = Goal::Joint(goal);
+  const PlanningResult r = planner_.Plan(req);
+  ExpectValid(r, req.start_q);
+  EXPECT_EQ(r.positions.cols(), 31);
+  EXPECT_EQ(r.num_waits, 0);
+  EXPECT_DOUBLE_EQ(r.delay, 0.0);
+}
+
+TEST_F(PlannerTest, PoseGoalsBetweenTableTopPosesAreValid) {
+  const auto poses = testing::TableTopPoses();
+  int successes = 0;
+  for (std::size_t a = 0; a < poses.size(); a += 3) {
+    const IkResult start_ik = planner_.SolveIk(poses[a].p, DownOrientation(0.0), Ready(), 1);
+    ASSERT_TRUE(start_ik.success) << poses[a].name;
+    for (std::size_t b = 0; b < poses.size(); b += 2) {
+      if (a == b) continue;
+      PlanningRequest req;
+      req.start_q = start_ik.q;
+      req.goal = Goal::Pose(poses[b].p, DownOrientation(0.0));
+      const PlanningResult r = planner_.Plan(req);
+      SCOPED_TRACE(std::string(poses[a].name) + " -> " + poses[b].name);
+      ExpectValid(r, req.start_q);
+      successes += r.success;
+      // The goal configuration reaches the pose.
+      collision::RobotData d(robot_);
+      collision::CalcForwardKinematics(robot_, r.goal_q, &d);
+      EXPECT_LT((d.X_WL[robot_.FindLink("panda_link8")].translation() - poses[b].p).norm(), 1e-3);
+    }
+  }
+  EXPECT_GT(successes, 0);
+}
+
+TEST_F(PlannerTest, PersonAcrossThePathIsAvoidedOrWaitedFor) {
+  // Start on the right of the table, goal on the left; the person's hand
+  // reaches to the middle of the straight-line path and stays there.
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  // Without the person, the straight path crosses the hand's region.
+  const PlanningResult free_r = planner_.Plan(req);
+  ASSERT_TRUE(free_r.success);
+  req.prediction = &pred;
+  req.prediction_dt = 0.1;
+  const PlanningResult r = planner_.Plan(req);
+  const double thr = 1.0 - planner_.params().delta_cl;
+  if (r.success) {
+    ExpectValid(r, req.start_q);
+    ASSERT_EQ(static_cast<int>(r.bounds.size()), r.positions.cols());
+    for (std::size_t i = 0; i < r.bounds.size(); ++i) EXPECT_LT(r.bounds[i], thr) << "waypoint " << i;
+    EXPECT_LT(r.max_bound, thr);
+    EXPECT_NEAR(r.delay, r.num_waits * planner_.params().wait_duration, 1e-12);
+    EXPECT_EQ(r.positions.cols(), 31 + r.num_waits * 5);
+  } else {
+    EXPECT_EQ(r.status, PlanStatus::kNoSafeTrajectory) << r.reason;
+    EXPECT_EQ(r.num_waits, planner_.params().max_waits);
+    EXPECT_GT(r.delay, 0.0);
+  }
+}
+
+TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  // The hand rests on the goal pose for the whole prediction.
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.45, 0.15, 0.30}}, 15, 0.03, 0.03);
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.prediction = &pred;
+  const PlanningResult r = planner_.Plan(req);
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(r.status, PlanStatus::kNoSafeTrajectory) << r.reason;
+  EXPECT_EQ(r.num_waits, planner_.params().max_waits);
+  EXPECT_NEAR(r.delay, r.num_waits * 0.5, 1e-12);
+  EXPECT_GE(r.max_bound, 1.0 - planner_.params().delta_cl);
+}
+
+TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
+  req.prediction = &pred;
+  const PlanningResult a = planner_.Plan(req, 6, 1, 42);
+  const PlanningResult b = planner_.Plan(req, 6, 3, 42);
+  const PlanningResult c = planner_.Plan(req, 6, 6, 42);
+  ASSERT_EQ(a.positions.cols(), b.positions.cols());
+  ASSERT_EQ(a.positions.cols(), c.positions.cols());
+  EXPECT_TRUE(a.positions == b.positions);
+  EXPECT_TRUE(a.positions == c.positions);
+  EXPECT_EQ(a.cost, b.cost);
+  EXPECT_EQ(a.winning_optimizer, c.winning_optimizer);
+  if (a.success) ExpectValid(a, req.start_q);
+  if (b.success) ExpectValid(b, req.start_q);
+  // A different seed perturbs optimisers 1..N-1 differently.
+  const PlanningResult d = planner_.Plan(req, 6, 2, 43);
+  if (d.winning_optimizer != 0 || a.winning_optimizer != 0) {
+    EXPECT_FALSE(a.positions == d.positions);
+  }
+}
+
+TEST_F(PlannerTest, OneAndManyOptimisersAreValid) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.goal = Goal::Pose({0.55, 0.45, 0.48}, DownOrientation(0.0));
+  ExpectValid(planner_.Plan(req, 1, 1, 5), req.start_q);
+  ExpectValid(planner_.Plan(req, 8, 2, 5), req.start_q);
+}
+
+TEST_F(PlannerTest, WarmStartKeepsTheFrozenPrefixAndStartVelocity) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  Eigen::VectorXd goal(7);
+  goal << 0.8, 0.2, 0.0, -1.8, 0.0, 2.0, 0.8;
+  req.goal = Goal::Joint(goal);
+  const PlanningResult first = planner_.Plan(req);
+  ASSERT_TRUE(first.success);
+  // Replanning 0.1 s later: the robot is at waypoint 1, moving.
+  PlanningRequest next;
+  next.warm_start = Planner::ShiftTrajectory(first.positions, first.dt, 0.1);
+  next.start_q = next.warm_start.col(0);
+  next.start_qdot = (first.positions.col(1) - first.positions.col(0)) / first.dt;
+  next.num_frozen = 3;
+  next.goal = req.goal;
+  const PlanningResult r = planner_.Plan(next);
+  ASSERT_TRUE(r.success) << r.reason;
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(r.positions.col(i), first.positions.col(i + 1));
+  EXPECT_EQ(CheckLimits(robot_, r.positions, r.dt, next.start_qdot), "");
+  EXPECT_GE(FclClearance(r.positions), -1e-9);
+}
+
+TEST_F(PlannerTest, UnreachablePoseIsReportedAsIkFailure) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.goal = Goal::Pose({1.5, 0.0, 0.4}, DownOrientation(0.0));
+  const PlanningResult r = planner_.Plan(req);
+  EXPECT_FALSE(r.success);
+  EXPECT_EQ(r.status, PlanStatus::kIkFailed);
+  EXPECT_NE(r.reason.find("no IK solution"), std::string::npos);
+}
+
+TEST_F(PlannerTest, BadInputsThrowWithTheValues) {
+  auto expect_throw = [&](const PlanningRequest& req, const std::string& text) {
+    try {
+      planner_.Plan(req);
+      ADD_FAILURE() << "no exception for " << text;
+    } catch (const std::invalid_argument& e) {
+      EXPECT_NE(std::string(e.what()).find(text), std::string::npos) << e.what();
+    }
+  };
+  PlanningRequest req;
+  req.start_q = Eigen::VectorXd::Zero(6);
+  req.goal = Goal::Joint(Ready());
+  expect_throw(req, "start has 6 joint values, the robot has 7");
+  req.start_q = Ready();
+  Eigen::VectorXd bad = Ready();
+  bad[3] = 0.5;  // joint 4 upper limit is -0.0698
+  req.goal = Goal::Joint(bad);
+  expect_throw(req, "goal joint 3 = 0.5");
+  bad = Ready();
+  bad[2] = std::nan("");
+  req.goal = Goal::Joint(bad);
+  expect_throw(req, "goal is not finite");
+  req.goal = Goal::Joint(Ready());
+  req.start_q[0] = std::numeric_limits<double>::quiet_NaN();
+  expect_throw(req, "start is not finite");
+  req.start_q = Ready();
+  req.goal = Goal::Pose({0.5, 0.0, std::nan("")}, DownOrientation(0.0));
+  expect_throw(req, "goal pose must be finite");
+  req.goal = Goal::Joint(Ready());
+  req.num_frozen = 2;
+  expect_throw(req, "num_frozen = 2 needs a warm_start");
+}
+
+TEST(PlannerConstruction, RejectsBadParamsAndNames) {
+  PlannerParams p;
+  p.end_effector_link = "nope";
+  try {
+    Planner pl(testing::LoadPanda(), testing::LoadCell(), p);
+    FAIL();
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("'nope'"), std::string::npos);
+  }
+  p = PlannerParams{};
+  p.num_optimizers = 0;
+  EXPECT_THROW(Planner(testing::LoadPanda(), testing::LoadCell(), p), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace iplan::planning
