@@ -4,6 +4,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "common/adapters.h"
 #include "core/risk_monitor.h"
 #include "iplan/framework/service.h"
 
@@ -66,10 +67,7 @@ class CollisionRiskService : public framework::Service {
                    std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
-                     for (const auto& p : m.points) {
-                       times.push_back(p.time_from_start.sec + p.time_from_start.nanosec * 1e-9);
-                       pos.push_back(p.positions);
-                     }
+                     services::FromTrajectory(m, &times, &pos);
                      Count(node, "trajectory", monitor_->UpdateTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
                    }));
     node.Subscribe(framework::topics::HumanSkeleton(),
@@ -113,25 +111,7 @@ class CollisionRiskService : public framework::Service {
   }
 
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {
-    PredictionInput in;
-    in.t0_ns = msg::ToNanoseconds(m.header.stamp);
-    in.time_step = m.time_step;
-    in.num_steps = static_cast<int>(m.num_steps);
-    in.joint_names = m.joint_names;
-    for (const auto& a : m.actions) {
-      in.actions.push_back(a.action);
-      in.probabilities.push_back(a.probability);
-      std::vector<Eigen::Vector3d> means;
-      std::vector<Eigen::Matrix3d> covs;
-      means.reserve(a.joints.size());
-      covs.reserve(a.joints.size());
-      for (const auto& g : a.joints) {
-        means.emplace_back(g.mean.x, g.mean.y, g.mean.z);
-        covs.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(g.covariance.data()));
-      }
-      in.means.push_back(std::move(means));
-      in.covariances.push_back(std::move(covs));
-    }
+    const PredictionInput in = services::ToJointMixture(m);
     const auto rejection = monitor_->UpdatePrediction(in);
     Count(node, "prediction", rejection);
     if (!rejection) Publish(node, msg::ToNanoseconds(msg::Now()));

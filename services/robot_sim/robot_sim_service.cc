@@ -5,6 +5,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "common/adapters.h"
 #include "core/robot_simulator.h"
 #include "iplan/framework/service.h"
 
@@ -43,10 +44,7 @@ class RobotSimService : public framework::Service {
                    std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
-                     for (const auto& p : m.points) {
-                       times.push_back(p.time_from_start.sec + p.time_from_start.nanosec * 1e-9);
-                       pos.push_back(p.positions);
-                     }
+                     services::FromTrajectory(m, &times, &pos);
                      if (auto why = sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos)) {
                        if (++rejected_trajectories_ == 1 || rejected_trajectories_ % 100 == 0) {
                          node.log().warn("trajectory refused ({} so far): {}", rejected_trajectories_, *why);

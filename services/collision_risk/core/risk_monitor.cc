@@ -109,36 +109,8 @@ std::optional<std::string> RiskMonitor::UpdateSkeleton(int64_t stamp_ns, const s
 }
 
 std::optional<std::string> RiskMonitor::UpdatePrediction(const PredictionInput& in) {
-  const int A = static_cast<int>(in.actions.size());
-  if (A == 0 || in.num_steps <= 0 || !(in.time_step > 0)) return std::string("empty prediction");
-  if (static_cast<int>(in.probabilities.size()) != A || static_cast<int>(in.means.size()) != A ||
-      static_cast<int>(in.covariances.size()) != A) {
-    return std::string("prediction sizes are inconsistent");
-  }
-  std::vector<int> idx;
-  if (auto e = MapNames(in.joint_names, body_.params().joints, &idx)) return "prediction: " + *e;
-  const std::size_t J = in.joint_names.size();
-  collision::HumanPrediction pred = body_.MakePrediction(A, in.num_steps);
-  Eigen::Matrix3Xd means(3, body_.num_joints());
-  std::vector<Eigen::Matrix3d> covs(static_cast<std::size_t>(body_.num_joints()));
-  for (int a = 0; a < A; ++a) {
-    if (in.means[a].size() != J * static_cast<std::size_t>(in.num_steps) || in.covariances[a].size() != in.means[a].size()) {
-      return "prediction action " + std::to_string(a) + " has the wrong number of Gaussians";
-    }
-    pred.set_action_probability(a, in.probabilities[a]);
-    for (int k = 0; k < in.num_steps; ++k) {
-      for (int j = 0; j < body_.num_joints(); ++j) {
-        const std::size_t src = static_cast<std::size_t>(k) * J + static_cast<std::size_t>(idx[static_cast<std::size_t>(j)]);
-        means.col(j) = in.means[a][src];
-        covs[static_cast<std::size_t>(j)] = in.covariances[a][src];
-      }
-      if (!body_.FillPrediction(means, covs, a, k, &pred)) {
-        return "prediction action " + std::to_string(a) + " step " + std::to_string(k) +
-               ": a sphere covariance is not positive definite";
-      }
-    }
-  }
-  pred.UpdateSummaries();
+  collision::HumanPrediction pred(1, 1, {0.1});
+  if (auto why = collision::BuildSpherePrediction(body_, in, &pred)) return why;
   prediction_ = std::move(pred);
   prediction_meta_ = in;
   prediction_meta_.means.clear();

@@ -27,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "iplan/collision/human_model.h"
+#include "iplan/collision/joint_mixture.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/trajectory_bound.h"
 
@@ -78,18 +79,8 @@ struct RiskReport {
   std::string reason;
 };
 
-/// A Gaussian mixture over actions of future joint positions.
-struct PredictionInput {
-  int64_t t0_ns = 0;       ///< time of the observation it starts from
-  double time_step = 0;    ///< s; step k is at t0 + (k + 1) time_step
-  int num_steps = 0;
-  std::vector<std::string> joint_names;
-  std::vector<std::string> actions;
-  std::vector<double> probabilities;
-  /// [action][step * J + joint]: mean (m) and covariance (m^2).
-  std::vector<std::vector<Eigen::Vector3d>> means;
-  std::vector<std::vector<Eigen::Matrix3d>> covariances;
-};
+/// The predicted person at joint level (see iplan/collision/joint_mixture.h).
+using PredictionInput = collision::JointMixture;
 
 class RiskMonitor {
  public:
