@@ -1,0 +1,194 @@
+#include "replanner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include "iplan/core/stats.h"
+
+namespace iplan::trajopt {
+
+std::string ReplannerParams::Validate() const {
+  if (!(planning_step > 0)) return "planning_step must be > 0";
+  if (frozen_waypoints < 2) return "frozen_waypoints must be >= 2";
+  if (!(goal_tolerance > 0)) return "goal_tolerance must be > 0";
+  if (!(settle_speed > 0)) return "settle_speed must be > 0";
+  if (!(stale_after > 0)) return "stale_after must be > 0";
+  return "";
+}
+
+Replanner::Replanner(const planning::Planner& planner, const collision::HumanBodyModel& body, ReplannerParams params)
+    : planner_(planner), body_(body), params_(params) {
+  if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
+}
+
+std::vector<std::string> Replanner::joint_names() const {
+  std::vector<std::string> names;
+  const auto& m = planner_.robot();
+  for (int j : m.q_joints) names.push_back(m.joints[static_cast<std::size_t>(j)].name);
+  return names;
+}
+
+std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
+                                                       const std::vector<double>& q, const std::vector<double>& qd) {
+  const auto model = joint_names();
+  if (names.size() != q.size()) return std::string("names and positions differ in size");
+  Eigen::VectorXd qq(static_cast<Eigen::Index>(model.size())), vv = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.size()));
+  for (std::size_t m = 0; m < model.size(); ++m) {
+    const auto it = std::find(names.begin(), names.end(), model[m]);
+    if (it == names.end()) return "joint state lacks '" + model[m] + "'";
+    const std::size_t i = static_cast<std::size_t>(it - names.begin());
+    qq[static_cast<Eigen::Index>(m)] = q[i];
+    if (qd.size() == q.size()) vv[static_cast<Eigen::Index>(m)] = qd[i];
+  }
+  q_ = std::make_pair(stamp_ns, qq);
+  qd_ = vv;
+  return std::nullopt;
+}
+
+std::optional<std::string> Replanner::UpdatePrediction(const collision::JointMixture& in) {
+  collision::HumanPrediction p(1, 1, {0.1});
+  if (auto why = collision::BuildSpherePrediction(body_, in, &p)) return why;
+  prediction_ = std::move(p);
+  prediction_meta_ = in;
+  prediction_meta_.means.clear();
+  prediction_meta_.covariances.clear();
+  return std::nullopt;
+}
+
+TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int64_t now_ns) {
+  TaskOutcome o;
+  o.id = task_->spec.id;
+  o.name = task_->spec.name;
+  o.status = status;
+  o.reason = reason;
+  o.duration = (now_ns - task_->start_ns) * 1e-9;
+  o.delay = task_->delay;
+  o.num_waits = task_->waits;
+  const core::Summary s = core::Summarize(task_->planning_times);
+  o.planning_time_p50 = s.p50;
+  o.planning_time_p99 = s.p99;
+  o.max_collision_bound = task_->max_bound;
+  task_.reset();
+  previous_.reset();
+  return o;
+}
+
+std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t now_ns) {
+  std::optional<TaskOutcome> replaced;
+  if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
+  task_ = Active{task, now_ns, std::nullopt, 0, 0, 0, {}};
+  return replaced;
+}
+
+std::optional<TaskOutcome> Replanner::CancelTask(uint32_t id, int64_t now_ns) {
+  if (!task_ || task_->spec.id != id) return std::nullopt;
+  return Finish(TaskStatus::kCancelled, "cancelled by command", now_ns);
+}
+
+CycleResult Replanner::Hold(int64_t now_ns, const Eigen::VectorXd& q, const std::string& status) {
+  CycleResult r;
+  r.publish = true;
+  r.start_ns = now_ns;
+  r.dt = planner_.params().dt;
+  r.positions = q.replicate(1, 2);
+  r.status = status;
+  return r;
+}
+
+CycleResult Replanner::Cycle(int64_t now_ns) {
+  CycleResult r;
+  const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
+  if (!q_ || now_ns - q_->first > stale) {
+    r.status = "waiting for a current robot state";
+    return r;
+  }
+  if (!task_) return Hold(now_ns, q_->second, "idle");
+  Active& t = *task_;
+  const double dt = planner_.params().dt;
+
+  // Arrived?
+  if (t.goal_q && (q_->second - *t.goal_q).cwiseAbs().maxCoeff() < params_.goal_tolerance &&
+      qd_.cwiseAbs().maxCoeff() < params_.settle_speed) {
+    CycleResult done = Hold(now_ns, q_->second, "goal reached");
+    done.outcome = Finish(TaskStatus::kSucceeded, "", now_ns);
+    return done;
+  }
+  if (t.spec.time_limit > 0 && (now_ns - t.start_ns) * 1e-9 > t.spec.time_limit) {
+    CycleResult late = Hold(now_ns, q_->second, "time limit");
+    late.outcome = Finish(TaskStatus::kFailed, "time limit of " + std::to_string(t.spec.time_limit) + " s exceeded", now_ns);
+    return late;
+  }
+
+  planning::PlanningRequest req;
+  int64_t start_ns = now_ns;
+  if (previous_) {
+    // Keep what executes while this cycle plans; replan the rest.
+    const int64_t steps = std::max<int64_t>(0, std::llround((now_ns - previous_->first) * 1e-9 / dt));
+    start_ns = previous_->first + static_cast<int64_t>(std::llround(steps * dt * 1e9));
+    req.warm_start = planning::Planner::ShiftTrajectory(previous_->second, dt, steps * dt);
+    req.start_q = req.warm_start.col(0);
+    req.start_qdot = req.warm_start.cols() > 1 ? Eigen::VectorXd((req.warm_start.col(1) - req.warm_start.col(0)) / dt)
+                                               : Eigen::VectorXd::Zero(req.start_q.size());
+    req.num_frozen = std::min<int>(params_.frozen_waypoints, static_cast<int>(req.warm_start.cols()));
+  } else {
+    req.start_q = q_->second;
+    req.start_qdot = Eigen::VectorXd::Zero(req.start_q.size());
+    req.num_frozen = 1;
+  }
+  req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
+  const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
+  if (predicted) {
+    req.prediction = &*prediction_;
+    req.prediction_dt = prediction_meta_.time_step;
+    // Step 0 of the prediction is at t0 + time_step.
+    req.prediction_start = (prediction_meta_.t0_ns - start_ns) * 1e-9 + prediction_meta_.time_step;
+  }
+
+  planning::PlanningResult res;
+  try {
+    res = planner_.Plan(req);
+  } catch (const std::exception& e) {
+    CycleResult bad = Hold(now_ns, q_->second, "planning refused the request");
+    bad.outcome = Finish(TaskStatus::kFailed, e.what(), now_ns);
+    return bad;
+  }
+  t.planning_times.push_back(res.planning_time);
+  r.planning_time = res.planning_time;
+  if (res.status == planning::PlanStatus::kIkFailed || res.status == planning::PlanStatus::kGoalInCollision) {
+    CycleResult bad = Hold(now_ns, q_->second, "goal unreachable");
+    bad.outcome = Finish(TaskStatus::kFailed, res.reason, now_ns);
+    return bad;
+  }
+  if (!t.goal_q && res.goal_q.size() > 0) t.goal_q = res.goal_q;
+  r.publish = true;
+  r.start_ns = start_ns;
+  r.dt = dt;
+  if (res.success) {
+    r.positions = res.positions;
+    t.max_bound = std::max(t.max_bound, res.max_bound);
+    if (res.num_waits > 0) {
+      // The robot holds for (part of) this step because of an inserted wait.
+      t.delay += std::min(params_.planning_step, res.delay);
+      ++t.waits;
+      r.status = "planned with " + std::to_string(res.num_waits) + " wait(s)";
+    } else {
+      r.status = "planned";
+    }
+  } else {
+    // No safe trajectory even with waits: keep the frozen prefix and hold at
+    // its end; count the step as waiting.
+    const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);
+    const int keep = std::max(1, std::min<int>(req.num_frozen, static_cast<int>(base.cols())));
+    r.positions.resize(base.rows(), keep + 1);
+    r.positions.leftCols(keep) = base.leftCols(keep);
+    r.positions.col(keep) = base.col(keep - 1);
+    t.delay += params_.planning_step;
+    ++t.waits;
+    r.status = "no safe trajectory: holding (" + res.reason + ")";
+  }
+  previous_ = std::make_pair(start_ns, r.positions);
+  return r;
+}
+
+}  // namespace iplan::trajopt

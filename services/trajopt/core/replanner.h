@@ -1,0 +1,115 @@
+// The replanning loop of the trajectory-optimisation service (METHOD 5,
+// interleaved planning and execution), without DDS types.
+//
+// Every planning step m the service calls Cycle(now): the part of the
+// current trajectory that executes while the new plan is computed (the first
+// `frozen_waypoints`) is kept, the rest is re-optimised against the newest
+// prediction from the newest state, warm-started from the previous plan.
+// When no safe trajectory exists the planner inserts waits; the task's delay
+// accumulates and is reported in the outcome, so the task planner learns to
+// avoid tasks that make the robot wait.
+//
+// Units: s, rad; times are ns since the epoch. Not thread-safe (one owner);
+// Cycle() blocks for the planning time.
+#pragma once
+
+#include <cstdint>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/collision/joint_mixture.h"
+#include "iplan/planning/planner.h"
+
+namespace iplan::trajopt {
+
+struct ReplannerParams {
+  double planning_step = 0.1;   ///< s, m: one cycle per step
+  int frozen_waypoints = 3;     ///< executing prefix kept each cycle (>= 2)
+  double goal_tolerance = 0.01; ///< rad, max joint error to count as arrived
+  double settle_speed = 0.05;   ///< rad/s, max joint speed to count as arrived
+  double stale_after = 0.5;     ///< s; older robot states / predictions are not used
+  std::string Validate() const;
+};
+
+enum class TaskStatus { kSucceeded = 0, kFailed = 1, kCancelled = 2 };
+
+struct TaskSpec {
+  uint32_t id = 0;
+  std::string name;
+  planning::Goal goal;
+  double time_limit = 0;  ///< s; 0: none
+};
+
+struct TaskOutcome {
+  uint32_t id = 0;
+  std::string name;
+  TaskStatus status = TaskStatus::kFailed;
+  std::string reason;
+  double duration = 0;       ///< s, command to arrival (or to the end)
+  double delay = 0;          ///< s the robot was held by inserted waits (planning_step per waiting cycle)
+  uint32_t num_waits = 0;    ///< cycles whose plan had to insert a wait
+  double planning_time_p50 = 0, planning_time_p99 = 0;  ///< s per cycle
+  double max_collision_bound = 0;
+};
+
+struct CycleResult {
+  bool publish = false;              ///< a trajectory to publish
+  int64_t start_ns = 0;              ///< time of waypoint 0
+  double dt = 0;
+  Eigen::MatrixXd positions;         ///< nq x (n + 1)
+  double planning_time = 0;          ///< s, 0 when nothing was planned
+  std::optional<TaskOutcome> outcome;
+  std::string status;                ///< what happened, for logs/diagnostics
+};
+
+class Replanner {
+ public:
+  /// `planner` must outlive this object. Throws std::invalid_argument on bad params.
+  Replanner(const planning::Planner& planner, const collision::HumanBodyModel& body, ReplannerParams params);
+
+  /// A new task replaces the current one, whose outcome (CANCELLED) is returned.
+  std::optional<TaskOutcome> StartTask(const TaskSpec& task, int64_t now_ns);
+  /// Cancels the current task if it has this id.
+  std::optional<TaskOutcome> CancelTask(uint32_t id, int64_t now_ns);
+  bool busy() const { return task_.has_value(); }
+
+  /// Newest robot state (model joint order). Returns why it was refused.
+  std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
+                                              const std::vector<double>& q, const std::vector<double>& qd);
+  /// Newest prediction. Returns why it was refused.
+  std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction);
+
+  /// One planning step at `now_ns`.
+  CycleResult Cycle(int64_t now_ns);
+
+  std::vector<std::string> joint_names() const;
+
+ private:
+  TaskOutcome Finish(TaskStatus status, const std::string& reason, int64_t now_ns);
+  CycleResult Hold(int64_t now_ns, const Eigen::VectorXd& q, const std::string& status);
+
+  const planning::Planner& planner_;
+  const collision::HumanBodyModel& body_;
+  ReplannerParams params_;
+  std::optional<std::pair<int64_t, Eigen::VectorXd>> q_;
+  Eigen::VectorXd qd_;
+  std::optional<collision::HumanPrediction> prediction_;
+  collision::JointMixture prediction_meta_;
+  struct Active {
+    TaskSpec spec;
+    int64_t start_ns = 0;
+    std::optional<Eigen::VectorXd> goal_q;
+    double delay = 0;
+    uint32_t waits = 0;
+    double max_bound = 0;
+    std::vector<double> planning_times;
+  };
+  std::optional<Active> task_;
+  // Previous plan (the trajectory being executed).
+  std::optional<std::pair<int64_t, Eigen::MatrixXd>> previous_;
+};
+
+}  // namespace iplan::trajopt

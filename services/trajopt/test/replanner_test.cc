@@ -1,0 +1,168 @@
+// The replanning loop with an ideal robot that follows every published plan:
+// tasks finish, consecutive plans join without jumps, a person standing on
+// the goal makes the robot wait (reported as delay), and unreachable goals
+// and cancellations end the task with the right outcome.
+#include "core/replanner.h"
+
+#include <gtest/gtest.h>
+
+#include "iplan/planning/planner_params.h"
+
+namespace iplan::trajopt {
+namespace {
+
+constexpr int64_t kSec = 1000000000;
+const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config/";
+
+class ReplannerTest : public ::testing::Test {
+ protected:
+  ReplannerTest()
+      : planner_(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                 collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
+                 planning::LoadPlannerParams(kConfig + "planner.yaml")),
+        body_(collision::HumanBodyParams::DefaultUpperBody()),
+        replanner_(planner_, body_, ReplannerParams{}) {}
+
+  static Eigen::VectorXd Ready() {
+    Eigen::VectorXd q(7);
+    q << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
+    return q;
+  }
+  static Eigen::VectorXd Goal() {
+    Eigen::VectorXd q(7);
+    q << 0.6, -0.2, 0.0, -2.0, 0.0, 1.9, 0.8;
+    return q;
+  }
+  // Position of a published plan at time t (linear interpolation).
+  static Eigen::VectorXd At(const CycleResult& c, int64_t t) {
+    const double s = std::max(0.0, (t - c.start_ns) * 1e-9 / c.dt);
+    const int i = std::min(static_cast<int>(s), static_cast<int>(c.positions.cols()) - 1);
+    const int j = std::min(i + 1, static_cast<int>(c.positions.cols()) - 1);
+    const double u = std::min(1.0, s - i);
+    return (1 - u) * c.positions.col(i) + u * c.positions.col(j);
+  }
+  void SetState(int64_t t, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+    ASSERT_EQ(replanner_.UpdateRobotState(t, replanner_.joint_names(),
+                                          std::vector<double>(q.data(), q.data() + q.size()),
+                                          std::vector<double>(qd.data(), qd.data() + qd.size())),
+              std::nullopt);
+  }
+  // A person whose right hand is at `hand` (m, world), standing behind it.
+  collision::JointMixture PersonAt(int64_t t0, const Eigen::Vector3d& hand) {
+    collision::JointMixture m;
+    m.t0_ns = t0;
+    m.time_step = 0.1;
+    m.num_steps = 10;
+    m.joint_names = body_.params().joints;
+    m.actions = {"stand"};
+    m.probabilities = {1.0};
+    m.means.resize(1);
+    m.covariances.resize(1);
+    const Eigen::Vector3d torso = hand + Eigen::Vector3d(0.35, 0.1, 0.1);
+    const std::vector<Eigen::Vector3d> joints = {
+        torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.3), torso,
+        torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0), torso + Eigen::Vector3d(-0.2, -0.2, -0.05),
+        torso + Eigen::Vector3d(0, 0.18, 0.25), hand + Eigen::Vector3d(0.15, 0, 0.05), hand};
+    for (int k = 0; k < m.num_steps; ++k) {
+      for (const auto& j : joints) {
+        m.means[0].push_back(j);
+        m.covariances[0].push_back(0.03 * 0.03 * Eigen::Matrix3d::Identity());
+      }
+    }
+    return m;
+  }
+  // Runs cycles every 0.1 s with an ideal robot until an outcome or `max_cycles`.
+  std::optional<TaskOutcome> Run(int64_t* t, int max_cycles, const std::function<void(int64_t)>& each = nullptr) {
+    std::optional<CycleResult> last;
+    for (int k = 0; k < max_cycles; ++k) {
+      if (each) each(*t);
+      CycleResult c = replanner_.Cycle(*t);
+      if (c.outcome) return c.outcome;
+      if (c.publish) {
+        if (last && last->positions.cols() > 1) {
+          // The new plan starts where the executing one is at that time.
+          EXPECT_LT((At(*last, c.start_ns) - c.positions.col(0)).cwiseAbs().maxCoeff(), 1e-6) << "cycle " << k;
+        }
+        last = c;
+      }
+      const int64_t next = *t + kSec / 10;
+      const Eigen::VectorXd q = last ? At(*last, next) : Ready();
+      const Eigen::VectorXd q2 = last ? At(*last, next + kSec / 100) : Ready();
+      SetState(next, q, (q2 - q) / 0.01);
+      *t = next;
+    }
+    return std::nullopt;
+  }
+
+  planning::Planner planner_;
+  collision::HumanBodyModel body_;
+  Replanner replanner_;
+};
+
+TEST_F(ReplannerTest, IdleHoldsTheCurrentPose) {
+  SetState(kSec, Ready(), Eigen::VectorXd::Zero(7));
+  const CycleResult c = replanner_.Cycle(kSec);
+  ASSERT_TRUE(c.publish);
+  EXPECT_EQ(c.status, "idle");
+  EXPECT_EQ(c.positions.col(0), Ready());
+  EXPECT_EQ(c.positions.col(1), Ready());
+  EXPECT_FALSE(replanner_.Cycle(10 * kSec).publish);  // the state went stale
+}
+
+TEST_F(ReplannerTest, ReachesAJointGoalWithoutDelay) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  EXPECT_EQ(replanner_.StartTask({7, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  const auto o = Run(&t, 80);
+  ASSERT_TRUE(o.has_value()) << "no outcome in 8 s";
+  EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
+  EXPECT_EQ(o->id, 7u);
+  EXPECT_EQ(o->delay, 0.0);
+  EXPECT_EQ(o->num_waits, 0u);
+  EXPECT_GT(o->duration, 0.5);
+  EXPECT_GT(o->planning_time_p50, 0.0);
+  EXPECT_FALSE(replanner_.busy());
+}
+
+TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  collision::RobotData data(planner_.robot());
+  collision::CalcForwardKinematics(planner_.robot(), Goal(), &data);
+  const Eigen::Vector3d goal_hand = data.X_WL.back().translation();
+  const int64_t leaves = t + 25 * kSec / 10;
+  ASSERT_EQ(replanner_.StartTask({8, "reach_blocked", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  const auto o = Run(&t, 150, [&](int64_t now) {
+    const Eigen::Vector3d hand = now < leaves ? goal_hand : Eigen::Vector3d(1.8, 0.8, 1.0);
+    ASSERT_EQ(replanner_.UpdatePrediction(PersonAt(now, hand)), std::nullopt);
+  });
+  ASSERT_TRUE(o.has_value()) << "no outcome in 15 s";
+  EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
+  EXPECT_GT(o->num_waits, 0u);
+  EXPECT_GT(o->delay, 0.0);
+  EXPECT_GT(o->duration, 2.5);  // it could not arrive before the person left
+  EXPECT_LT(o->max_collision_bound, 0.05);
+}
+
+TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  ASSERT_EQ(replanner_.StartTask({9, "too_far", planning::Goal::Pose({3.0, 0, 0.5}, Eigen::Quaterniond::Identity()), 0}, t),
+            std::nullopt);
+  const auto o = Run(&t, 5);
+  ASSERT_TRUE(o.has_value());
+  EXPECT_EQ(o->status, TaskStatus::kFailed);
+  EXPECT_FALSE(o->reason.empty());
+  ASSERT_EQ(replanner_.StartTask({10, "a", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  const auto replaced = replanner_.StartTask({11, "b", planning::Goal::Joint(Ready()), 0}, t);
+  ASSERT_TRUE(replaced.has_value());
+  EXPECT_EQ(replaced->id, 10u);
+  EXPECT_EQ(replaced->status, TaskStatus::kCancelled);
+  EXPECT_EQ(replanner_.CancelTask(99, t), std::nullopt);
+  const auto cancelled = replanner_.CancelTask(11, t);
+  ASSERT_TRUE(cancelled.has_value());
+  EXPECT_EQ(cancelled->status, TaskStatus::kCancelled);
+}
+
+}  // namespace
+}  // namespace iplan::trajopt

@@ -1,0 +1,171 @@
+// iplan-trajopt: the trajectory-optimisation service. Every planning step it
+// replans the robot's trajectory against the newest prediction (ITOMP,
+// common/planning), publishes it, and reports each task's outcome.
+#include <chrono>
+#include <filesystem>
+
+#include "common/adapters.h"
+#include "core/replanner.h"
+#include "iplan/framework/service.h"
+#include "iplan/planning/planner_params.h"
+
+namespace iplan::trajopt {
+namespace {
+
+using framework::ConfigSection;
+using framework::Node;
+using framework::Result;
+
+class TrajoptService : public framework::Service {
+ public:
+  Result OnConfigure(ConfigSection& config, Node& node) override {
+    std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml",
+                scene_file = "scenes/cell.yaml", planner_file = "planner.yaml";
+    config.Read("robot", &robot_file);
+    config.Read("human_body", &body_file);
+    config.Read("scene", &scene_file);
+    config.Read("planner", &planner_file);
+    config.Read("planning_step", &params_.planning_step, framework::InRange(0.01, 2.0));
+    config.Read("frozen_waypoints", &params_.frozen_waypoints, framework::InRange(2, 50));
+    config.Read("goal_tolerance", &params_.goal_tolerance, framework::Positive<double>());
+    config.Read("settle_speed", &params_.settle_speed, framework::Positive<double>());
+    config.Read("stale_after", &params_.stale_after, framework::Positive<double>());
+    const auto base = std::filesystem::path(config.file()).parent_path();
+    auto path = [&](const std::string& f) { return (base / f).lexically_normal().string(); };
+    try {
+      planner_ = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(path(robot_file)),
+                                                     collision::LoadSceneParams(path(scene_file)),
+                                                     planning::LoadPlannerParams(path(planner_file)));
+      body_ = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(path(body_file)));
+      replanner_ = std::make_unique<Replanner>(*planner_, *body_, params_);
+    } catch (const std::exception& e) {
+      return Result::Fail(e.what());
+    }
+    trajectory_writer_ = &node.Advertise(framework::topics::RobotTrajectory());
+    outcome_writer_ = &node.Advertise(framework::topics::TaskOutcome());
+    using SI = const dds::SampleInfo&;
+    node.Subscribe(framework::topics::JointStates(),
+                   std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
+                     Count(node, "joint_states",
+                           replanner_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position, m.velocity));
+                   }));
+    node.Subscribe(framework::topics::HumanPrediction(),
+                   std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
+                     Count(node, "prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
+                   }));
+    node.Subscribe(framework::topics::TaskCommand(),
+                   std::function<void(const msg::TaskCommand& m, SI)>([this, &node](const msg::TaskCommand& m, SI) {
+                     OnCommand(node, m);
+                   }),
+                   framework::SubscribeOptions{false});
+    return Result::Ok();
+  }
+
+  Result OnActivate(Node& node) override {
+    timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(params_.planning_step * 1e9)),
+                           [this, &node] { Step(node); });
+    return Result::Ok();
+  }
+
+  Result OnDeactivate(Node& node) override {
+    node.CancelTimer(timer_);
+    return Result::Ok();
+  }
+
+ private:
+  void Count(Node& node, const std::string& what, const std::optional<std::string>& rejection) {
+    if (!rejection) return;
+    const uint64_t n = ++rejected_[what];
+    node.SetDiagnosticValue("rejected_inputs/" + what, std::to_string(n));
+    if (n == 1 || n % 100 == 0) node.log().warn("{} rejected ({} so far): {}", what, n, *rejection);
+  }
+
+  void OnCommand(Node& node, const msg::TaskCommand& m) {
+    const int64_t now = msg::ToNanoseconds(msg::Now());
+    if (m.command == msg::TaskCommand::CANCEL) {
+      if (auto o = replanner_->CancelTask(m.task_id, now)) Publish(node, *o);
+      return;
+    }
+    TaskSpec t;
+    t.id = m.task_id;
+    t.name = m.task_name;
+    t.time_limit = m.time_limit;
+    if (m.goal_type == msg::TaskCommand::GOAL_JOINTS) {
+      if (static_cast<int>(m.goal_positions.size()) != planner_->robot().nq) {
+        TaskOutcome o;
+        o.id = m.task_id;
+        o.name = m.task_name;
+        o.status = TaskStatus::kFailed;
+        o.reason = "goal has " + std::to_string(m.goal_positions.size()) + " joint positions, the robot " +
+                   std::to_string(planner_->robot().nq);
+        Publish(node, o);
+        return;
+      }
+      t.goal = planning::Goal::Joint(Eigen::Map<const Eigen::VectorXd>(m.goal_positions.data(),
+                                                                       static_cast<Eigen::Index>(m.goal_positions.size())));
+    } else {
+      const auto& p = m.goal_pose;
+      t.goal = planning::Goal::Pose({p.position.x, p.position.y, p.position.z},
+                                    Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
+                                        .normalized());
+    }
+    node.log().info("task {} '{}' started", t.id, t.name);
+    if (auto replaced = replanner_->StartTask(t, now)) Publish(node, *replaced);
+  }
+
+  void Publish(Node& node, const TaskOutcome& o) {
+    msg::TaskOutcome m;
+    m.header.stamp = msg::Now();
+    m.task_id = o.id;
+    m.task_name = o.name;
+    m.status = static_cast<uint8_t>(o.status);
+    m.reason = o.reason;
+    m.duration = o.duration;
+    m.delay = o.delay;
+    m.num_waits = o.num_waits;
+    m.planning_time_p50 = o.planning_time_p50;
+    m.planning_time_p99 = o.planning_time_p99;
+    m.max_collision_bound = o.max_collision_bound;
+    outcome_writer_->Write(m);
+    static const char* kStatus[] = {"SUCCEEDED", "FAILED", "CANCELLED"};
+    node.log().info("task {} '{}' {} after {:.2f} s (delay {:.2f} s, {} waits){}{}", o.id, o.name,
+                    kStatus[static_cast<int>(o.status)], o.duration, o.delay, o.num_waits,
+                    o.reason.empty() ? "" : ": ", o.reason);
+  }
+
+  void Step(Node& node) {
+    const auto t0 = std::chrono::steady_clock::now();
+    const CycleResult r = replanner_->Cycle(msg::ToNanoseconds(msg::Now()));
+    if (r.publish) {
+      trajectory_writer_->Write(services::ToTrajectory(msg::TimeFromNanoseconds(r.start_ns), replanner_->joint_names(),
+                                                       r.positions, r.dt));
+    }
+    if (r.outcome) Publish(node, *r.outcome);
+    if (r.status != last_status_) {
+      node.log().debug("{}", r.status);
+      last_status_ = r.status;
+    }
+    node.SetDiagnosticValue("status", r.status);
+    node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+
+  ReplannerParams params_;
+  std::unique_ptr<planning::Planner> planner_;
+  std::unique_ptr<collision::HumanBodyModel> body_;
+  std::unique_ptr<Replanner> replanner_;
+  dds::Writer<msg::JointTrajectory>* trajectory_writer_ = nullptr;
+  dds::Writer<msg::TaskOutcome>* outcome_writer_ = nullptr;
+  std::map<std::string, uint64_t> rejected_;
+  std::string last_status_;
+  int timer_ = 0;
+};
+
+}  // namespace
+}  // namespace iplan::trajopt
+
+int main(int argc, char** argv) {
+  return iplan::framework::RunService(
+      argc, argv,
+      {"trajopt", "replans the robot trajectory every planning step against the predicted person (ITOMP)"},
+      [] { return std::make_unique<iplan::trajopt::TrajoptService>(); });
+}
