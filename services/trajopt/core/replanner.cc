@@ -57,6 +57,7 @@ std::optional<std::string> Replanner::UpdatePrediction(const collision::JointMix
 }
 
 TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int64_t now_ns) {
+  if (task_->waiting) task_->delay += (now_ns - task_->last_cycle_ns) * 1e-9;
   TaskOutcome o;
   o.id = task_->spec.id;
   o.name = task_->spec.name;
@@ -77,7 +78,10 @@ TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int6
 std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t now_ns) {
   std::optional<TaskOutcome> replaced;
   if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
-  task_ = Active{task, now_ns, std::nullopt, 0, 0, 0, {}};
+  task_ = Active{};
+  task_->spec = task;
+  task_->start_ns = now_ns;
+  task_->last_cycle_ns = now_ns;
   return replaced;
 }
 
@@ -106,6 +110,11 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (!task_) return Hold(now_ns, q_->second, "idle");
   Active& t = *task_;
   const double dt = planner_.params().dt;
+  // The robot waited from the previous cycle until now (cycles can be longer
+  // than the planning step while the planner inserts waits).
+  if (t.waiting) t.delay += (now_ns - t.last_cycle_ns) * 1e-9;
+  t.waiting = false;
+  t.last_cycle_ns = now_ns;
 
   // Arrived?
   if (t.goal_q && (q_->second - *t.goal_q).cwiseAbs().maxCoeff() < params_.goal_tolerance &&
@@ -168,8 +177,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     r.positions = res.positions;
     t.max_bound = std::max(t.max_bound, res.max_bound);
     if (res.num_waits > 0) {
-      // The robot holds for (part of) this step because of an inserted wait.
-      t.delay += std::min(params_.planning_step, res.delay);
+      t.waiting = true;
       ++t.waits;
       r.status = "planned with " + std::to_string(res.num_waits) + " wait(s)";
     } else {
@@ -183,7 +191,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     r.positions.resize(base.rows(), keep + 1);
     r.positions.leftCols(keep) = base.leftCols(keep);
     r.positions.col(keep) = base.col(keep - 1);
-    t.delay += params_.planning_step;
+    t.waiting = true;
     ++t.waits;
     r.status = "no safe trajectory: holding (" + res.reason + ")";
   }

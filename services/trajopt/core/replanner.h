@@ -49,7 +49,7 @@ struct TaskOutcome {
   TaskStatus status = TaskStatus::kFailed;
   std::string reason;
   double duration = 0;       ///< s, command to arrival (or to the end)
-  double delay = 0;          ///< s the robot was held by inserted waits (planning_step per waiting cycle)
+  double delay = 0;          ///< s from each cycle whose plan waited to the next cycle (wall time)
   uint32_t num_waits = 0;    ///< cycles whose plan had to insert a wait
   double planning_time_p50 = 0, planning_time_p99 = 0;  ///< s per cycle
   double max_collision_bound = 0;
@@ -106,6 +106,8 @@ class Replanner {
     uint32_t waits = 0;
     double max_bound = 0;
     std::vector<double> planning_times;
+    bool waiting = false;        // the last cycle's plan made the robot wait
+    int64_t last_cycle_ns = 0;
   };
   std::optional<Active> task_;
   // Previous plan (the trajectory being executed).

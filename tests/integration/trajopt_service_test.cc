@@ -1,0 +1,182 @@
+// iplan-trajopt and iplan-robot-sim as separate processes (Cyclone and Fast
+// DDS); this process sends a task and scripts the person. The service
+// publishes a trajectory every cycle and an outcome at the end; with a person
+// standing on the goal the outcome reports waits and delay, and the simulated
+// robot never touches the person's true body.
+#include <signal.h>
+
+#include <cmath>
+
+#include <Eigen/Core>
+#include <gtest/gtest.h>
+
+#include "iplan/collision/robot_model.h"
+#include "iplan/framework/node.h"
+#include "test_paths.h"
+
+namespace iplan::testing {
+namespace {
+
+using namespace std::chrono_literals;
+using Clock = std::chrono::steady_clock;
+
+const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
+                                          "shoulder_r", "elbow_r", "hand_r"};
+const std::vector<double> kGoal = {0.6, -0.2, 0.0, -2.0, 0.0, 1.9, 0.8};
+
+std::vector<Eigen::Vector3d> PersonWithHandAt(const Eigen::Vector3d& hand) {
+  const Eigen::Vector3d torso = hand + Eigen::Vector3d(0.35, 0.1, 0.1);
+  return {torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.3), torso,
+          torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0), torso + Eigen::Vector3d(-0.2, -0.2, -0.05),
+          torso + Eigen::Vector3d(0, 0.18, 0.25), hand + Eigen::Vector3d(0.15, 0, 0.05), hand};
+}
+
+struct Result {
+  std::optional<msg::TaskOutcome> outcome;
+  int trajectories = 0;
+  double seconds = 0;
+  std::string contacts;
+};
+
+Result RunTask(double block_for_s) {
+  const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10));
+  Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain)});
+  Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain)});
+  dds::ParticipantOptions o;
+  o.vendor = dds::Vendor::kCyclone;
+  o.domain_id = domain;
+  auto p = dds::Participant::Create(o);
+  framework::NodeOptions no;
+  no.diagnostics_period = 0;
+  framework::Node node("test_cell", *p, no);
+  auto& cmd = node.Advertise(framework::topics::TaskCommand());
+  auto& pred = node.Advertise(framework::topics::HumanPrediction());
+  auto& truth = node.Advertise(framework::topics::HumanTruth());
+  Result r;
+  bool started = false;
+  node.Subscribe(framework::topics::RobotTrajectory(),
+                 std::function<void(const msg::JointTrajectory&, const dds::SampleInfo&)>(
+                     [&](const msg::JointTrajectory& t, const dds::SampleInfo&) {
+                       if (started && !r.outcome) ++r.trajectories;
+                       EXPECT_EQ(t.joint_names.size(), 7u);
+                     }));
+  node.Subscribe(framework::topics::TaskOutcome(),
+                 std::function<void(const msg::TaskOutcome&, const dds::SampleInfo&)>(
+                     [&](const msg::TaskOutcome& m, const dds::SampleInfo&) { r.outcome = m; }),
+                 framework::SubscribeOptions{false});
+  node.Subscribe(framework::topics::Diagnostics(),
+                 std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
+                     [&](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
+                       for (const auto& s : a.status) {
+                         if (s.name != "robot_sim") continue;
+                         for (const auto& kv : s.values) {
+                           if (kv.key == "true_contacts") r.contacts = kv.value;
+                         }
+                       }
+                     }));
+  // Both services up: the optimiser reads commands, and a hold trajectory flows.
+  const auto up = Clock::now() + 30s;
+  while (Clock::now() < up && (cmd.MatchedReaders() == 0 || pred.MatchedReaders() == 0 || truth.MatchedReaders() == 0)) {
+    node.SpinOnce(20ms);
+  }
+  for (int i = 0; i < 20; ++i) node.SpinOnce(20ms);
+  EXPECT_GT(cmd.MatchedReaders(), 0) << opt.Stderr();
+
+  auto model = collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
+  collision::RobotData data(model);
+  collision::CalcForwardKinematics(model, Eigen::Map<const Eigen::VectorXd>(kGoal.data(), 7), &data);
+  const Eigen::Vector3d goal_hand = data.X_WL.back().translation();
+
+  msg::TaskCommand c;
+  c.header.stamp = msg::Now();
+  c.task_id = 42;
+  c.task_name = "reach_goal";
+  c.command = msg::TaskCommand::START;
+  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
+  c.goal_positions = kGoal;
+  c.time_limit = 30;
+  const auto start = Clock::now();
+  auto next = start;
+  started = true;
+  cmd.Write(c);
+  while (!r.outcome && Clock::now() - start < 40s) {
+    if (Clock::now() >= next) {
+      const double t = std::chrono::duration<double>(Clock::now() - start).count();
+      const Eigen::Vector3d hand = t < block_for_s ? goal_hand : Eigen::Vector3d(1.8, 0.8, 1.0);
+      const auto joints = PersonWithHandAt(hand);
+      const msg::Time stamp = msg::Now();
+      msg::HumanPrediction m;
+      m.header.stamp = stamp;
+      m.time_step = 0.1;
+      m.num_steps = 10;
+      m.joint_names = kJoints;
+      msg::ActionPrediction a;
+      a.action = "stand";
+      a.probability = 1;
+      for (int k = 0; k < 10; ++k) {
+        for (const auto& j : joints) {
+          msg::JointGaussian g;
+          g.mean = {j.x(), j.y(), j.z()};
+          g.covariance = {9e-4, 0, 0, 0, 9e-4, 0, 0, 0, 9e-4};
+          a.joints.push_back(g);
+        }
+      }
+      m.actions = {a};
+      pred.Write(m);
+      msg::HumanSkeleton s;
+      s.header.stamp = stamp;
+      s.confidence = 1;
+      for (std::size_t j = 0; j < joints.size(); ++j) {
+        msg::HumanJoint h;
+        h.name = kJoints[j];
+        h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
+        h.confidence = 1;
+        s.joints.push_back(h);
+      }
+      truth.Write(s);
+      next += 66ms;
+    }
+    node.SpinOnce(10ms);
+  }
+  r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  const auto diag_end = Clock::now() + 2s;
+  while (Clock::now() < diag_end) node.SpinOnce(20ms);  // the simulator's next diagnostics
+  opt.Signal(SIGTERM);
+  sim.Signal(SIGTERM);
+  EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
+  EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
+  return r;
+}
+
+TEST(TrajoptService, ReachesTheGoalPublishingEveryCycle) {
+  const Result r = RunTask(0.0);
+  ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
+  EXPECT_EQ(r.outcome->status, msg::TaskOutcome::SUCCEEDED) << r.outcome->reason;
+  EXPECT_EQ(r.outcome->task_id, 42u);
+  EXPECT_EQ(r.outcome->num_waits, 0u);
+  EXPECT_EQ(r.outcome->delay, 0.0);
+  // A trajectory every 0.1 s cycle (allow for scheduling on 2 cores).
+  EXPECT_GE(r.trajectories, static_cast<int>(0.7 * r.outcome->duration / 0.1)) << r.outcome->duration;
+  EXPECT_GT(r.outcome->planning_time_p50, 0.0);
+  EXPECT_EQ(r.contacts, "0");
+}
+
+TEST(TrajoptService, PersonOnTheGoalIsReportedAsWaitAndDelayNotContact) {
+  const Result r = RunTask(3.0);
+  ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
+  std::cout << "outcome: status " << int(r.outcome->status) << ", duration " << r.outcome->duration << " s, delay "
+            << r.outcome->delay << " s, waits " << r.outcome->num_waits << ", planning p50/p99 "
+            << r.outcome->planning_time_p50 << "/" << r.outcome->planning_time_p99 << " s, max bound "
+            << r.outcome->max_collision_bound << "\n";
+  EXPECT_EQ(r.outcome->status, msg::TaskOutcome::SUCCEEDED) << r.outcome->reason;
+  EXPECT_GT(r.outcome->num_waits, 0u);
+  // The person stands on the goal for 3 s; unobstructed the task takes about
+  // 1.5 s (first test), so the robot must have waited well over a second.
+  EXPECT_GT(r.outcome->delay, 1.0);
+  EXPECT_GT(r.outcome->duration, 3.0);
+  EXPECT_LT(r.outcome->max_collision_bound, 0.05);
+  EXPECT_EQ(r.contacts, "0");
+}
+
+}  // namespace
+}  // namespace iplan::testing
