@@ -1,0 +1,39 @@
+#!/usr/bin/env bash
+# Installs the build into a temporary prefix and checks the deployment:
+# every systemd unit passes `systemd-analyze verify` without a complaint
+# (it exits 0 on parse warnings, so its output must be empty too), and every
+# installed service accepts its installed configuration (--check-config),
+# except the intent service, which must refuse clearly until a model is trained.
+set -euo pipefail
+build="$1"
+prefix="$(mktemp -d)"
+trap 'rm -rf "$prefix"' EXIT
+cmake --install "$build" --prefix "$prefix" > "$prefix/install.log"
+units="$prefix/lib/systemd/system"
+failures=0
+for unit in "$units"/*.service "$units"/iplan.target; do
+  out="$(SYSTEMD_UNIT_PATH="$units:" systemd-analyze verify "$unit" 2>&1)" || { echo "FAIL verify $unit: $out"; failures=$((failures+1)); continue; }
+  if [ -n "$out" ]; then echo "FAIL verify $unit: $out"; failures=$((failures+1)); else echo "ok   verify $(basename "$unit")"; fi
+done
+grep -q '^Type=notify$' "$units/iplan-trajopt.service" || { echo "FAIL units are not Type=notify"; failures=$((failures+1)); }
+grep -q '^WatchdogSec=' "$units/iplan-trajopt.service" || { echo "FAIL units have no watchdog"; failures=$((failures+1)); }
+# shellcheck disable=SC1091
+set -a; . "$prefix/etc/iplan/iplan.env"; set +a
+for svc in perception collision_risk trajopt robot_sim; do
+  exe="$prefix/bin/iplan-${svc//_/-}"
+  if out="$("$exe" --config "$IPLAN_CONFIG_DIR/$svc.yaml" --check-config 2>&1)"; then
+    echo "ok   $svc accepts its installed configuration"
+  else
+    echo "FAIL $svc refuses its installed configuration: $out"; failures=$((failures+1))
+  fi
+done
+set +e
+out="$("$prefix/bin/iplan-intent" --config "$IPLAN_CONFIG_DIR/intent.yaml" --check-config 2>&1)"; rc=$?
+set -e
+if [ "$rc" -eq 2 ] && grep -q "model" <<<"$out"; then
+  echo "ok   intent refuses to start without a trained model (exit 2, names the model)"
+else
+  echo "FAIL intent without a model: exit $rc: $out"; failures=$((failures+1))
+fi
+echo "$failures failures"
+[ "$failures" -eq 0 ]
