@@ -30,6 +30,7 @@ class TrajoptService : public framework::Service {
     config.Read("goal_tolerance", &params_.goal_tolerance, framework::Positive<double>());
     config.Read("settle_speed", &params_.settle_speed, framework::Positive<double>());
     config.Read("stale_after", &params_.stale_after, framework::Positive<double>());
+    config.Read("max_tracking_error", &params_.max_tracking_error, framework::Positive<double>());
     const auto base = std::filesystem::path(config.file()).parent_path();
     auto path = [&](const std::string& f) { return (base / f).lexically_normal().string(); };
     try {

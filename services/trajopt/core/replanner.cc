@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <stdexcept>
+#include <utility>
 
 #include "iplan/core/stats.h"
 
@@ -14,6 +15,7 @@ std::string ReplannerParams::Validate() const {
   if (!(goal_tolerance > 0)) return "goal_tolerance must be > 0";
   if (!(settle_speed > 0)) return "settle_speed must be > 0";
   if (!(stale_after > 0)) return "stale_after must be > 0";
+  if (!(max_tracking_error > 0)) return "max_tracking_error must be > 0";
   return "";
 }
 
@@ -132,6 +134,17 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   planning::PlanningRequest req;
   int64_t start_ns = now_ns;
   if (previous_) {
+    // Where the executing plan says the robot is at the state's stamp.
+    const auto& [p_start, P] = *previous_;
+    const double s = std::clamp((q_->first - p_start) * 1e-9 / dt, 0.0, static_cast<double>(P.cols() - 1));
+    const int i = static_cast<int>(s), j = std::min(i + 1, static_cast<int>(P.cols()) - 1);
+    const Eigen::VectorXd expected = (1 - (s - i)) * P.col(i) + (s - i) * P.col(j);
+    if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
+      previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
+      r.status = "robot off the plan: replanning from its state; ";
+    }
+  }
+  if (previous_) {
     // Keep what executes while this cycle plans; replan the rest.
     const int64_t steps = std::max<int64_t>(0, std::llround((now_ns - previous_->first) * 1e-9 / dt));
     start_ns = previous_->first + static_cast<int64_t>(std::llround(steps * dt * 1e9));
@@ -173,15 +186,16 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   r.publish = true;
   r.start_ns = start_ns;
   r.dt = dt;
+  const std::string prefix = r.status;
   if (res.success) {
     r.positions = res.positions;
     t.max_bound = std::max(t.max_bound, res.max_bound);
     if (res.num_waits > 0) {
       t.waiting = true;
       ++t.waits;
-      r.status = "planned with " + std::to_string(res.num_waits) + " wait(s)";
+      r.status = prefix + "planned with " + std::to_string(res.num_waits) + " wait(s)";
     } else {
-      r.status = "planned";
+      r.status = prefix + "planned";
     }
   } else {
     // No safe trajectory even with waits: keep the frozen prefix and hold at
@@ -193,7 +207,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     r.positions.col(keep) = base.col(keep - 1);
     t.waiting = true;
     ++t.waits;
-    r.status = "no safe trajectory: holding (" + res.reason + ")";
+    r.status = prefix + "no safe trajectory: holding (" + res.reason + ")";
   }
   previous_ = std::make_pair(start_ns, r.positions);
   return r;

@@ -31,6 +31,10 @@ struct ReplannerParams {
   double goal_tolerance = 0.01; ///< rad, max joint error to count as arrived
   double settle_speed = 0.05;   ///< rad/s, max joint speed to count as arrived
   double stale_after = 0.5;     ///< s; older robot states / predictions are not used
+  /// rad; when the robot is further than this from where the executing plan
+  /// says it should be (e.g. after a protective stop), replan from the
+  /// measured state instead of continuing the plan.
+  double max_tracking_error = 0.05;
   std::string Validate() const;
 };
 

@@ -146,6 +146,24 @@ TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {
   EXPECT_LT(o->max_collision_bound, 0.05);
 }
 
+TEST_F(ReplannerTest, RobotOffThePlanIsReplannedFromItsState) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  ASSERT_EQ(replanner_.StartTask({12, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  CycleResult c = replanner_.Cycle(t);
+  ASSERT_TRUE(c.publish);
+  // The robot was stopped: it stays at Ready while the plan moved on.
+  for (int k = 0; k < 5; ++k) {
+    t += kSec / 10;
+    SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  }
+  c = replanner_.Cycle(t);
+  ASSERT_TRUE(c.publish);
+  EXPECT_EQ(c.status.rfind("robot off the plan", 0), 0u) << c.status;
+  EXPECT_LT((c.positions.col(0) - Ready()).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(c.start_ns, t);
+}
+
 TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
   int64_t t = 100 * kSec;
   SetState(t, Ready(), Eigen::VectorXd::Zero(7));
