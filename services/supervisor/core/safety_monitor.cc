@@ -1,0 +1,42 @@
+#include "safety_monitor.h"
+
+#include <algorithm>
+
+namespace iplan::supervisor {
+
+SafetyMonitor::SafetyMonitor(std::vector<std::string> watched_topics) : topics_(std::move(watched_topics)) {
+  for (const auto& t : topics_) causes_[t] = "never seen";
+}
+
+void SafetyMonitor::OnData(const std::string& topic) {
+  if (causes_.count(topic)) causes_[topic].clear();
+}
+
+void SafetyMonitor::OnDeadlineMissed(const std::string& topic) {
+  if (causes_.count(topic) && causes_[topic].empty()) causes_[topic] = "deadline missed";
+}
+
+void SafetyMonitor::OnLivelinessLost(const std::string& topic, int alive_writers) {
+  if (causes_.count(topic) && alive_writers == 0) causes_[topic] = "publisher gone (liveliness lost)";
+}
+
+void SafetyMonitor::OnRiskVerdict(uint8_t verdict, const std::string& reason) {
+  risk_cause_ = verdict == 2 ? "collision risk: " + reason : "";
+}
+
+SafetyDecision SafetyMonitor::Evaluate(bool* changed) {
+  SafetyDecision d;
+  std::string reason;
+  for (const auto& t : topics_) {
+    const std::string& c = causes_[t];
+    if (!c.empty()) reason += (reason.empty() ? "" : "; ") + t + ": " + c;
+  }
+  if (!risk_cause_.empty()) reason += (reason.empty() ? "" : "; ") + risk_cause_;
+  d.stop = !reason.empty();
+  d.reason = d.stop ? reason : "all inputs healthy";
+  if (changed) *changed = !last_ || last_->stop != d.stop || (d.stop && last_->reason != d.reason);
+  last_ = d;
+  return d;
+}
+
+}  // namespace iplan::supervisor

@@ -1,0 +1,290 @@
+#include "task_planner.h"
+
+#include <algorithm>
+#include <cmath>
+#include <cstring>
+#include <fstream>
+#include <sstream>
+#include <stdexcept>
+
+#include <yaml-cpp/yaml.h>
+
+#include "iplan/core/atomic_file.h"
+
+namespace iplan::supervisor {
+namespace {
+
+constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
+
+uint64_t Fnv(const void* data, std::size_t n, uint64_t h = 1469598103934665603ULL) {
+  const auto* p = static_cast<const unsigned char*>(data);
+  for (std::size_t i = 0; i < n; ++i) {
+    h ^= p[i];
+    h *= 1099511628211ULL;
+  }
+  return h;
+}
+
+template <class T>
+void Put(std::string* out, const T& v) {
+  out->append(reinterpret_cast<const char*>(&v), sizeof(T));
+}
+
+template <class T>
+bool Get(const std::string& in, std::size_t* pos, T* v) {
+  if (*pos + sizeof(T) > in.size()) return false;
+  std::memcpy(v, in.data() + *pos, sizeof(T));
+  *pos += sizeof(T);
+  return true;
+}
+
+}  // namespace
+
+std::string TaskGraph::Validate() const {
+  if (tasks.empty()) return "no robot tasks";
+  if (tasks.size() > 63) return "at most 63 robot tasks";
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    for (std::size_t j = 0; j < i; ++j) {
+      if (tasks[i].name == tasks[j].name) return "task '" + tasks[i].name + "' defined twice";
+    }
+    if (tasks[i].goal.empty()) return "task '" + tasks[i].name + "' has no goal";
+    for (const auto& a : tasks[i].after) {
+      if (std::none_of(tasks.begin(), tasks.end(), [&](const RobotTask& t) { return t.name == a; })) {
+        return "task '" + tasks[i].name + "' comes after unknown task '" + a + "'";
+      }
+    }
+    for (const auto& c : tasks[i].conflicts_with) {
+      if (std::find(human_actions.begin(), human_actions.end(), c) == human_actions.end()) {
+        return "task '" + tasks[i].name + "' conflicts with unknown human action '" + c + "'";
+      }
+    }
+  }
+  // Cycles: repeatedly finish tasks whose predecessors are finished.
+  std::vector<bool> done(tasks.size(), false);
+  for (std::size_t round = 0; round < tasks.size(); ++round) {
+    for (std::size_t i = 0; i < tasks.size(); ++i) {
+      if (done[i]) continue;
+      bool ready = true;
+      for (const auto& a : tasks[i].after) {
+        for (std::size_t j = 0; j < tasks.size(); ++j) {
+          if (tasks[j].name == a && !done[j]) ready = false;
+        }
+      }
+      if (ready) done[i] = true;
+    }
+  }
+  for (std::size_t i = 0; i < tasks.size(); ++i) {
+    if (!done[i]) return "the precedence of task '" + tasks[i].name + "' has a cycle";
+  }
+  return "";
+}
+
+TaskGraph LoadTaskGraph(const std::string& path) {
+  YAML::Node root;
+  try {
+    root = YAML::LoadFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  auto fail = [&](const std::string& key, const std::string& why) {
+    throw std::runtime_error(path + ": key '" + key + "': " + why);
+  };
+  for (auto it = root.begin(); it != root.end(); ++it) {
+    const std::string k = it->first.as<std::string>();
+    if (k != "human_actions" && k != "robot_tasks") fail(k, "unknown key");
+  }
+  TaskGraph g;
+  try {
+    if (root["human_actions"]) g.human_actions = root["human_actions"].as<std::vector<std::string>>();
+    if (!root["robot_tasks"] || !root["robot_tasks"].IsSequence()) fail("robot_tasks", "a list of tasks is required");
+    for (std::size_t i = 0; i < root["robot_tasks"].size(); ++i) {
+      const YAML::Node n = root["robot_tasks"][i];
+      const std::string where = "robot_tasks[" + std::to_string(i) + "]";
+      for (auto it = n.begin(); it != n.end(); ++it) {
+        const std::string k = it->first.as<std::string>();
+        if (k != "name" && k != "goal" && k != "after" && k != "conflicts_with") fail(where + "." + k, "unknown key");
+      }
+      RobotTask t;
+      if (!n["name"]) fail(where + ".name", "is required");
+      t.name = n["name"].as<std::string>();
+      if (!n["goal"]) fail(where + ".goal", "is required");
+      t.goal = n["goal"].as<std::vector<double>>();
+      if (n["after"]) t.after = n["after"].as<std::vector<std::string>>();
+      if (n["conflicts_with"]) t.conflicts_with = n["conflicts_with"].as<std::vector<std::string>>();
+      g.tasks.push_back(std::move(t));
+    }
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": " + e.what());
+  }
+  if (const std::string why = g.Validate(); !why.empty()) throw std::runtime_error(path + ": " + why);
+  return g;
+}
+
+std::string QLearningParams::Validate() const {
+  if (!(alpha > 0 && alpha <= 1)) return "alpha must be in (0, 1]";
+  if (!(gamma >= 0 && gamma < 1)) return "gamma must be in [0, 1)";
+  if (!(epsilon >= 0 && epsilon <= 1)) return "epsilon must be in [0, 1]";
+  if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
+  return "";
+}
+
+TaskPlanner::TaskPlanner(TaskGraph graph, QLearningParams params)
+    : graph_(std::move(graph)), params_(params), rng_(params.seed) {
+  if (const std::string why = graph_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  for (const auto& t : graph_.tasks) {
+    uint64_t mask = 0;
+    for (const auto& a : t.after) {
+      for (std::size_t j = 0; j < graph_.tasks.size(); ++j) {
+        if (graph_.tasks[j].name == a) mask |= 1ULL << j;
+      }
+    }
+    prerequisites_.push_back(mask);
+  }
+}
+
+bool TaskPlanner::episode_done() const { return state_ == (1ULL << graph_.tasks.size()) - 1; }
+
+std::vector<int> TaskPlanner::Available() const {
+  std::vector<int> out;
+  for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
+    const uint64_t bit = 1ULL << i;
+    if (!(state_ & bit) && (state_ & prerequisites_[i]) == prerequisites_[i]) out.push_back(static_cast<int>(i));
+  }
+  return out;
+}
+
+double TaskPlanner::Harmony(int task, const std::map<std::string, double>& belief) const {
+  double conflict = 0;
+  for (const auto& c : graph_.tasks[static_cast<std::size_t>(task)].conflicts_with) {
+    const auto it = belief.find(c);
+    if (it != belief.end()) conflict += it->second;
+  }
+  return 1.0 - std::clamp(conflict, 0.0, 1.0);
+}
+
+std::vector<double>& TaskPlanner::Row(State s) {
+  auto it = q_.find(s);
+  if (it == q_.end()) it = q_.emplace(s, std::vector<double>(graph_.tasks.size(), 0.0)).first;
+  return it->second;
+}
+
+double TaskPlanner::Q(State s, int task) const {
+  const auto it = q_.find(s);
+  return it == q_.end() ? 0.0 : it->second[static_cast<std::size_t>(task)];
+}
+
+int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
+  const std::vector<int> avail = Available();
+  if (avail.empty()) return -1;
+  if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < params_.epsilon) {
+    return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
+  }
+  int best = avail.front();
+  for (int a : avail) {
+    const double qa = Q(state_, a), qb = Q(state_, best);
+    if (qa > qb + 1e-12 || (std::abs(qa - qb) <= 1e-12 && Harmony(a, belief) > Harmony(best, belief))) best = a;
+  }
+  return best;
+}
+
+double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief) {
+  const double reward = Harmony(task, belief) - params_.delay_weight * delay;
+  const State s = state_;
+  const State next = succeeded ? (s | (1ULL << task)) : s;
+  if (params_.learning) {
+    double best_next = 0;
+    bool any = false;
+    for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
+      const uint64_t bit = 1ULL << i;
+      if (!(next & bit) && (next & prerequisites_[i]) == prerequisites_[i]) {
+        const double q = Q(next, static_cast<int>(i));
+        best_next = any ? std::max(best_next, q) : q;
+        any = true;
+      }
+    }
+    double& q = Row(s)[static_cast<std::size_t>(task)];
+    q += params_.alpha * (reward + params_.gamma * best_next - q);
+  }
+  state_ = next;
+  return reward;
+}
+
+uint64_t TaskPlanner::GraphHash() const {
+  uint64_t h = Fnv("graph", 5);
+  for (const auto& t : graph_.tasks) {
+    h = Fnv(t.name.data(), t.name.size(), h);
+    for (const auto& a : t.after) h = Fnv(a.data(), a.size(), h);
+  }
+  return h;
+}
+
+void TaskPlanner::Save(const std::string& path) const {
+  std::string body;
+  Put(&body, GraphHash());
+  Put(&body, static_cast<uint64_t>(graph_.tasks.size()));
+  Put(&body, static_cast<uint64_t>(q_.size()));
+  for (const auto& [s, row] : q_) {
+    Put(&body, s);
+    for (double v : row) Put(&body, v);
+  }
+  std::string file(kMagic, sizeof(kMagic));
+  Put(&file, Fnv(body.data(), body.size()));
+  file += body;
+  // Keep the previous good table: if the new one is ever damaged, the
+  // loader falls back to it.
+  if (std::ifstream(path).good()) core::WriteFileAtomically(path + ".bak", core::ReadFile(path));
+  core::WriteFileAtomically(path, file);
+}
+
+std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
+  std::string data;
+  try {
+    data = core::ReadFile(path);
+  } catch (const std::exception& e) {
+    return std::string(e.what());
+  }
+  if (data.size() < sizeof(kMagic) + 8 || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
+    return path + " is not an iplan Q-table";
+  }
+  std::size_t pos = sizeof(kMagic);
+  uint64_t checksum = 0, hash = 0, ntasks = 0, nrows = 0;
+  Get(data, &pos, &checksum);
+  if (Fnv(data.data() + pos, data.size() - pos) != checksum) return path + " is corrupt (checksum mismatch)";
+  if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows)) return path + " is truncated";
+  if (hash != GraphHash() || ntasks != graph_.tasks.size()) return path + " belongs to another task graph";
+  std::map<State, std::vector<double>> q;
+  for (uint64_t r = 0; r < nrows; ++r) {
+    State s = 0;
+    std::vector<double> row(ntasks);
+    if (!Get(data, &pos, &s)) return path + " is truncated";
+    for (auto& v : row) {
+      if (!Get(data, &pos, &v) || !std::isfinite(v)) return path + " has an invalid value";
+    }
+    q[s] = std::move(row);
+  }
+  if (pos != data.size()) return path + " has trailing bytes";
+  q_ = std::move(q);
+  return std::nullopt;
+}
+
+bool TaskPlanner::Load(const std::string& path, std::string* note) {
+  const bool main_exists = std::ifstream(path).good(), backup_exists = std::ifstream(path + ".bak").good();
+  if (!main_exists && !backup_exists) {
+    if (note) *note = path + " does not exist: starting with an empty Q-table";
+    return false;
+  }
+  const auto main_error = main_exists ? TryLoad(path) : std::optional<std::string>(path + " is missing");
+  if (!main_error) {
+    if (note) *note = "loaded " + path + " (" + std::to_string(q_.size()) + " states)";
+    return true;
+  }
+  const auto backup_error = backup_exists ? TryLoad(path + ".bak") : std::optional<std::string>("no backup");
+  if (!backup_error) {
+    if (note) *note = *main_error + "; refused it and loaded the previous good table " + path + ".bak";
+    return true;
+  }
+  throw std::runtime_error("cannot load the Q-table: " + *main_error + "; backup: " + *backup_error);
+}
+
+}  // namespace iplan::supervisor

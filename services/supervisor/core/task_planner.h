@@ -1,0 +1,98 @@
+// The task planner of METHOD 6: an MDP whose states are the progress of the
+// whole task (a bitmask of finished robot sub-tasks over a precedence graph),
+// whose actions are the robot sub-tasks available in a state, learned with
+// Q-learning. The reward prefers tasks that do not conflict with what the
+// person is predicted to do and penalises the delay a task caused:
+//   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
+// The Q-table is saved atomically and reloaded; a corrupt file is refused
+// with a message and the previous good copy is used. No DDS types. Not
+// thread-safe.
+#pragma once
+
+#include <cstdint>
+#include <map>
+#include <optional>
+#include <random>
+#include <string>
+#include <vector>
+
+namespace iplan::supervisor {
+
+struct RobotTask {
+  std::string name;
+  std::vector<double> goal;               ///< joint goal (rad), robot joint order
+  std::vector<std::string> after;         ///< tasks that must be finished first
+  std::vector<std::string> conflicts_with; ///< human actions this task conflicts with
+};
+
+struct TaskGraph {
+  std::vector<RobotTask> tasks;            ///< at most 63
+  std::vector<std::string> human_actions;
+  /// Empty when consistent (unique names, known predecessors and actions,
+  /// no cycles), else the reason.
+  std::string Validate() const;
+};
+
+/// Loads a task graph from YAML (strict). Throws std::runtime_error naming the file and key.
+TaskGraph LoadTaskGraph(const std::string& path);
+
+struct QLearningParams {
+  double alpha = 0.2;         ///< learning rate
+  double gamma = 0.6;         ///< discount
+  double epsilon = 0.3;       ///< exploration in learning mode
+  double delay_weight = 1.0;  ///< w_d, per second of delay
+  bool learning = true;       ///< false: deployment, greedy, no updates
+  uint64_t seed = 1;
+  std::string Validate() const;
+};
+
+using State = uint64_t;  ///< bit i set: robot task i finished
+
+class TaskPlanner {
+ public:
+  /// Throws std::invalid_argument on an invalid graph or params.
+  TaskPlanner(TaskGraph graph, QLearningParams params);
+
+  const TaskGraph& graph() const { return graph_; }
+  State state() const { return state_; }
+  bool episode_done() const;
+  /// Tasks available in the current state (predecessors done, not done yet).
+  std::vector<int> Available() const;
+  /// h(s, a | belief): 1 - sum_c p(c) conflict(a, c); belief over
+  /// graph().human_actions (missing actions count as 0).
+  double Harmony(int task, const std::map<std::string, double>& belief) const;
+  /// Chooses the next task: epsilon-greedy on Q in learning mode, greedy in
+  /// deployment; ties broken by the harmony with the current belief, then by
+  /// index. -1 when the episode is done.
+  int Choose(const std::map<std::string, double>& belief);
+  /// Q-learning update after `task` ended with `delay` (s); advances the
+  /// state when `succeeded`. Returns the reward.
+  double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief);
+  /// Starts a new episode (state 0).
+  void ResetEpisode() { state_ = 0; }
+
+  double Q(State s, int task) const;
+
+  /// Writes the Q-table atomically to `path`, keeping the previous file as
+  /// `path.bak`. Throws std::runtime_error on I/O errors.
+  void Save(const std::string& path) const;
+  /// Loads `path`; if it is missing returns false (fresh table); if it is
+  /// corrupt or belongs to another task graph, tries `path.bak`. Throws
+  /// std::runtime_error when neither is usable, with both reasons. `*note`
+  /// says what happened (e.g. "qtable.bin is corrupt (...); using the backup").
+  bool Load(const std::string& path, std::string* note);
+
+ private:
+  std::vector<double>& Row(State s);
+  std::optional<std::string> TryLoad(const std::string& path);
+  uint64_t GraphHash() const;
+
+  TaskGraph graph_;
+  QLearningParams params_;
+  std::map<State, std::vector<double>> q_;
+  State state_ = 0;
+  std::vector<uint64_t> prerequisites_;  // bitmask per task
+  std::mt19937_64 rng_;
+};
+
+}  // namespace iplan::supervisor

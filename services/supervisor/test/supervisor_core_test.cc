@@ -1,0 +1,154 @@
+// The task planner (task graph, Q-learning, persistence) and the safety
+// monitor of the supervisor, without DDS.
+#include <unistd.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include <gtest/gtest.h>
+
+#include "core/safety_monitor.h"
+#include "core/task_planner.h"
+
+namespace iplan::supervisor {
+namespace {
+
+TaskGraph Graph() {
+  TaskGraph g;
+  g.human_actions = {"reach_bin", "assemble"};
+  g.tasks = {{"pick_left", {0.1}, {}, {"reach_bin"}},
+             {"pick_right", {0.2}, {}, {}},
+             {"place", {0.3}, {"pick_left", "pick_right"}, {"assemble"}}};
+  return g;
+}
+
+std::string TempPath(const std::string& name) {
+  return (std::filesystem::temp_directory_path() / ("iplan-sup-" + std::to_string(getpid()) + "-" + name)).string();
+}
+
+TEST(TaskGraph, ValidationNamesTheProblem) {
+  TaskGraph g = Graph();
+  EXPECT_EQ(g.Validate(), "");
+  g.tasks[2].after.push_back("fly");
+  EXPECT_EQ(g.Validate(), "task 'place' comes after unknown task 'fly'");
+  g = Graph();
+  g.tasks[0].after = {"place"};
+  EXPECT_EQ(g.Validate(), "the precedence of task 'pick_left' has a cycle");
+  g = Graph();
+  g.tasks[1].conflicts_with = {"dance"};
+  EXPECT_EQ(g.Validate(), "task 'pick_right' conflicts with unknown human action 'dance'");
+}
+
+TEST(TaskPlanner, PrecedenceAndHarmony) {
+  TaskPlanner p(Graph(), QLearningParams{});
+  EXPECT_EQ(p.Available(), (std::vector<int>{0, 1}));
+  EXPECT_DOUBLE_EQ(p.Harmony(0, {{"reach_bin", 0.8}, {"assemble", 0.2}}), 0.2);
+  EXPECT_DOUBLE_EQ(p.Harmony(1, {{"reach_bin", 0.8}}), 1.0);
+  p.Complete(0, true, 0, {});
+  EXPECT_EQ(p.Available(), (std::vector<int>{1}));
+  p.Complete(1, false, 0, {});  // failed: not done
+  EXPECT_EQ(p.Available(), (std::vector<int>{1}));
+  p.Complete(1, true, 0, {});
+  EXPECT_EQ(p.Available(), (std::vector<int>{2}));
+  p.Complete(2, true, 0, {});
+  EXPECT_TRUE(p.episode_done());
+  EXPECT_EQ(p.Choose({}), -1);
+}
+
+TEST(TaskPlanner, LearnsToAvoidTheTaskThatCausesDelay) {
+  QLearningParams params;
+  params.seed = 3;
+  TaskPlanner p(Graph(), params);
+  // pick_left always makes the robot wait 3 s (the person works at the bin).
+  for (int episode = 0; episode < 60; ++episode) {
+    p.ResetEpisode();
+    while (!p.episode_done()) {
+      const int t = p.Choose({});
+      p.Complete(t, true, t == 0 ? 3.0 : 0.0, {});
+    }
+  }
+  EXPECT_LT(p.Q(0, 0), p.Q(0, 1));
+  QLearningParams deploy = params;
+  deploy.learning = false;
+  const std::string path = TempPath("learned.bin");
+  p.Save(path);
+  TaskPlanner d(Graph(), deploy);
+  std::string note;
+  ASSERT_TRUE(d.Load(path, &note)) << note;
+  EXPECT_EQ(d.Choose({}), 1);  // greedy: the task that did not wait first
+  EXPECT_EQ(d.Q(0, 0), p.Q(0, 0));
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, CorruptTableIsRefusedAndThePreviousGoodOneKept) {
+  const std::string path = TempPath("corrupt.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  p.Save(path);                                   // first good table
+  const double q_first = p.Q(0, 1);
+  p.ResetEpisode();
+  p.Complete(1, true, 0.0, {});
+  p.Save(path);                                   // second; the first is now path.bak
+  {
+    std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+    f.seekp(30);
+    f.put('\x7f');                                // damage the newest
+  }
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("is corrupt (checksum mismatch); refused it and loaded the previous good table"), std::string::npos)
+      << note;
+  EXPECT_EQ(q.Q(0, 1), q_first);
+  // Both damaged: a clear error.
+  std::ofstream(path + ".bak") << "garbage";
+  TaskPlanner r(Graph(), QLearningParams{});
+  try {
+    r.Load(path, &note);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("cannot load the Q-table"), std::string::npos) << e.what();
+  }
+  // Another graph's table is refused.
+  TaskGraph other = Graph();
+  other.tasks[1].name = "pick_middle";
+  other.tasks[2].after = {"pick_left", "pick_middle"};
+  TaskPlanner s(other, QLearningParams{});
+  p.Save(path);
+  EXPECT_THROW(s.Load(path, &note), std::runtime_error);
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {
+  SafetyMonitor m({"rt/a", "rt/b"});
+  bool changed = false;
+  SafetyDecision d = m.Evaluate(&changed);
+  EXPECT_TRUE(d.stop);
+  EXPECT_EQ(d.reason, "rt/a: never seen; rt/b: never seen");
+  m.OnData("rt/a");
+  m.OnData("rt/b");
+  d = m.Evaluate(&changed);
+  EXPECT_FALSE(d.stop);
+  EXPECT_TRUE(changed);
+  m.OnDeadlineMissed("rt/b");
+  d = m.Evaluate(&changed);
+  EXPECT_TRUE(d.stop);
+  EXPECT_EQ(d.reason, "rt/b: deadline missed");
+  m.OnLivelinessLost("rt/b", 0);
+  EXPECT_EQ(m.Evaluate(&changed).reason, "rt/b: publisher gone (liveliness lost)");
+  EXPECT_TRUE(changed);
+  m.OnData("rt/b");
+  d = m.Evaluate(&changed);
+  EXPECT_FALSE(d.stop);
+  m.OnRiskVerdict(2, "separation 0.3 m below 0.5 m");
+  EXPECT_EQ(m.Evaluate(&changed).reason, "collision risk: separation 0.3 m below 0.5 m");
+  m.OnRiskVerdict(1, "slow");
+  EXPECT_FALSE(m.Evaluate(&changed).stop);
+  m.Evaluate(&changed);
+  EXPECT_FALSE(changed);
+}
+
+}  // namespace
+}  // namespace iplan::supervisor
