@@ -42,7 +42,11 @@ struct EvalReport {
 };
 
 /// Evaluates `model` on every sequence of `data`. Accuracy: for each track
-/// and fraction f the model sees the first ceil(f n) frames (last T of them).
+/// and fraction f the model sees the first ceil(f n) frames: the windows of
+/// the last T frames ending at every one of them are classified and combined
+/// by a BeliefFilter with model.classifier.belief (one update per model
+/// frame), as the intent service does online; the belief after frame
+/// ceil(f n) is scored.
 /// Forecasts: every window (stride `forecast_stride`) whose true future of
 /// `horizon` frames is recorded. Throws std::invalid_argument when the data
 /// lack a model joint or contain an action the model does not know.
