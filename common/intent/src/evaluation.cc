@@ -79,6 +79,7 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
   // Accuracy: as online, the model's belief filter combines the windows
   // ending at every frame of the observed prefix (one update per model frame).
   BeliefFilter filter(C, model.classifier.belief);
+  Eigen::VectorXd window_p(C);
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
     const int truth = action_id.at(t.action);
@@ -93,7 +94,9 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
       // The observed frames of the window (not padded), as the service has them.
       const int first = std::max(0, e - T + 1);
       const Eigen::MatrixXd window = t.positions.middleRows(first, e - first + 1);
-      filter.UpdateWithWindow(ClassifyWindow(model, window), window, T, e / rate);
+      timed_predict(window);  // as the service: PredictIntent, then the filter
+      for (int c = 0; c < C; ++c) window_p(c) = pred.actions[c].probability;
+      filter.UpdateWithWindow(window_p, window, T, e / rate);
       beliefs[e] = filter.probabilities();
     }
     for (size_t fi = 0; fi < params.fractions.size(); ++fi) {

@@ -36,7 +36,8 @@ struct EvalReport {
   std::vector<double> error_const_velocity;  ///< (D) m, baseline: extrapolate last-frame velocity.
   double coverage95 = 0.0;           ///< Share of true future joints inside the
                                      ///< moment-matched mixture's 95 % ellipsoid.
-  double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame).
+  double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame; accuracy
+                                     ///< and forecast windows).
   double inference_p99_ms = 0.0;
   int num_inference_calls = 0;
 };
