@@ -60,7 +60,7 @@ std::vector<Eigen::Vector3d> ParseObjects(const std::string& text) {
 
 struct TrainOptions {
   std::string data, subjects, out, joints, torso, hands, objects;
-  std::string sigma_factors, lambdas, prefixes;
+  std::string sigma_factors, lambdas, prefixes, belief_taus;
   double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 1.0;
   bool normalise_size = false;
   double ivm_tolerance = 1e-3;
@@ -96,6 +96,7 @@ void RunTrain(const TrainOptions& o) {
   params.max_gap = o.max_gap;
   if (!o.sigma_factors.empty()) params.sigma_factors = ParseDoubles(o.sigma_factors, "--sigma-factors");
   if (!o.lambdas.empty()) params.lambdas = ParseDoubles(o.lambdas, "--lambdas");
+  if (!o.belief_taus.empty()) params.belief_time_constants = ParseDoubles(o.belief_taus, "--belief-taus");
   if (!o.prefixes.empty()) params.prefix_fractions = ParseDoubles(o.prefixes, "--prefixes");
   params.ivm.max_import = o.max_import;
   params.ivm.stop_tolerance = o.ivm_tolerance;
@@ -126,8 +127,18 @@ void RunTrain(const TrainOptions& o) {
     std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
   }
   std::cout << "  chosen sigma " << rep.sigma << " m, lambda " << rep.lambda << ", "
-            << rep.num_import_vectors << " import vectors, " << rep.seconds_classifier
-            << " s\nforecasters (" << params.pseudo_inputs << " pseudo-inputs each): windows per action:";
+            << rep.num_import_vectors << " import vectors, " << rep.seconds_classifier << " s\n";
+  if (!rep.belief_cv_table.empty()) {
+    std::cout << "  belief filter over successive windows, cross-validation (leave one subject out):\n"
+              << "    motion_weighted  tau_s  logloss  accuracy\n";
+    for (const auto& row : rep.belief_cv_table) {
+      std::cout << "    " << (row[0] != 0.0 ? "yes" : "no ") << "  " << row[1] << "  " << row[2]
+                << "  " << row[3] << "\n";
+    }
+  }
+  std::cout << "  chosen belief filter: time constant " << rep.belief_time_constant << " s, "
+            << (rep.belief_motion_weighted ? "motion weighted" : "not motion weighted")
+            << "\nforecasters (" << params.pseudo_inputs << " pseudo-inputs each): windows per action:";
   for (size_t c = 0; c < rep.forecast_windows.size(); ++c) {
     std::cout << " " << rep.forecast_windows[c] << (rep.forecast_padded[c] ? "*" : "");
   }
@@ -190,6 +201,8 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--ivm-tolerance", t.ivm_tolerance, "IVM stopping: relative decrease over 3 additions")->capture_default_str();
   train->add_option("--sigma-factors", t.sigma_factors, "CV kernel widths x median DTW (default 0.5,1,2)");
   train->add_option("--lambdas", t.lambdas, "CV regularisers (default 1e-4,1e-3,1e-2)");
+  train->add_option("--belief-taus", t.belief_taus,
+                    "CV belief-filter time constants, s; inf allowed (default 0,0.25,0.5,1,2,4,inf)");
   train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
   train->add_option("--gp-iterations", t.gp_iterations, "L-BFGS iterations per action")->capture_default_str();
   train->add_option("--max-forecast-windows", t.max_forecast_windows, "Forecaster windows per action")->capture_default_str();

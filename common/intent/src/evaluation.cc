@@ -12,6 +12,8 @@
 #include <Eigen/Cholesky>
 #include <nlohmann/json.hpp>
 
+#include "iplan/intent/belief_filter.h"
+
 namespace iplan::intent {
 namespace {
 
@@ -74,15 +76,35 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
         std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
   };
 
+  // Accuracy: as online, the model's belief filter combines the windows
+  // ending at every frame of the observed prefix (one update per model frame).
+  BeliefFilter filter(C, model.classifier.belief);
+  Eigen::VectorXd window_p(C);
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
     const int truth = action_id.at(t.action);
+    std::vector<int> ends(params.fractions.size());
     for (size_t fi = 0; fi < params.fractions.size(); ++fi) {
-      const int end = std::max(1, static_cast<int>(std::ceil(params.fractions[fi] * n - 1e-9))) - 1;
-      timed_predict(WindowEndingAt(t.positions, end, T));
-      const int guess = pred.MostLikely();
+      ends[fi] = std::max(1, static_cast<int>(std::ceil(params.fractions[fi] * n - 1e-9))) - 1;
+    }
+    const int last = *std::max_element(ends.begin(), ends.end());
+    std::vector<Eigen::VectorXd> beliefs(static_cast<size_t>(last) + 1);
+    filter.Reset();
+    for (int e = 0; e <= last; ++e) {
+      // The observed frames of the window (not padded), as the service has them.
+      const int first = std::max(0, e - T + 1);
+      const Eigen::MatrixXd window = t.positions.middleRows(first, e - first + 1);
+      timed_predict(window);  // as the service: PredictIntent, then the filter
+      for (int c = 0; c < C; ++c) window_p(c) = pred.actions[c].probability;
+      filter.UpdateWithWindow(window_p, window, T, e / rate);
+      beliefs[e] = filter.probabilities();
+    }
+    for (size_t fi = 0; fi < params.fractions.size(); ++fi) {
+      const Eigen::VectorXd& b = beliefs[ends[fi]];
+      Eigen::Index guess = 0;
+      b.maxCoeff(&guess);
       if (guess == truth) r.accuracy[fi] += 1.0;
-      r.mean_true_probability[fi] += pred.actions[truth].probability;
+      r.mean_true_probability[fi] += b(truth);
       if (fi + 1 == params.fractions.size()) r.confusion(truth, guess) += 1;
     }
   }

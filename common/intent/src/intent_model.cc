@@ -109,6 +109,14 @@ std::string TrainParams::Validate() const {
   if (sigma_factors.empty() || lambdas.empty()) return "sigma_factors and lambdas must not be empty";
   for (double s : sigma_factors) if (!(s > 0.0)) return "sigma factor " + std::to_string(s) + " must be > 0";
   for (double l : lambdas) if (!(l > 0.0)) return "lambda " + std::to_string(l) + " must be > 0";
+  if (belief_time_constants.empty()) return "belief_time_constants is empty";
+  if (belief_motion_weighting.empty()) return "belief_motion_weighting is empty";
+  for (double t : belief_time_constants) {
+    if (!(t >= 0.0)) return "belief time constant " + std::to_string(t) + " must be >= 0";
+  }
+  if (!(belief_min_probability > 0.0 && belief_min_probability < 1.0)) {
+    return "belief_min_probability " + std::to_string(belief_min_probability) + " must be in (0, 1)";
+  }
   const std::string ivm_error = ivm.Validate();
   if (!ivm_error.empty() && ivm_error.find("lambda") == std::string::npos) return "ivm: " + ivm_error;
   if (pseudo_inputs < 1) return "pseudo_inputs " + std::to_string(pseudo_inputs) + " must be >= 1";
@@ -256,6 +264,92 @@ IntentModel TrainIntentModel(const SkeletonDataset& data, const IntentModelConfi
   }
   rep.sigma = best_sigma;
   rep.lambda = best_lambda;
+
+  // ---- Belief filter time constant, leave-one-subject-out at (sigma, lambda). ----
+  model.classifier.belief.min_probability = params.belief_min_probability;
+  model.classifier.belief.time_constant = params.belief_time_constants.front();
+  model.classifier.belief.motion_weighted = params.belief_motion_weighting.front();
+  if (num_subjects >= 2 &&
+      params.belief_time_constants.size() * params.belief_motion_weighting.size() > 1) {
+    const Eigen::MatrixXd K = KernelFromDtw(Dm, best_sigma);
+    // Per training track: the held-out fold's probabilities of the windows
+    // ending at every frame (n, C).
+    std::vector<Eigen::MatrixXd> frame_probs(tracks.size());
+    std::vector<Eigen::VectorXd> frame_motion(tracks.size());  // WindowMotion per frame
+    std::vector<double> ws;
+    for (int fold = 0; fold < num_subjects; ++fold) {
+      std::vector<int> tr;
+      for (int i = 0; i < N; ++i) if (cs.subject[i] != fold) tr.push_back(i);
+      if (tr.empty()) continue;
+      Eigen::MatrixXd Ktr(tr.size(), tr.size());
+      std::vector<int> ytr;
+      for (size_t a = 0; a < tr.size(); ++a) {
+        ytr.push_back(cs.labels[tr[a]]);
+        for (size_t b = 0; b < tr.size(); ++b) Ktr(a, b) = K(tr[a], tr[b]);
+      }
+      IvmParams ip = params.ivm;
+      ip.lambda = best_lambda;
+      const IvmModel ivm = FitIvm(Ktr, ytr, C, ip);
+      const Eigen::Index q = ivm.import_index.size();
+      Eigen::VectorXd k(q), p;
+      for (size_t ti = 0; ti < tracks.size(); ++ti) {
+        const Track& t = tracks[ti];
+        if (subject_id.at(t.subject) != fold) continue;
+        const int n = static_cast<int>(t.positions.rows());
+        frame_probs[ti].resize(n, C);
+        frame_motion[ti].resize(n);
+        for (int e = 0; e < n; ++e) {
+          const Eigen::MatrixXd window = WindowEndingAt(t.positions, e, config.window);
+          frame_motion[ti](e) = WindowMotion(window);
+          const Eigen::MatrixXd f = layout.FrameFeatures(window).transpose();
+          for (Eigen::Index s = 0; s < q; ++s) {
+            const double d = DtwDistanceColumns(f, cs.windows[tr[ivm.import_index(s)]],
+                                                config.dtw_band, &ws);
+            k(s) = DtwKernel(d, best_sigma);
+          }
+          ivm.Probabilities(k, &p);
+          frame_probs[ti].row(e) = p.transpose();
+        }
+      }
+    }
+    double best_belief_loss = std::numeric_limits<double>::infinity();
+    for (const bool motion_weighted : params.belief_motion_weighting)
+    for (double tau : params.belief_time_constants) {
+      BeliefFilter filter(C, BeliefFilterParams{tau, params.belief_min_probability, motion_weighted});
+      double loss = 0.0;
+      int correct = 0, count = 0;
+      for (size_t ti = 0; ti < tracks.size(); ++ti) {
+        const Eigen::MatrixXd& P = frame_probs[ti];
+        if (P.rows() == 0) continue;
+        const int n = static_cast<int>(P.rows());
+        const int truth = action_id.at(tracks[ti].action);
+        std::set<int> ends;
+        for (double f : params.prefix_fractions) {
+          ends.insert(std::max(1, static_cast<int>(std::ceil(f * n - 1e-9))) - 1);
+        }
+        filter.Reset();
+        for (int e = 0; e <= *ends.rbegin(); ++e) {
+          if (e + 1 < config.window) filter.Reset();  // partial window: see BeliefFilter
+          filter.Update(P.row(e).transpose(), e / config.rate,
+                        motion_weighted ? std::max(frame_motion[ti](e), 1e-6) : 1.0);
+          if (ends.count(e) == 0) continue;
+          loss -= std::log(std::max(filter.probabilities()(truth), 1e-12));
+          if (filter.MostLikely() == truth) ++correct;
+          ++count;
+        }
+      }
+      loss /= std::max(1, count);
+      rep.belief_cv_table.push_back({motion_weighted ? 1.0 : 0.0, tau, loss,
+                                     static_cast<double>(correct) / std::max(1, count)});
+      if (loss < best_belief_loss) {
+        best_belief_loss = loss;
+        model.classifier.belief.time_constant = tau;
+        model.classifier.belief.motion_weighted = motion_weighted;
+      }
+    }
+  }
+  rep.belief_time_constant = model.classifier.belief.time_constant;
+  rep.belief_motion_weighted = model.classifier.belief.motion_weighted;
   rep.num_import_vectors = static_cast<int>(model.classifier.import_windows.size());
   rep.seconds_classifier = Seconds(t0);
 

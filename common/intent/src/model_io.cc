@@ -151,6 +151,9 @@ std::string SerializeIntentModel(const IntentModel& m) {
   w.Mat(m.classifier.ivm.import_index.cast<double>());
   w.Mat(m.classifier.ivm.alpha);
   w.Vec(m.classifier.ivm.bias);
+  w.F64(m.classifier.belief.time_constant);
+  w.F64(m.classifier.belief.min_probability);
+  w.I64(m.classifier.belief.motion_weighted ? 1 : 0);
   w.U64(m.forecasters.size());
   for (const ActionForecaster& f : m.forecasters) {
     w.Vec(f.input_mean);
@@ -231,6 +234,10 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
   m.classifier.ivm.import_index = r.Mat().col(0).cast<int>();
   m.classifier.ivm.alpha = r.Mat();
   m.classifier.ivm.bias = r.Vec();
+  m.classifier.belief.time_constant = r.F64();
+  m.classifier.belief.min_probability = r.F64();
+  m.classifier.belief.motion_weighted = r.I64() != 0;
+  if (const std::string why = m.classifier.belief.Validate(); !why.empty()) r.Fail("belief filter: " + why);
   const std::uint64_t nf = r.U64();
   const Eigen::Index C = static_cast<Eigen::Index>(m.actions.size());
   const FeatureLayout layout(c.joints, c.features);

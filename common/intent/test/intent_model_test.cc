@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <limits>
 #include <random>
 #include <sstream>
 
@@ -113,6 +114,15 @@ TEST_F(IntentModelTest, SaveLoadRoundTripsBitExactly) {
   std::stringstream ss;
   ss << in.rdbuf();
   EXPECT_EQ(ss.str(), SerializeIntentModel(*model_));
+  EXPECT_EQ(loaded.classifier.belief.time_constant, model_->classifier.belief.time_constant);
+  EXPECT_EQ(loaded.classifier.belief.min_probability, model_->classifier.belief.min_probability);
+  EXPECT_EQ(loaded.classifier.belief.motion_weighted, model_->classifier.belief.motion_weighted);
+  IntentModel odd = *model_;  // a setting the CV grid does not contain survives too
+  odd.classifier.belief = {std::numeric_limits<double>::infinity(), 0.02, true};
+  const IntentModel odd_loaded = DeserializeIntentModel(SerializeIntentModel(odd), "odd");
+  EXPECT_EQ(odd_loaded.classifier.belief.time_constant, std::numeric_limits<double>::infinity());
+  EXPECT_EQ(odd_loaded.classifier.belief.min_probability, 0.02);
+  EXPECT_TRUE(odd_loaded.classifier.belief.motion_weighted);
   MixturePrediction a, b;
   const Eigen::MatrixXd window = data_->sequences[5].positions.topRows(12);
   PredictIntent(*model_, window, &a);
@@ -155,7 +165,7 @@ TEST_F(IntentModelTest, CorruptAndMismatchedFilesAreRefused) {
   std::string other_version = good;
   other_version[8] = 99;  // version field follows the 8-byte magic
   write(Path("version.bin"), other_version);
-  ExpectLoadFails(Path("version.bin"), {}, "format version 99, but this build reads version 1");
+  ExpectLoadFails(Path("version.bin"), {}, "format version 99, but this build reads version 2");
 
   write(Path("good.bin"), good);
   ModelExpectation joints;

@@ -76,7 +76,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
                                                " bodies (max_bodies); body " + std::to_string(frame.body_id) +
                                                " ignored"};
     }
-    it = bodies_.emplace(frame.body_id, Body{}).first;
+    it = bodies_.emplace(frame.body_id, Body(*model_)).first;
   }
   Body& body = it->second;
   if (!body.stamps.empty()) {
@@ -89,6 +89,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
     if (frame.stamp - last > params_.max_gap) {  // tracking gap: start over
       body.stamps.clear();
       body.positions.clear();
+      body.belief.Reset();
     }
   }
   body.stamps.push_back(frame.stamp);
@@ -100,6 +101,14 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
   }
   BuildWindow(body);
   intent::PredictIntent(*model_, window_, out);
+  window_probabilities_.resize(static_cast<Eigen::Index>(out->actions.size()));
+  for (std::size_t c = 0; c < out->actions.size(); ++c) {
+    window_probabilities_(static_cast<Eigen::Index>(c)) = out->actions[c].probability;
+  }
+  body.belief.UpdateWithWindow(window_probabilities_, window_, model_->config.window, frame.stamp);
+  for (std::size_t c = 0; c < out->actions.size(); ++c) {
+    out->actions[c].probability = body.belief.probabilities()(static_cast<Eigen::Index>(c));
+  }
   DropStale(frame.stamp);
   return {};
 }

@@ -5,6 +5,11 @@
 // (rows at t, t - 1/rate, ..., linear interpolation between neighbouring
 // frames), forms the window of the last T rows (padded at the front by the
 // library while fewer have been observed) and runs iplan::intent::PredictIntent.
+// The action probabilities of successive windows of a body are combined by an
+// iplan::intent::BeliefFilter with the model's parameters
+// (model.classifier.belief, cross-validated at training time), exactly as in
+// iplan::intent::EvaluateIntentModel; the filter restarts with the body's
+// history (new body or tracking gap).
 //
 // Frames: positions are metres in the frame of the incoming skeletons (W);
 // the model must have been trained in that frame. Stamps are seconds (any
@@ -26,6 +31,7 @@
 
 #include <Eigen/Core>
 
+#include "iplan/intent/belief_filter.h"
 #include "iplan/intent/intent_model.h"
 
 namespace iplan::intent_service {
@@ -80,6 +86,7 @@ class IntentEstimator {
 
   /// Adds a frame. When accepted, `*out` holds the mixture prediction for the
   /// window ending at frame.stamp (future step k at stamp + (k + 1) / rate),
+  /// its action probabilities being the body's belief over its windows so far,
   /// and bodies unseen for longer than body_timeout before frame.stamp are
   /// dropped. A rejected frame changes nothing.
   FrameResult Update(const SkeletonFrame& frame, intent::MixturePrediction* out);
@@ -97,8 +104,11 @@ class IntentEstimator {
 
  private:
   struct Body {
+    explicit Body(const intent::IntentModel& model)
+        : belief(static_cast<int>(model.actions.size()), model.classifier.belief) {}
     std::deque<double> stamps;             // s, increasing
     std::deque<Eigen::VectorXd> positions; // (3 J) per frame, model joint order
+    intent::BeliefFilter belief;           // over this body's windows since its history began
   };
   /// Fills window_ from a body's history; returns the number of rows.
   void BuildWindow(const Body& body);
@@ -111,6 +121,7 @@ class IntentEstimator {
   Eigen::VectorXd scratch_;     // (3 J) positions of the incoming frame
   std::vector<int> seen_;       // per model joint: times seen in the frame
   Eigen::MatrixXd window_;      // (<= T, 3 J)
+  Eigen::VectorXd window_probabilities_;  // (C) of the newest window
 };
 
 }  // namespace iplan::intent_service

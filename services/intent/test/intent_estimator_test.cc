@@ -83,7 +83,11 @@ class IntentEstimatorTest : public ::testing::Test {
     p.pseudo_inputs = 6;
     p.gp_iterations = 15;
     p.max_forecast_windows = 60;
-    model_ = std::make_shared<const IntentModel>(intent::TrainIntentModel(ToyData(), c, p));
+    IntentModel m = intent::TrainIntentModel(ToyData(), c, p);
+    // A fixed accumulating belief filter, so that the tests exercise it
+    // whatever the cross-validation picks on the toy data.
+    m.classifier.belief = {1.0, 1e-3, true};
+    model_ = std::make_shared<const IntentModel>(std::move(m));
   }
   static void TearDownTestSuite() { model_.reset(); }
   static std::shared_ptr<const IntentModel> model_;
@@ -98,10 +102,11 @@ Eigen::RowVectorXd ModelRow(const IntentModel& m, const Eigen::VectorXd& p) {
   return row;
 }
 
-void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b, double tol) {
+void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b, double tol,
+                          bool compare_probabilities = true) {
   ASSERT_EQ(a.actions.size(), b.actions.size());
   for (std::size_t c = 0; c < a.actions.size(); ++c) {
-    EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
+    if (compare_probabilities) EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
     ASSERT_EQ(a.actions[c].joints.size(), b.actions[c].joints.size());
     for (std::size_t k = 0; k < a.actions[c].joints.size(); ++k) {
       EXPECT_LE((a.actions[c].joints[k].mean - b.actions[c].joints[k].mean).norm(), tol);
@@ -112,9 +117,15 @@ void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b
 TEST_F(IntentEstimatorTest, FramesAtTheModelRateGiveTheLibraryPredictionOfTheSameWindow) {
   IntentEstimator est(model_, {});
   const int T = model_->config.window;
+  const int C = static_cast<int>(model_->actions.size());
   const double dt = 1.0 / model_->config.rate;
   Eigen::MatrixXd rows(0, 18);
   MixturePrediction got, want;
+  // The evaluation's recipe: per-window probabilities through the model's
+  // belief filter, fed with the observed (unpadded) last T rows.
+  intent::BeliefFilter belief(C, model_->classifier.belief);
+  Eigen::VectorXd window_p(C);
+  int accumulated = 0;
   for (int i = 0; i < T + 4; ++i) {
     const double t = 1000.0 + i * dt;
     const Eigen::VectorXd p = Pose(1, i * dt);
@@ -122,8 +133,15 @@ TEST_F(IntentEstimatorTest, FramesAtTheModelRateGiveTheLibraryPredictionOfTheSam
     rows.conservativeResize(rows.rows() + 1, Eigen::NoChange);
     rows.row(rows.rows() - 1) = ModelRow(*model_, p);
     intent::PredictIntent(*model_, rows, &want);  // pads / takes the last T rows itself
+    for (int c = 0; c < C; ++c) window_p(c) = want.actions[c].probability;
+    belief.UpdateWithWindow(window_p, rows.bottomRows(std::min<Eigen::Index>(rows.rows(), T)), T, t);
+    accumulated = belief.num_updates();
+    for (int c = 0; c < C; ++c) want.actions[c].probability = belief.probabilities()(c);
     ExpectSamePrediction(got, want, 1e-9);
   }
+  // The partial window ending at frame T - 2 (the whole history then) and the
+  // full windows ending at frames T - 1 ... T + 3.
+  EXPECT_EQ(accumulated, 6);
   EXPECT_EQ(got.horizon, model_->config.horizon);
   EXPECT_EQ(got.num_joints, 6);
   EXPECT_EQ(model_->actions[got.MostLikely()], "raise_right");
@@ -145,7 +163,8 @@ TEST_F(IntentEstimatorTest, FasterFramesAreResampledToTheModelRate) {
   Eigen::MatrixXd grid(model_->config.window, 18);
   for (int r = 0; r < grid.rows(); ++r) grid.row(r) = ModelRow(*model_, pose(t - (grid.rows() - 1 - r) * dt));
   intent::PredictIntent(*model_, grid, &want);
-  ExpectSamePrediction(got, want, 1e-9);
+  // Same forecasts; the probabilities are the belief over all windows so far.
+  ExpectSamePrediction(got, want, 1e-9, /*compare_probabilities=*/false);
   double sum = 0;
   for (const auto& h : got.actions) sum += h.probability;
   EXPECT_NEAR(sum, 1.0, 1e-9);
@@ -232,9 +251,13 @@ TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
   EXPECT_EQ(est.DropStale(1.45), 1);  // body 2 last seen at 0.9
   EXPECT_EQ(est.buffered_frames(2), 0);
   ASSERT_TRUE(est.Update(Frame(3, 1.5, Rest()), &out).accepted());
-  // Body 1 comes back after a gap longer than max_gap: its history restarts.
+  // Body 1 comes back after a gap longer than max_gap: its history restarts,
+  // and so does its belief (the prediction is that of the single new frame).
   ASSERT_TRUE(est.Update(Frame(1, 1.5, Rest()), &out).accepted());
   EXPECT_EQ(est.buffered_frames(1), 1);
+  MixturePrediction single;
+  intent::PredictIntent(*model_, ModelRow(*model_, Rest()), &single);
+  ExpectSamePrediction(out, single, 1e-9);
   // A frame of body 3 two timeouts later drops body 1 (not seen since 1.5 s).
   ASSERT_TRUE(est.Update(Frame(3, 2.6, Rest()), &out).accepted());
   EXPECT_EQ(est.num_bodies(), 1);

@@ -36,13 +36,18 @@ struct EvalReport {
   std::vector<double> error_const_velocity;  ///< (D) m, baseline: extrapolate last-frame velocity.
   double coverage95 = 0.0;           ///< Share of true future joints inside the
                                      ///< moment-matched mixture's 95 % ellipsoid.
-  double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame).
+  double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame; accuracy
+                                     ///< and forecast windows).
   double inference_p99_ms = 0.0;
   int num_inference_calls = 0;
 };
 
 /// Evaluates `model` on every sequence of `data`. Accuracy: for each track
-/// and fraction f the model sees the first ceil(f n) frames (last T of them).
+/// and fraction f the model sees the first ceil(f n) frames: the windows of
+/// the last T frames ending at every one of them are classified and combined
+/// by a BeliefFilter with model.classifier.belief (one update per model
+/// frame), as the intent service does online; the belief after frame
+/// ceil(f n) is scored.
 /// Forecasts: every window (stride `forecast_stride`) whose true future of
 /// `horizon` frames is recorded. Throws std::invalid_argument when the data
 /// lack a model joint or contain an action the model does not know.

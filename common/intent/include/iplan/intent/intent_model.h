@@ -10,11 +10,13 @@
 
 #include <array>
 #include <cstdint>
+#include <limits>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
+#include "iplan/intent/belief_filter.h"
 #include "iplan/intent/features.h"
 #include "iplan/intent/ivm.h"
 #include "iplan/intent/skeleton_data.h"
@@ -49,6 +51,19 @@ struct TrainParams {
   /// IVM regularisers tried in cross-validation.
   std::vector<double> lambdas{1e-4, 1e-3, 1e-2};
   IvmParams ivm;  ///< IVM options; `lambda` is replaced by the CV choice.
+  /// Belief-filter time constants tau (s, >= 0, may be +infinity) tried in
+  /// leave-one-subject-out cross-validation at the chosen (sigma, lambda):
+  /// per held-out training track the filter runs over the windows ending at
+  /// every frame, scored (mean log-loss of the belief) at `prefix_fractions`.
+  /// Without cross-validation (fewer than two subjects or one entry) the
+  /// first entry is used. 0 = classify the last window only.
+  std::vector<double> belief_time_constants{0.0, 0.25, 0.5, 1.0, 2.0, 4.0,
+                                            std::numeric_limits<double>::infinity()};
+  double belief_min_probability = 1e-3;  ///< BeliefFilterParams::min_probability.
+  /// BeliefFilterParams::motion_weighted values tried in the same
+  /// cross-validation (jointly with the time constants); without
+  /// cross-validation the first entry is used.
+  std::vector<bool> belief_motion_weighting{false, true};
   int pseudo_inputs = 20;          ///< M per action.
   int forecast_stride = 2;         ///< Frames between forecaster training windows.
   int max_forecast_windows = 600;  ///< Per action, seeded random subset beyond this.
@@ -68,6 +83,9 @@ struct ActionClassifier {
   double sigma = 1.0;                          ///< DTW kernel width, m.
   std::vector<Eigen::MatrixXd> import_windows; ///< (q) each (F, T): frame features as columns.
   IvmModel ivm;                                ///< q import samples, C classes.
+  /// How successive windows of one person are combined (BeliefFilter); the
+  /// time constant is the cross-validated choice.
+  BeliefFilterParams belief;
 };
 
 /// Forecaster of one action: standardisation plus the SPGP.
@@ -131,6 +149,11 @@ struct TrainReport {
   double lambda = 0.0;
   /// One row per (sigma, lambda) tried: sigma, lambda, CV mean log-loss, CV accuracy.
   std::vector<std::array<double, 4>> cv_table;
+  double belief_time_constant = 0.0;
+  bool belief_motion_weighted = false;
+  /// One row per belief setting tried: motion weighted (0/1), tau (s), CV mean
+  /// log-loss, CV accuracy.
+  std::vector<std::array<double, 4>> belief_cv_table;
   std::vector<int> forecast_windows;  ///< Per action.
   std::vector<bool> forecast_padded;  ///< Per action: held-last-pose futures used.
   double seconds_classifier = 0.0;
@@ -158,7 +181,10 @@ std::vector<Track> MakeTracks(const SkeletonDataset& data,
 Eigen::VectorXd ClassifyWindow(const IntentModel& model, const Eigen::MatrixXd& window);
 
 /// Full prediction (classification + per-action forecast) for a window (as
-/// in ClassifyWindow). Reuses the storage in `out`. Throws as ClassifyWindow.
+/// in ClassifyWindow). The action probabilities are those of this window
+/// alone; to combine successive windows of one person feed them to a
+/// BeliefFilter built with model.classifier.belief (as the evaluation and
+/// the intent service do) and use its probabilities. Reuses the storage in `out`. Throws as ClassifyWindow.
 /// Thread-safe.
 void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
                    MixturePrediction* out);

@@ -17,7 +17,8 @@
 namespace iplan::intent {
 
 /// The format version this build writes and reads.
-inline constexpr std::uint32_t kIntentModelFormatVersion = 1;
+/// 2: the classifier stores its belief-filter parameters.
+inline constexpr std::uint32_t kIntentModelFormatVersion = 2;
 
 /// What the user of a model (a service, the CLI) is configured for. Empty /
 /// unset fields are not checked.
