@@ -106,7 +106,9 @@ void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b
                           bool compare_probabilities = true) {
   ASSERT_EQ(a.actions.size(), b.actions.size());
   for (std::size_t c = 0; c < a.actions.size(); ++c) {
-    if (compare_probabilities) EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
+    if (compare_probabilities) {
+      EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
+    }
     ASSERT_EQ(a.actions[c].joints.size(), b.actions[c].joints.size());
     for (std::size_t k = 0; k < a.actions[c].joints.size(); ++k) {
       EXPECT_LE((a.actions[c].joints[k].mean - b.actions[c].joints[k].mean).norm(), tol);
