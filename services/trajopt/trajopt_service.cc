@@ -110,6 +110,7 @@ class TrajoptService : public framework::Service {
                                     Eigen::Quaterniond(p.orientation.w, p.orientation.x, p.orientation.y, p.orientation.z)
                                         .normalized());
     }
+    if (replanner_->current_task_id() == t.id) return;  // a re-sent command of the running task
     node.log().info("task {} '{}' started", t.id, t.name);
     if (auto replaced = replanner_->StartTask(t, now)) Publish(node, *replaced);
   }

@@ -79,6 +79,7 @@ TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int6
 
 std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t now_ns) {
   std::optional<TaskOutcome> replaced;
+  if (task_ && task_->spec.id == task.id) return replaced;  // a repeat of the running task
   if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
   task_ = Active{};
   task_->spec = task;

@@ -74,11 +74,14 @@ class Replanner {
   /// `planner` must outlive this object. Throws std::invalid_argument on bad params.
   Replanner(const planning::Planner& planner, const collision::HumanBodyModel& body, ReplannerParams params);
 
-  /// A new task replaces the current one, whose outcome (CANCELLED) is returned.
+  /// A new task replaces the current one, whose outcome (CANCELLED) is
+  /// returned. A repeat of the running task's id is ignored (commands may be
+  /// re-sent after a fault).
   std::optional<TaskOutcome> StartTask(const TaskSpec& task, int64_t now_ns);
   /// Cancels the current task if it has this id.
   std::optional<TaskOutcome> CancelTask(uint32_t id, int64_t now_ns);
   bool busy() const { return task_.has_value(); }
+  std::optional<uint32_t> current_task_id() const { return task_ ? std::optional<uint32_t>(task_->spec.id) : std::nullopt; }
 
   /// Newest robot state (model joint order). Returns why it was refused.
   std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,

@@ -174,6 +174,8 @@ TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
   EXPECT_EQ(o->status, TaskStatus::kFailed);
   EXPECT_FALSE(o->reason.empty());
   ASSERT_EQ(replanner_.StartTask({10, "a", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  EXPECT_EQ(replanner_.StartTask({10, "a", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);  // repeat: ignored
+  EXPECT_EQ(replanner_.current_task_id(), 10u);
   const auto replaced = replanner_.StartTask({11, "b", planning::Goal::Joint(Ready()), 0}, t);
   ASSERT_TRUE(replaced.has_value());
   EXPECT_EQ(replaced->id, 10u);

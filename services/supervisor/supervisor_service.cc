@@ -1,0 +1,209 @@
+// iplan-supervisor: the task planner (MDP + Q-learning, METHOD 6) and the
+// cell's deadline / liveliness monitor. It issues task commands to the
+// trajectory optimiser, learns from their outcomes and the predicted human
+// action, and commands a protective stop whenever an input is late or gone
+// or the collision-risk verdict says so, resuming when all is healthy.
+#include <chrono>
+#include <filesystem>
+
+#include "core/safety_monitor.h"
+#include "core/task_planner.h"
+#include "iplan/framework/service.h"
+
+namespace iplan::supervisor {
+namespace {
+
+using framework::ConfigSection;
+using framework::Node;
+using framework::Result;
+
+class SupervisorService : public framework::Service {
+ public:
+  Result OnConfigure(ConfigSection& config, Node& node) override {
+    std::string graph_file = "tasks/table_top.yaml", mode = "learning";
+    std::vector<std::string> watched = {"human_skeleton", "human_prediction", "joint_states", "robot_trajectory",
+                                        "collision_risk"};
+    QLearningParams q;
+    config.Read("task_graph", &graph_file);
+    config.Read("q_table", &q_table_);
+    config.Read("mode", &mode, framework::OneOf({"learning", "deployment"}));
+    config.Read("alpha", &q.alpha, framework::InRange(1e-6, 1.0));
+    config.Read("gamma", &q.gamma, framework::InRange(0.0, 0.999));
+    config.Read("epsilon", &q.epsilon, framework::InRange(0.0, 1.0));
+    config.Read("delay_weight", &q.delay_weight, framework::NonNegative<double>());
+    int seed = 1;
+    config.Read("seed", &seed, framework::NonNegative<int>());
+    config.Read("watch", &watched);
+    config.Read("pause_between_tasks", &pause_, framework::NonNegative<double>());
+    config.Read("max_episodes", &max_episodes_, framework::NonNegative<int>());
+    q.learning = mode == "learning";
+    q.seed = static_cast<uint64_t>(seed);
+    const auto base = std::filesystem::path(config.file()).parent_path();
+    if (!q_table_.empty() && q_table_[0] != '/') q_table_ = (base / q_table_).lexically_normal().string();
+    try {
+      planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph((base / graph_file).lexically_normal().string()), q);
+      if (!q_table_.empty()) {
+        std::string note;
+        planner_->Load(q_table_, &note);
+        node.log().info("{}", note);
+      }
+    } catch (const std::exception& e) {
+      return Result::Fail(e.what());
+    }
+    command_writer_ = &node.Advertise(framework::topics::TaskCommand());
+    safety_writer_ = &node.Advertise(framework::topics::SafetyCommand());
+    using SI = const dds::SampleInfo&;
+    // Watched topics: any sample is a sign of life; deadline and liveliness
+    // events come through OnReaderEvent.
+    std::vector<std::string> names;
+    for (const std::string& w : watched) {
+      if (w == "human_skeleton") Watch(node, framework::topics::HumanSkeleton(), &names);
+      else if (w == "human_prediction") Watch(node, framework::topics::HumanPrediction(), &names);
+      else if (w == "joint_states") Watch(node, framework::topics::JointStates(), &names);
+      else if (w == "robot_trajectory") Watch(node, framework::topics::RobotTrajectory(), &names);
+      else if (w == "collision_risk") Watch(node, framework::topics::CollisionRisk(), &names);
+      else if (w == "action_belief") Watch(node, framework::topics::ActionBelief(), &names);
+      else return Result::Fail(config.file() + ": key 'supervisor.watch': unknown topic '" + w +
+                               "' (human_skeleton, human_prediction, action_belief, joint_states, robot_trajectory, collision_risk)");
+    }
+    monitor_ = std::make_unique<SafetyMonitor>(names);
+    node.OnReaderEvent([this](const std::string& topic, const dds::ReaderEvent& e) {
+      if (e.kind == dds::EventKind::kDeadlineMissed) monitor_->OnDeadlineMissed(topic);
+      if (e.kind == dds::EventKind::kLivelinessLost) monitor_->OnLivelinessLost(topic, e.current);
+    });
+    if (std::find(watched.begin(), watched.end(), "action_belief") == watched.end()) {
+      node.Subscribe(framework::topics::ActionBelief(),
+                     std::function<void(const msg::ActionBelief&, SI)>([this](const msg::ActionBelief& b, SI) { Belief(b); }));
+    }
+    node.Subscribe(framework::topics::TaskOutcome(),
+                   std::function<void(const msg::TaskOutcome&, SI)>([this, &node](const msg::TaskOutcome& o, SI) {
+                     OnOutcome(node, o);
+                   }),
+                   framework::SubscribeOptions{false});
+    return Result::Ok();
+  }
+
+  Result OnActivate(Node& node) override {
+    timer_ = node.AddTimer(std::chrono::milliseconds(20), [this, &node] { Tick(node); });
+    return Result::Ok();
+  }
+
+  Result OnDeactivate(Node& node) override {
+    node.CancelTimer(timer_);
+    return Result::Ok();
+  }
+
+ private:
+  template <class T>
+  void Watch(Node& node, const framework::Topic<T>& topic, std::vector<std::string>* names) {
+    names->push_back(topic.name);
+    const std::string name = topic.name;
+    node.Subscribe(topic, std::function<void(const T&, const dds::SampleInfo&)>([this, name](const T& m, const dds::SampleInfo&) {
+                     monitor_->OnData(name);
+                     if constexpr (std::is_same_v<T, msg::CollisionRisk>) monitor_->OnRiskVerdict(m.verdict, m.reason);
+                     if constexpr (std::is_same_v<T, msg::ActionBelief>) Belief(m);
+                   }));
+  }
+
+  void Belief(const msg::ActionBelief& b) {
+    belief_.clear();
+    for (std::size_t i = 0; i < b.actions.size(); ++i) belief_[b.actions[i]] = b.probabilities[i];
+  }
+
+  void Tick(Node& node) {
+    bool changed = false;
+    const SafetyDecision d = monitor_->Evaluate(&changed);
+    if (changed) {
+      msg::SafetyCommand c;
+      c.header.stamp = msg::Now();
+      c.seq = ++safety_seq_;
+      c.command = d.stop ? msg::SafetyCommand::PROTECTIVE_STOP : msg::SafetyCommand::RESUME;
+      c.source = "supervisor";
+      c.reason = d.reason;
+      safety_writer_->Write(c);
+      if (d.stop) {
+        ++stops_;
+        node.log().warn("PROTECTIVE STOP: {}", d.reason);
+      } else {
+        node.log().info("RESUME: {}", d.reason);
+        // A restarted trajectory optimiser never saw the running task's
+        // (volatile) command: send it again; the optimiser ignores a repeat.
+        if (current_task_ >= 0) {
+          command_.header.stamp = msg::Now();
+          command_writer_->Write(command_);
+        }
+      }
+      node.SetDiagnosticValue("safety", d.stop ? "stopped: " + d.reason : "running");
+      node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
+    }
+    // Issue the next task when idle (tasks are not started while stopped).
+    if (d.stop || current_task_ >= 0) return;
+    if (max_episodes_ > 0 && episodes_ >= max_episodes_) return;
+    if (std::chrono::steady_clock::now() < next_task_at_) return;
+    if (planner_->episode_done()) {
+      ++episodes_;
+      node.log().info("episode {} done", episodes_);
+      node.SetDiagnosticValue("episodes", std::to_string(episodes_));
+      planner_->ResetEpisode();
+      if (max_episodes_ > 0 && episodes_ >= max_episodes_) return;
+    }
+    current_task_ = planner_->Choose(belief_);
+    if (current_task_ < 0) return;
+    const RobotTask& t = planner_->graph().tasks[static_cast<std::size_t>(current_task_)];
+    msg::TaskCommand& c = command_;
+    c.header.stamp = msg::Now();
+    c.task_id = ++task_id_;
+    c.task_name = t.name;
+    c.command = msg::TaskCommand::START;
+    c.goal_type = msg::TaskCommand::GOAL_JOINTS;
+    c.goal_positions = t.goal;
+    command_writer_->Write(c);
+    node.log().info("task {} '{}' (episode {}, state {:#x})", task_id_, t.name, episodes_ + 1, planner_->state());
+  }
+
+  void OnOutcome(Node& node, const msg::TaskOutcome& o) {
+    if (current_task_ < 0 || o.task_id != task_id_) return;  // not ours / stale
+    const bool ok = o.status == msg::TaskOutcome::SUCCEEDED;
+    const double reward = planner_->Complete(current_task_, ok, o.delay, belief_);
+    ++completed_;
+    node.log().info("task {} '{}' {} in {:.2f} s, delay {:.2f} s, reward {:.3f}", o.task_id, o.task_name,
+                    ok ? "succeeded" : "failed", o.duration, o.delay, reward);
+    current_task_ = -1;
+    next_task_at_ = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int64_t>(pause_ * 1000));
+    node.SetDiagnosticValue("tasks_completed", std::to_string(completed_));
+    node.SetDiagnosticValue("last_reward", std::to_string(reward));
+    if (!q_table_.empty()) {
+      try {
+        planner_->Save(q_table_);
+      } catch (const std::exception& e) {
+        node.log().error("Q-table not saved: {}", e.what());
+      }
+    }
+  }
+
+  std::unique_ptr<TaskPlanner> planner_;
+  std::unique_ptr<SafetyMonitor> monitor_;
+  std::string q_table_ = "state/q_table.bin";
+  double pause_ = 0.5;
+  int max_episodes_ = 0;
+  dds::Writer<msg::TaskCommand>* command_writer_ = nullptr;
+  dds::Writer<msg::SafetyCommand>* safety_writer_ = nullptr;
+  std::map<std::string, double> belief_;
+  msg::TaskCommand command_;  // the running task's command (re-sent on resume)
+  int current_task_ = -1;
+  uint32_t task_id_ = 0, safety_seq_ = 0;
+  int episodes_ = 0;
+  uint64_t completed_ = 0, stops_ = 0;
+  std::chrono::steady_clock::time_point next_task_at_{};
+  int timer_ = 0;
+};
+
+}  // namespace
+}  // namespace iplan::supervisor
+
+int main(int argc, char** argv) {
+  return iplan::framework::RunService(
+      argc, argv,
+      {"supervisor", "task planning (MDP + Q-learning) and the deadline / liveliness monitor that stops the robot"},
+      [] { return std::make_unique<iplan::supervisor::SupervisorService>(); });
+}
