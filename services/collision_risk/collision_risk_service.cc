@@ -61,14 +61,14 @@ class CollisionRiskService : public framework::Service {
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
                    std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
-                     Count(node, "joint_states", monitor_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position));
+                     node.CountRejection("joint_states", monitor_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position));
                    }));
     node.Subscribe(framework::topics::RobotTrajectory(),
                    std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
                      services::FromTrajectory(m, &times, &pos);
-                     Count(node, "trajectory", monitor_->UpdateTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
+                     node.CountRejection("trajectory", monitor_->UpdateTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
                    }));
     node.Subscribe(framework::topics::HumanSkeleton(),
                    std::function<void(const msg::HumanSkeleton&, SI)>([this, &node](const msg::HumanSkeleton& m, SI) {
@@ -78,7 +78,7 @@ class CollisionRiskService : public framework::Service {
                        names.push_back(j.name);
                        p.emplace_back(j.position.x, j.position.y, j.position.z);
                      }
-                     Count(node, "skeleton", monitor_->UpdateSkeleton(msg::ToNanoseconds(m.header.stamp), names, p));
+                     node.CountRejection("skeleton", monitor_->UpdateSkeleton(msg::ToNanoseconds(m.header.stamp), names, p));
                    }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
@@ -103,17 +103,10 @@ class CollisionRiskService : public framework::Service {
   }
 
  private:
-  void Count(Node& node, const std::string& what, const std::optional<std::string>& rejection) {
-    if (!rejection) return;
-    const uint64_t n = ++rejected_[what];
-    node.SetDiagnosticValue("rejected_inputs/" + what, std::to_string(n));
-    if (n == 1 || n % 100 == 0) node.log().warn("{} rejected ({} so far): {}", what, n, *rejection);
-  }
-
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {
     const PredictionInput in = services::ToJointMixture(m);
     const auto rejection = monitor_->UpdatePrediction(in);
-    Count(node, "prediction", rejection);
+    node.CountRejection("prediction", rejection);
     if (!rejection) Publish(node, msg::ToNanoseconds(msg::Now()));
   }
 
@@ -153,7 +146,6 @@ class CollisionRiskService : public framework::Service {
   double rate_hz_ = 15;
   std::unique_ptr<RiskMonitor> monitor_;
   dds::Writer<msg::CollisionRisk>* writer_ = nullptr;
-  std::map<std::string, uint64_t> rejected_;
   int timer_ = 0;
   int64_t last_publish_ns_ = 0;
   Verdict last_verdict_ = Verdict::kOk;

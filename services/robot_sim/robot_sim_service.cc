@@ -45,12 +45,8 @@ class RobotSimService : public framework::Service {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
                      services::FromTrajectory(m, &times, &pos);
-                     if (auto why = sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos)) {
-                       if (++rejected_trajectories_ == 1 || rejected_trajectories_ % 100 == 0) {
-                         node.log().warn("trajectory refused ({} so far): {}", rejected_trajectories_, *why);
-                       }
-                       node.SetDiagnosticValue("rejected_trajectories", std::to_string(rejected_trajectories_));
-                     }
+                     node.CountRejection("trajectory",
+                                         sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
                    }));
     node.Subscribe(framework::topics::SafetyCommand(),
                    std::function<void(const msg::SafetyCommand&, SI)>([this, &node](const msg::SafetyCommand& m, SI) {
@@ -120,7 +116,7 @@ class RobotSimService : public framework::Service {
   dds::Writer<msg::JointState>* joint_writer_ = nullptr;
   int timer_ = 0;
   int64_t last_ = 0;
-  uint64_t steps_ = 0, rejected_trajectories_ = 0, stops_ = 0;
+  uint64_t steps_ = 0, stops_ = 0;
 };
 
 }  // namespace

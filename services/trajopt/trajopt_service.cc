@@ -47,12 +47,12 @@ class TrajoptService : public framework::Service {
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
                    std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
-                     Count(node, "joint_states",
+                     node.CountRejection("joint_states",
                            replanner_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position, m.velocity));
                    }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
-                     Count(node, "prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
+                     node.CountRejection("prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
                    }));
     node.Subscribe(framework::topics::TaskCommand(),
                    std::function<void(const msg::TaskCommand& m, SI)>([this, &node](const msg::TaskCommand& m, SI) {
@@ -74,13 +74,6 @@ class TrajoptService : public framework::Service {
   }
 
  private:
-  void Count(Node& node, const std::string& what, const std::optional<std::string>& rejection) {
-    if (!rejection) return;
-    const uint64_t n = ++rejected_[what];
-    node.SetDiagnosticValue("rejected_inputs/" + what, std::to_string(n));
-    if (n == 1 || n % 100 == 0) node.log().warn("{} rejected ({} so far): {}", what, n, *rejection);
-  }
-
   void OnCommand(Node& node, const msg::TaskCommand& m) {
     const int64_t now = msg::ToNanoseconds(msg::Now());
     if (m.command == msg::TaskCommand::CANCEL) {
@@ -157,7 +150,6 @@ class TrajoptService : public framework::Service {
   std::unique_ptr<Replanner> replanner_;
   dds::Writer<msg::JointTrajectory>* trajectory_writer_ = nullptr;
   dds::Writer<msg::TaskOutcome>* outcome_writer_ = nullptr;
-  std::map<std::string, uint64_t> rejected_;
   std::string last_status_;
   int timer_ = 0;
 };

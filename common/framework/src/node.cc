@@ -149,6 +149,14 @@ bool Node::AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns)
   return true;
 }
 
+bool Node::CountRejection(const std::string& input, const std::optional<std::string>& rejection) {
+  if (!rejection) return false;
+  const uint64_t n = ++core_rejections_[input];
+  SetDiagnosticValue("rejected_inputs/" + input, std::to_string(n));
+  if (n == 1 || n % 100 == 0) log_->warn("{} rejected ({} so far): {}", input, n, *rejection);
+  return true;
+}
+
 void Node::RecordCycleTime(double seconds) {
   cycle_times_.push_back(seconds);
   if (cycle_times_.size() > 1000) cycle_times_.pop_front();

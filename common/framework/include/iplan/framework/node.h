@@ -89,6 +89,12 @@ class Node {
   /// `on_idle` after every SpinOnce (e.g. systemd watchdog).
   void SpinUntil(const std::function<bool()>& stop, const std::function<void()>& on_idle = nullptr);
 
+  /// Counts an input that a service's core refused after the boundary check
+  /// (unknown joint names, inconsistent content): no-op when `rejection` is
+  /// empty; else counted in diagnostics as `rejected_inputs/<input>`, logged
+  /// the first time and every 100th. Returns true when it was a rejection.
+  bool CountRejection(const std::string& input, const std::optional<std::string>& rejection);
+
   /// Processing time of one cycle of the service's main loop, s.
   void RecordCycleTime(double seconds);
   /// Lifecycle state shown in diagnostics ("configured", "active", ...).
@@ -145,6 +151,7 @@ class Node {
   std::string state_ = "unconfigured";
   uint8_t level_ = msg::DiagnosticStatus::OK;
   std::map<std::string, std::string> extra_values_;
+  std::map<std::string, uint64_t> core_rejections_;
   std::deque<double> cycle_times_;
   dds::Writer<msg::DiagnosticArray>* diagnostics_writer_ = nullptr;
 };
