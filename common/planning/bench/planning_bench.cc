@@ -15,6 +15,7 @@
 //    The cycle time is the wall time of Planner::Plan.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -33,6 +34,20 @@ double Pct(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5));
   return v[i];
+}
+
+// FNV-1a over the bytes of a result's trajectory, cost and bounds: a
+// fingerprint that changes only when results change (for checking that a
+// speed-up is output-preserving).
+void Fingerprint(const PlanningResult& r, std::uint64_t* h) {
+  auto mix = [h](const void* p, std::size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) *h = (*h ^ b[i]) * 1099511628211ULL;
+  };
+  mix(r.positions.data(), sizeof(double) * r.positions.size());
+  mix(&r.cost, sizeof r.cost);
+  mix(r.bounds.data(), sizeof(double) * r.bounds.size());
+  mix(&r.num_waits, sizeof r.num_waits);
 }
 
 struct Problem {
@@ -89,6 +104,7 @@ int main(int argc, char** argv) {
   std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
               "%d worker threads, dt %.2f s, horizon %.1f s\n",
               num_problems, ik_rejected, threads, params.dt, params.horizon);
+  std::uint64_t fingerprint = 14695981039346656037ULL;
   for (int nopt : {8, 1}) {
     int ok = 0, ok_1s = 0;
     std::vector<double> t_first, t_total, cost;
@@ -98,6 +114,7 @@ int main(int argc, char** argv) {
       req.goal = problems[i].goal;
       const PlanningResult r = planner.Plan(req, nopt, std::min(threads, nopt), 1000 + i);
       t_total.push_back(r.planning_time);
+      Fingerprint(r, &fingerprint);
       if (r.success) {
         ++ok;
         if (r.planning_time <= 1.0) ++ok_1s;
@@ -152,6 +169,7 @@ int main(int argc, char** argv) {
       }
       const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
       cycle.push_back(r.planning_time);
+      Fingerprint(r, &fingerprint);
       total_waits += r.num_waits;
       if (!r.success) {
         ++cycles_failed;
@@ -168,5 +186,7 @@ int main(int argc, char** argv) {
               1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
   std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
               cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+  std::printf("results fingerprint %016llx (same seeds and results => same value)\n",
+              static_cast<unsigned long long>(fingerprint));
   return 0;
 }
