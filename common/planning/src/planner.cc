@@ -136,6 +136,10 @@ struct Planner::Impl {
     Eigen::MatrixXd Hinv;  // m x m inverse smoothness Hessian (unweighted)
     std::vector<int> steps;
     const HumanPrediction* prediction = nullptr;
+    // Exact bounds of the waypoints no optimiser changes (the frozen prefix
+    // 0..k-1 and the goal n; size n+1, free entries unused), computed once
+    // per attempt by FixBounds.
+    std::vector<double> fixed_bounds;
     double prediction_dt = 0.1, prediction_start = 0.0;
     bool perturb_base = true;
   };
@@ -187,8 +191,9 @@ struct Planner::Impl {
     if (at.prediction != nullptr) {
       ws->spheres.radii = radii;
       ws->spheres.links = links;
-      ws->spheres.centres.resize(3, static_cast<Eigen::Index>(W) * radii.size());
-      ws->spheres.steps = at.steps;
+      // Only the free waypoints k..n-1: the others never change (FixBounds).
+      ws->spheres.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
+      ws->spheres.steps.assign(at.steps.begin() + at.k, at.steps.begin() + at.n);
       if (!ws->bound_ws)
         ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(
             static_cast<int>(radii.size()), at.prediction->num_spheres());
@@ -250,13 +255,12 @@ struct Planner::Impl {
         }
       }
     }
-    // Forward kinematics (all waypoints if a prediction is present, else the free ones).
+    // Forward kinematics of the free waypoints (the only ones the costs use).
     const int S = static_cast<int>(radii.size());
-    const int first_fk = at.prediction ? 0 : k;
-    for (int i = first_fk; i <= n; ++i) {
+    for (int i = k; i < n; ++i) {
       collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
       if (at.prediction)
-        ws->spheres.centres.middleCols(static_cast<Eigen::Index>(i) * S, S) = ws->data[i].p_WS;
+        ws->spheres.centres.middleCols(static_cast<Eigen::Index>(i - k) * S, S) = ws->data[i].p_WS;
     }
     // Static obstacles.
     const double margin = params.obstacle_margin;
@@ -282,12 +286,20 @@ struct Planner::Impl {
     }
     // Dynamic obstacle (the person).
     if (at.prediction) {
+      // Bounds of the free waypoints only (ev->bounds[i - k]). Pairs whose
+      // upper bound is below tau are not evaluated exactly: a waypoint whose
+      // bound is <= tau costs nothing and has no gradient, and one above tau
+      // gets the same exact value and argmax pair as with the default
+      // (see EvaluateTrajectoryBound's pruning); reported values below tau
+      // are upper bounds, which also keeps the safety test (>= 1 - delta_CL
+      // > tau) unchanged. Exact values for the result: ExactBounds.
+      const double tau = params.dynamic_activation * Threshold();
       collision::TrajectoryBoundParams bp;
+      bp.negligible = tau * (1.0 - 1e-9);
       collision::EvaluateTrajectoryBound(*at.prediction, ws->spheres, bp, ws->bound_ws.get(),
                                          &ev->bounds);
-      const double tau = params.dynamic_activation * Threshold();
       for (int i = k; i < n; ++i) {
-        const collision::WaypointBound& wb = ev->bounds[i];
+        const collision::WaypointBound& wb = ev->bounds[i - k];
         if (wb.bound <= tau) continue;
         ev->dynamic += w.dynamic * (wb.bound - tau) * (wb.bound - tau);
         if (!G || wb.robot_sphere < 0) continue;
@@ -357,13 +369,45 @@ struct Planner::Impl {
     c->max_bound = 0.0;
     c->first_unsafe = -1;
     if (at.prediction) {
-      for (const auto& b : ev.bounds) c->bounds.push_back(b.bound);
+      c->bounds = at.fixed_bounds;
+      for (int i = at.k; i < at.n; ++i) c->bounds[i] = ev.bounds[i - at.k].bound;
       for (int i = at.k; i <= at.n; ++i) {
         c->max_bound = std::max(c->max_bound, c->bounds[i]);
         if (c->first_unsafe < 0 && c->bounds[i] >= Threshold()) c->first_unsafe = i;
       }
     }
     c->safe = c->first_unsafe < 0;
+  }
+
+  // Exact bounds (default TrajectoryBoundParams) of the waypoints [from, to]
+  // of Q into (*out)[from..to]; *out must have Q.cols() entries.
+  void ExactBounds(const Attempt& at, const Eigen::MatrixXd& Q, int from, int to,
+                   std::vector<double>* out) const {
+    const int S = static_cast<int>(radii.size());
+    collision::RobotSpheresTrajectory rs;
+    rs.radii = radii;
+    rs.links = links;
+    rs.centres.resize(3, static_cast<Eigen::Index>(to - from + 1) * S);
+    RobotData d(robot);
+    for (int i = from; i <= to; ++i) {
+      collision::CalcForwardKinematics(robot, Q.col(i), &d);
+      rs.centres.middleCols(static_cast<Eigen::Index>(i - from) * S, S) = d.p_WS;
+      rs.steps.push_back(at.steps[i]);
+    }
+    collision::TrajectoryBoundWorkspace bw(S, at.prediction->num_spheres());
+    std::vector<collision::WaypointBound> wb;
+    collision::EvaluateTrajectoryBound(*at.prediction, rs, collision::TrajectoryBoundParams{}, &bw,
+                                       &wb);
+    for (int i = from; i <= to; ++i) (*out)[i] = wb[i - from].bound;
+  }
+
+  // Bounds of the frozen prefix and the goal of at->base (unchanged by the
+  // optimisers).
+  void FixBounds(Attempt* at) const {
+    at->fixed_bounds.assign(at->n + 1, 0.0);
+    if (!at->prediction) return;
+    ExactBounds(*at, at->base, 0, at->k - 1, &at->fixed_bounds);
+    ExactBounds(*at, at->base, at->n, at->n, &at->fixed_bounds);
   }
 
   // One optimiser: initial trajectory from the base (perturbed for o > 0),
@@ -730,6 +774,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
         I.Project(at, &at.base);
       }
     }
+    I.FixBounds(&at);
     std::vector<Impl::Candidate> cands = I.RunAll(at, num_optimizers, num_threads, seed, t0);
     int win = -1, num_ok = 0;
     int ref = -1;  // lowest-cost statically feasible candidate
@@ -849,6 +894,13 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
         << (lim.empty() ? "limits ok" : lim) << ", clearance " << best_fail.min_clearance << " m";
       result.reason = s.str();
     }
+  }
+  // The optimisers' bounds below the dynamic cost's activation are upper
+  // bounds (see Evaluate); report exact values for the returned trajectory.
+  if (at.prediction && result.positions.cols() == at.n + 1) {
+    I.ExactBounds(at, result.positions, 0, at.n, &result.bounds);
+    result.max_bound = 0.0;
+    for (int i = at.k; i <= at.n; ++i) result.max_bound = std::max(result.max_bound, result.bounds[i]);
   }
   result.planning_time = Seconds(t0, Clock::now());
   return result;
