@@ -123,6 +123,8 @@ struct Planner::Impl {
   std::vector<std::vector<char>> checked;  // [sphere][object]
   std::vector<double> radii;
   std::vector<int> links;
+  // Robot spheres grouped by link (for culling waypoints far from the person).
+  std::vector<std::vector<int>> link_groups;
   int ee_link = -1;
   Eigen::Vector3d ee_offset = Eigen::Vector3d::Zero();
   Eigen::VectorXd lower, upper, vmax, amax;
@@ -154,6 +156,9 @@ struct Planner::Impl {
     collision::RobotSpheresTrajectory spheres;
     std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
     Eigen::MatrixXd A, V, G;
+    std::vector<double> group_log_volume;  // [group * H + human sphere]
+    std::vector<int> active;               // free waypoints passed to the bound
+    std::vector<collision::WaypointBound> active_bounds;
   };
 
   struct Candidate {
@@ -193,10 +198,21 @@ struct Planner::Impl {
       ws->spheres.links = links;
       // Only the free waypoints k..n-1: the others never change (FixBounds).
       ws->spheres.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
-      ws->spheres.steps.assign(at.steps.begin() + at.k, at.steps.begin() + at.n);
+      ws->spheres.steps.reserve(at.n - at.k);
+      ws->active.reserve(at.n - at.k);
+      ws->active_bounds.reserve(at.n - at.k);
       if (!ws->bound_ws)
         ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(
             static_cast<int>(radii.size()), at.prediction->num_spheres());
+      const int H = at.prediction->num_spheres();
+      ws->group_log_volume.resize(link_groups.size() * H);
+      for (std::size_t g = 0; g < link_groups.size(); ++g) {
+        double r = 0.0;
+        for (int sp : link_groups[g]) r = std::max(r, radii[sp]);
+        for (int l = 0; l < H; ++l)
+          ws->group_log_volume[g * H + l] =
+              std::log(collision::BallVolume(r + at.prediction->radius(l)));
+      }
     }
   }
 
@@ -257,11 +273,7 @@ struct Planner::Impl {
     }
     // Forward kinematics of the free waypoints (the only ones the costs use).
     const int S = static_cast<int>(radii.size());
-    for (int i = k; i < n; ++i) {
-      collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
-      if (at.prediction)
-        ws->spheres.centres.middleCols(static_cast<Eigen::Index>(i - k) * S, S) = ws->data[i].p_WS;
-    }
+    for (int i = k; i < n; ++i) collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
     // Static obstacles.
     const double margin = params.obstacle_margin;
     for (int i = k; i < n; ++i) {
@@ -296,8 +308,58 @@ struct Planner::Impl {
       const double tau = params.dynamic_activation * Threshold();
       collision::TrajectoryBoundParams bp;
       bp.negligible = tau * (1.0 - 1e-9);
-      collision::EvaluateTrajectoryBound(*at.prediction, ws->spheres, bp, ws->bound_ws.get(),
-                                         &ev->bounds);
+      // Waypoints where every pair's level-1 upper bound (the library's
+      // first pruning test) is <= negligible contribute nothing; they are
+      // recognised per link group (a ball around the link's spheres; every
+      // sphere's level-1 bound is at most the group's) and not passed on.
+      const HumanPrediction& hp = *at.prediction;
+      const int H = hp.num_spheres();
+      const double log_negligible = std::log(bp.negligible);
+      const double log_psum = std::log(hp.probability_sum());
+      ws->active.clear();
+      for (int i = k; i < n; ++i) {
+        const int t = at.steps[i];
+        const RobotData& d = ws->data[i];
+        bool may_matter = false;
+        for (std::size_t g = 0; g < link_groups.size() && !may_matter; ++g) {
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (int sp : link_groups[g]) c += d.p_WS.col(sp);
+          c /= static_cast<double>(link_groups[g].size());
+          double cover = 0.0;
+          for (int sp : link_groups[g]) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+          for (int l = 0; l < H; ++l) {
+            const HumanPrediction::Summary& sm = hp.summary(t, l);
+            const double delta =
+                std::max(0.0, (sm.centre - c).norm() - sm.spread - cover - hp.radius(l));
+            const double lu = log_psum + std::min(0.0, ws->group_log_volume[g * H + l] +
+                                                           sm.max_log_peak -
+                                                           delta * delta * sm.half_inverse_max_eigenvalue);
+            if (lu > log_negligible) {
+              may_matter = true;
+              break;
+            }
+          }
+        }
+        if (may_matter) ws->active.push_back(i);
+      }
+      const int num_active = static_cast<int>(ws->active.size());
+      ev->bounds.assign(n - k, collision::WaypointBound{});
+      for (auto& b : ev->bounds) {
+        b.bound = bp.negligible;  // an upper bound of the culled waypoints
+        b.exact = false;
+      }
+      if (num_active > 0) {
+        ws->spheres.centres.resize(3, static_cast<Eigen::Index>(num_active) * S);
+        ws->spheres.steps.clear();
+        for (int a = 0; a < num_active; ++a) {
+          const int i = ws->active[a];
+          ws->spheres.centres.middleCols(static_cast<Eigen::Index>(a) * S, S) = ws->data[i].p_WS;
+          ws->spheres.steps.push_back(at.steps[i]);
+        }
+        collision::EvaluateTrajectoryBound(hp, ws->spheres, bp, ws->bound_ws.get(),
+                                           &ws->active_bounds);
+        for (int a = 0; a < num_active; ++a) ev->bounds[ws->active[a] - k] = ws->active_bounds[a];
+      }
       for (int i = k; i < n; ++i) {
         const collision::WaypointBound& wb = ev->bounds[i - k];
         if (wb.bound <= tau) continue;
@@ -542,6 +604,14 @@ Planner::Planner(RobotModel robot, collision::SceneParams scene, PlannerParams p
   for (const auto& s : I.robot.spheres) {
     I.radii.push_back(s.radius);
     I.links.push_back(s.link);
+  }
+  for (std::size_t s = 0; s < I.radii.size(); ++s) {
+    auto g = std::find_if(I.link_groups.begin(), I.link_groups.end(),
+                          [&](const std::vector<int>& v) { return I.links[v[0]] == I.links[s]; });
+    if (g == I.link_groups.end())
+      I.link_groups.push_back({static_cast<int>(s)});
+    else
+      g->push_back(static_cast<int>(s));
   }
   I.checked.assign(I.radii.size(), std::vector<char>(I.objects.size(), 1));
   for (const auto& [link_name, object_name] : I.params.allowed_collisions) {
