@@ -125,6 +125,7 @@ struct Planner::Impl {
   std::vector<int> links;
   // Robot spheres grouped by link (for culling waypoints far from the person).
   std::vector<std::vector<int>> link_groups;
+  std::vector<int> sphere_group;  // group of each sphere
   int ee_link = -1;
   Eigen::Vector3d ee_offset = Eigen::Vector3d::Zero();
   Eigen::VectorXd lower, upper, vmax, amax;
@@ -153,11 +154,13 @@ struct Planner::Impl {
 
   struct Workspace {
     std::vector<RobotData> data;
-    collision::RobotSpheresTrajectory spheres;
     std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
     Eigen::MatrixXd A, V, G;
     std::vector<double> group_log_volume;  // [group * H + human sphere]
     std::vector<int> active;               // free waypoints passed to the bound
+    std::vector<char> group_needed;        // link groups passed to the bound
+    collision::RobotSpheresTrajectory sub;  // their spheres at the active waypoints
+    std::vector<int> sub_spheres;          // sphere index of each sub sphere
     std::vector<collision::WaypointBound> active_bounds;
   };
 
@@ -194,11 +197,13 @@ struct Planner::Impl {
     const int W = at.n + 1;
     while (static_cast<int>(ws->data.size()) < W) ws->data.emplace_back(robot);
     if (at.prediction != nullptr) {
-      ws->spheres.radii = radii;
-      ws->spheres.links = links;
-      // Only the free waypoints k..n-1: the others never change (FixBounds).
-      ws->spheres.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
-      ws->spheres.steps.reserve(at.n - at.k);
+      // Only the free waypoints k..n-1 are evaluated: the others never
+      // change (FixBounds).
+      ws->sub.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
+      ws->sub.steps.reserve(at.n - at.k);
+      ws->sub.radii.reserve(radii.size());
+      ws->sub.links.reserve(radii.size());
+      ws->sub_spheres.reserve(radii.size());
       ws->active.reserve(at.n - at.k);
       ws->active_bounds.reserve(at.n - at.k);
       if (!ws->bound_ws)
@@ -286,10 +291,13 @@ struct Planner::Impl {
           if (!checked[s][o]) continue;
           const auto& ob = objects[o];
           if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= margin) continue;
-          Eigen::Vector3d n_W;
-          const double dist = internal::PointSignedDistance(ob, p, &n_W) - radii[s];
+          // The normal only for spheres within the margin (the same distance).
+          const double dist = internal::PointSignedDistance(ob, p, nullptr) - radii[s];
           if (dist >= margin) continue;
           ev->obstacle += w.obstacle * (margin - dist) * (margin - dist);
+          if (!G) continue;
+          Eigen::Vector3d n_W;
+          internal::PointSignedDistance(ob, p, &n_W);
           gp -= 2.0 * w.obstacle * (margin - dist) * n_W;
           any = true;
         }
@@ -317,11 +325,12 @@ struct Planner::Impl {
       const double log_negligible = std::log(bp.negligible);
       const double log_psum = std::log(hp.probability_sum());
       ws->active.clear();
+      ws->group_needed.assign(link_groups.size(), 0);
       for (int i = k; i < n; ++i) {
         const int t = at.steps[i];
         const RobotData& d = ws->data[i];
         bool may_matter = false;
-        for (std::size_t g = 0; g < link_groups.size() && !may_matter; ++g) {
+        for (std::size_t g = 0; g < link_groups.size(); ++g) {
           Eigen::Vector3d c = Eigen::Vector3d::Zero();
           for (int sp : link_groups[g]) c += d.p_WS.col(sp);
           c /= static_cast<double>(link_groups[g].size());
@@ -336,6 +345,7 @@ struct Planner::Impl {
                                                            delta * delta * sm.half_inverse_max_eigenvalue);
             if (lu > log_negligible) {
               may_matter = true;
+              ws->group_needed[g] = 1;
               break;
             }
           }
@@ -349,16 +359,35 @@ struct Planner::Impl {
         b.exact = false;
       }
       if (num_active > 0) {
-        ws->spheres.centres.resize(3, static_cast<Eigen::Index>(num_active) * S);
-        ws->spheres.steps.clear();
+        // Only the spheres of links that may matter at some active waypoint,
+        // in their original order: the others' pairs would all be skipped as
+        // negligible, so the maximum and its argmax pair are unchanged.
+        collision::RobotSpheresTrajectory& sub = ws->sub;
+        ws->sub_spheres.clear();
+        sub.radii.clear();
+        sub.links.clear();
+        for (int sp = 0; sp < S; ++sp) {
+          if (!ws->group_needed[sphere_group[sp]]) continue;
+          ws->sub_spheres.push_back(sp);
+          sub.radii.push_back(radii[sp]);
+          sub.links.push_back(links[sp]);
+        }
+        const int SS = static_cast<int>(ws->sub_spheres.size());
+        sub.centres.resize(3, static_cast<Eigen::Index>(num_active) * SS);
+        sub.steps.clear();
         for (int a = 0; a < num_active; ++a) {
           const int i = ws->active[a];
-          ws->spheres.centres.middleCols(static_cast<Eigen::Index>(a) * S, S) = ws->data[i].p_WS;
-          ws->spheres.steps.push_back(at.steps[i]);
+          for (int j = 0; j < SS; ++j)
+            sub.centres.col(static_cast<Eigen::Index>(a) * SS + j) =
+                ws->data[i].p_WS.col(ws->sub_spheres[j]);
+          sub.steps.push_back(at.steps[i]);
         }
-        collision::EvaluateTrajectoryBound(hp, ws->spheres, bp, ws->bound_ws.get(),
-                                           &ws->active_bounds);
-        for (int a = 0; a < num_active; ++a) ev->bounds[ws->active[a] - k] = ws->active_bounds[a];
+        collision::EvaluateTrajectoryBound(hp, sub, bp, ws->bound_ws.get(), &ws->active_bounds);
+        for (int a = 0; a < num_active; ++a) {
+          collision::WaypointBound b = ws->active_bounds[a];
+          if (b.robot_sphere >= 0) b.robot_sphere = ws->sub_spheres[b.robot_sphere];
+          ev->bounds[ws->active[a] - k] = b;
+        }
       }
       for (int i = k; i < n; ++i) {
         const collision::WaypointBound& wb = ev->bounds[i - k];
@@ -613,6 +642,9 @@ Planner::Planner(RobotModel robot, collision::SceneParams scene, PlannerParams p
     else
       g->push_back(static_cast<int>(s));
   }
+  I.sphere_group.assign(I.radii.size(), 0);
+  for (std::size_t g = 0; g < I.link_groups.size(); ++g)
+    for (int s : I.link_groups[g]) I.sphere_group[s] = static_cast<int>(g);
   I.checked.assign(I.radii.size(), std::vector<char>(I.objects.size(), 1));
   for (const auto& [link_name, object_name] : I.params.allowed_collisions) {
     const int link = I.robot.FindLink(link_name);
