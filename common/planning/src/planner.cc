@@ -503,12 +503,23 @@ struct Planner::Impl {
 
   // One optimiser: initial trajectory from the base (perturbed for o > 0),
   // covariant gradient descent with backtracking, feasibility check.
-  Candidate RunOptimizer(const Attempt& at, int o, std::uint64_t seed, Workspace* ws,
-                         Clock::time_point t0) const {
-    PrepareWorkspace(at, ws);
-    std::mt19937_64 rng(SplitMix(seed ^ SplitMix(static_cast<std::uint64_t>(o) + 1)));
+  // State of one optimiser between rounds (see RunAll).
+  struct OptState {
+    Eigen::MatrixXd Q, G, G_new, Qn;
+    Eval ev, ev_new;
+    int iterations = 0;   // accepted iterations so far
+    bool started = false;
+    bool done = false;    // converged, stuck or at max_iterations
+    bool checked = false; // `c` describes the current Q
     Candidate c;
-    Eigen::MatrixXd Q = at.base;
+  };
+
+  // Initial trajectory from the base (perturbed for o > 0) and its cost.
+  void StartOptimizer(const Attempt& at, int o, std::uint64_t seed, Workspace* ws,
+                      OptState* st) const {
+    std::mt19937_64 rng(SplitMix(seed ^ SplitMix(static_cast<std::uint64_t>(o) + 1)));
+    Eigen::MatrixXd& Q = st->Q;
+    Q = at.base;
     if (o > 0 && at.perturb_base) {
       std::normal_distribution<double> nd(0.0, params.initial_perturbation);
       Eigen::VectorXd delta(at.nq);
@@ -523,56 +534,99 @@ struct Planner::Impl {
       }
       Project(at, &Q);
     }
-    Eval ev, ev_new;
-    Eigen::MatrixXd G, G_new, Qn;
-    Evaluate(at, Q, ws, &ev, &G);
+    Evaluate(at, Q, ws, &st->ev, &st->G);
+    st->started = true;
+  }
+
+  // Covariant gradient descent with backtracking until `until` accepted
+  // iterations (or convergence / no decrease / max_iterations).
+  void IterateOptimizer(const Attempt& at, int until, Workspace* ws, OptState* st) const {
     const double inv_ws = 1.0 / params.weights.smoothness;
-    for (int it = 0; it < params.max_iterations; ++it) {
-      const Eigen::MatrixXd D = G.middleCols(at.k, at.m) * at.Hinv * inv_ws;
+    until = std::min(until, params.max_iterations);
+    while (!st->done && st->iterations < until) {
+      const Eigen::MatrixXd D = st->G.middleCols(at.k, at.m) * at.Hinv * inv_ws;
       double alpha = params.step_size;
       bool accepted = false;
       for (int ls = 0; ls < 6; ++ls) {
-        Qn = Q;
-        Qn.middleCols(at.k, at.m) -= alpha * D;
-        Project(at, &Qn);
-        Evaluate(at, Qn, ws, &ev_new, &G_new);
-        if (ev_new.total < ev.total) {
+        st->Qn = st->Q;
+        st->Qn.middleCols(at.k, at.m) -= alpha * D;
+        Project(at, &st->Qn);
+        Evaluate(at, st->Qn, ws, &st->ev_new, &st->G_new);
+        if (st->ev_new.total < st->ev.total) {
           accepted = true;
           break;
         }
         alpha *= 0.5;
       }
-      if (!accepted) break;
-      const double rel = (ev.total - ev_new.total) / std::max(ev.total, 1e-12);
-      Q.swap(Qn);
-      G.swap(G_new);
-      std::swap(ev, ev_new);
-      if (rel < params.convergence_tolerance) break;
+      if (!accepted) {
+        st->done = true;
+        break;
+      }
+      const double rel = (st->ev.total - st->ev_new.total) / std::max(st->ev.total, 1e-12);
+      st->Q.swap(st->Qn);
+      st->G.swap(st->G_new);
+      std::swap(st->ev, st->ev_new);
+      st->checked = false;
+      ++st->iterations;
+      if (rel < params.convergence_tolerance) st->done = true;
     }
-    c.Q = Q;
-    c.cost = ev.total;
-    Check(at, ev, ws, &c);
-    if (c.static_ok && c.safe) c.first_feasible_time = Seconds(t0, Clock::now());
-    return c;
+    if (st->iterations >= params.max_iterations) st->done = true;
   }
 
+  // Feasibility of the current Q (once per Q).
+  void CheckOptimizer(const Attempt& at, Workspace* ws, OptState* st, Clock::time_point t0) const {
+    if (st->checked) return;
+    Candidate& c = st->c;
+    c.Q = st->Q;
+    c.cost = st->ev.total;
+    Check(at, st->ev, ws, &c);
+    if (c.static_ok && c.safe && c.first_feasible_time < 0.0)
+      c.first_feasible_time = Seconds(t0, Clock::now());
+    st->checked = true;
+  }
+
+  // Runs the optimisers on up to num_threads threads. With
+  // early_stop_interval = K > 0 they advance in rounds of K iterations; after
+  // each round (all optimisers at the same iteration budget) every optimiser
+  // is checked, and if one is feasible and safe all stop. The decision uses
+  // only the optimisers' states at the round's end, never the order in which
+  // threads finish, so the result is the same for any thread count. K = 0:
+  // one round, every optimiser runs to convergence.
   std::vector<Candidate> RunAll(const Attempt& at, int num_opt, int num_threads,
                                 std::uint64_t seed, Clock::time_point t0) const {
-    std::vector<Candidate> out(num_opt);
     const int workers = std::max(1, std::min(num_threads <= 0 ? num_opt : num_threads, num_opt));
-    std::atomic<int> next{0};
-    auto work = [&]() {
-      Workspace ws;
-      for (int o = next.fetch_add(1); o < num_opt; o = next.fetch_add(1))
-        out[o] = RunOptimizer(at, o, seed, &ws, t0);
-    };
-    if (workers == 1) {
-      work();
-    } else {
-      std::vector<std::thread> threads;
-      for (int t = 0; t < workers; ++t) threads.emplace_back(work);
-      for (auto& t : threads) t.join();
+    const int K = params.early_stop_interval > 0 ? params.early_stop_interval : params.max_iterations;
+    std::vector<OptState> st(num_opt);
+    std::vector<Workspace> wss(workers);
+    for (auto& ws : wss) PrepareWorkspace(at, &ws);
+    for (int round = 1;; ++round) {
+      const int until = round * K;
+      std::atomic<int> next{0};
+      auto work = [&](int t) {
+        Workspace* ws = &wss[t];
+        for (int o = next.fetch_add(1); o < num_opt; o = next.fetch_add(1)) {
+          OptState& s = st[o];
+          if (!s.started) StartOptimizer(at, o, seed, ws, &s);
+          IterateOptimizer(at, until, ws, &s);
+          CheckOptimizer(at, ws, &s, t0);
+        }
+      };
+      if (workers == 1) {
+        work(0);
+      } else {
+        std::vector<std::thread> threads;
+        for (int t = 0; t < workers; ++t) threads.emplace_back(work, t);
+        for (auto& t : threads) t.join();
+      }
+      bool all_done = true, any_ok = false;
+      for (const auto& s : st) {
+        all_done = all_done && s.done;
+        any_ok = any_ok || (s.c.static_ok && s.c.safe);
+      }
+      if (all_done || any_ok || until >= params.max_iterations) break;
     }
+    std::vector<Candidate> out(num_opt);
+    for (int o = 0; o < num_opt; ++o) out[o] = std::move(st[o].c);
     return out;
   }
 
