@@ -159,6 +159,7 @@ struct Planner::Impl {
     std::vector<double> group_log_volume;  // [group * H + human sphere]
     std::vector<int> active;               // free waypoints passed to the bound
     std::vector<char> group_needed;        // link groups passed to the bound
+    std::vector<char> far;                 // [group * objects + object]: beyond the margin
     collision::RobotSpheresTrajectory sub;  // their spheres at the active waypoints
     std::vector<int> sub_spheres;          // sphere index of each sub sphere
     std::vector<collision::WaypointBound> active_bounds;
@@ -180,14 +181,26 @@ struct Planner::Impl {
 
   // Minimum signed distance of all checked spheres at the FK in `data`.
   double Clearance(const RobotData& data) const {
+    // Per link, a ball around its spheres first (the signed distance is
+    // 1-Lipschitz; 1e-9 against rounding): links that cannot go below the
+    // best so far are skipped. The minimum is the same.
     double best = std::numeric_limits<double>::infinity();
-    for (int s = 0; s < static_cast<int>(radii.size()); ++s) {
-      const Eigen::Vector3d p = data.p_WS.col(s);
+    for (const std::vector<int>& grp : link_groups) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int sp : grp) c += data.p_WS.col(sp);
+      c /= static_cast<double>(grp.size());
+      double cover = 0.0;
+      for (int sp : grp) cover = std::max(cover, (data.p_WS.col(sp) - c).norm() + radii[sp]);
       for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
-        if (!checked[s][o]) continue;
+        if (!checked[grp[0]][o]) continue;  // allowed pairs are per link
         const auto& ob = objects[o];
-        if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= best) continue;
-        best = std::min(best, internal::PointSignedDistance(ob, p, nullptr) - radii[s]);
+        if ((c - ob.centre_W).norm() - ob.bounding_radius - cover >= best + 1e-9) continue;
+        if (internal::PointSignedDistance(ob, c, nullptr) - cover >= best + 1e-9) continue;
+        for (int s : grp) {
+          const Eigen::Vector3d p = data.p_WS.col(s);
+          if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= best) continue;
+          best = std::min(best, internal::PointSignedDistance(ob, p, nullptr) - radii[s]);
+        }
       }
     }
     return best;
@@ -279,16 +292,36 @@ struct Planner::Impl {
     // Forward kinematics of the free waypoints (the only ones the costs use).
     const int S = static_cast<int>(radii.size());
     for (int i = k; i < n; ++i) collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
-    // Static obstacles.
+    // Static obstacles. Per link, a ball around its spheres first: the
+    // signed distance is 1-Lipschitz, so when the ball's centre is farther
+    // than its cover radius + margin (+ 1e-9 against rounding) from an
+    // object, none of the link's spheres is within the margin of it.
     const double margin = params.obstacle_margin;
+    const int NO = static_cast<int>(objects.size());
+    const int NG = static_cast<int>(link_groups.size());
+    ws->far.resize(static_cast<std::size_t>(NG) * NO);
     for (int i = k; i < n; ++i) {
       const RobotData& d = ws->data[i];
+      for (int g = 0; g < NG; ++g) {
+        const std::vector<int>& grp = link_groups[g];
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (int sp : grp) c += d.p_WS.col(sp);
+        c /= static_cast<double>(grp.size());
+        double cover = 0.0;
+        for (int sp : grp) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+        for (int o = 0; o < NO; ++o) {
+          const auto& ob = objects[o];
+          double lower = (c - ob.centre_W).norm() - ob.bounding_radius - cover;
+          if (lower < margin + 1e-9) lower = internal::PointSignedDistance(ob, c, nullptr) - cover;
+          ws->far[g * NO + o] = lower >= margin + 1e-9;
+        }
+      }
       for (int s = 0; s < S; ++s) {
         const Eigen::Vector3d p = d.p_WS.col(s);
         Eigen::Vector3d gp = Eigen::Vector3d::Zero();
         bool any = false;
-        for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
-          if (!checked[s][o]) continue;
+        for (int o = 0; o < NO; ++o) {
+          if (!checked[s][o] || ws->far[sphere_group[s] * NO + o]) continue;
           const auto& ob = objects[o];
           if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= margin) continue;
           // The normal only for spheres within the margin (the same distance).
