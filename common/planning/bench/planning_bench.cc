@@ -15,6 +15,7 @@
 //    The cycle time is the wall time of Planner::Plan.
 #include <algorithm>
 #include <chrono>
+#include <cstdint>
 #include <cstdio>
 #include <random>
 #include <vector>
@@ -33,6 +34,20 @@ double Pct(std::vector<double> v, double p) {
   std::sort(v.begin(), v.end());
   const std::size_t i = std::min(v.size() - 1, static_cast<std::size_t>(p * (v.size() - 1) + 0.5));
   return v[i];
+}
+
+// FNV-1a over the bytes of a result's trajectory, cost and bounds: a
+// fingerprint that changes only when results change (for checking that a
+// speed-up is output-preserving).
+void Fingerprint(const PlanningResult& r, std::uint64_t* h) {
+  auto mix = [h](const void* p, std::size_t n) {
+    const unsigned char* b = static_cast<const unsigned char*>(p);
+    for (std::size_t i = 0; i < n; ++i) *h = (*h ^ b[i]) * 1099511628211ULL;
+  };
+  mix(r.positions.data(), sizeof(double) * r.positions.size());
+  mix(&r.cost, sizeof r.cost);
+  mix(r.bounds.data(), sizeof(double) * r.bounds.size());
+  mix(&r.num_waits, sizeof r.num_waits);
 }
 
 struct Problem {
@@ -89,6 +104,7 @@ int main(int argc, char** argv) {
   std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
               "%d worker threads, dt %.2f s, horizon %.1f s\n",
               num_problems, ik_rejected, threads, params.dt, params.horizon);
+  std::uint64_t fingerprint = 14695981039346656037ULL;
   for (int nopt : {8, 1}) {
     int ok = 0, ok_1s = 0;
     std::vector<double> t_first, t_total, cost;
@@ -98,6 +114,7 @@ int main(int argc, char** argv) {
       req.goal = problems[i].goal;
       const PlanningResult r = planner.Plan(req, nopt, std::min(threads, nopt), 1000 + i);
       t_total.push_back(r.planning_time);
+      Fingerprint(r, &fingerprint);
       if (r.success) {
         ++ok;
         if (r.planning_time <= 1.0) ++ok_1s;
@@ -122,10 +139,13 @@ int main(int argc, char** argv) {
   for (int c = 0; c < 10; ++c)
     targets.emplace_back(0.78 + 0.03 * (c % 3), -0.45 + 0.1 * c, 0.20 + 0.02 * (c % 4));
   // Replanning configuration: one wait per cycle (the next cycle replans
-  // anyway) and fewer iterations, since the warm start is already good.
+  // anyway) and fewer iterations, since the warm start is already good; all
+  // optimisers stop after the first 3-iteration round in which one of them is
+  // feasible and safe (deterministic, see PlannerParams::early_stop_interval).
   PlannerParams replan_params = params;
   replan_params.max_waits = 1;
   replan_params.max_iterations = 30;
+  replan_params.early_stop_interval = 3;
   Planner replanner(robot, testing::LoadCell(), replan_params);
   std::vector<double> cycle;
   int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
@@ -152,6 +172,7 @@ int main(int argc, char** argv) {
       }
       const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
       cycle.push_back(r.planning_time);
+      Fingerprint(r, &fingerprint);
       total_waits += r.num_waits;
       if (!r.success) {
         ++cycles_failed;
@@ -162,11 +183,13 @@ int main(int argc, char** argv) {
     }
     tasks_ok += task_ok;
   }
-  std::printf("replanning (max_waits 1, max_iterations 30): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
+  std::printf("replanning (max_waits 1, max_iterations 30, early_stop_interval 3): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
               tasks, cycles_per_task, threads, body.num_spheres());
   std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
               1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
   std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
               cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+  std::printf("results fingerprint %016llx (same seeds and results => same value)\n",
+              static_cast<unsigned long long>(fingerprint));
   return 0;
 }

@@ -123,6 +123,9 @@ struct Planner::Impl {
   std::vector<std::vector<char>> checked;  // [sphere][object]
   std::vector<double> radii;
   std::vector<int> links;
+  // Robot spheres grouped by link (for culling waypoints far from the person).
+  std::vector<std::vector<int>> link_groups;
+  std::vector<int> sphere_group;  // group of each sphere
   int ee_link = -1;
   Eigen::Vector3d ee_offset = Eigen::Vector3d::Zero();
   Eigen::VectorXd lower, upper, vmax, amax;
@@ -136,6 +139,10 @@ struct Planner::Impl {
     Eigen::MatrixXd Hinv;  // m x m inverse smoothness Hessian (unweighted)
     std::vector<int> steps;
     const HumanPrediction* prediction = nullptr;
+    // Exact bounds of the waypoints no optimiser changes (the frozen prefix
+    // 0..k-1 and the goal n; size n+1, free entries unused), computed once
+    // per attempt by FixBounds.
+    std::vector<double> fixed_bounds;
     double prediction_dt = 0.1, prediction_start = 0.0;
     bool perturb_base = true;
   };
@@ -147,9 +154,15 @@ struct Planner::Impl {
 
   struct Workspace {
     std::vector<RobotData> data;
-    collision::RobotSpheresTrajectory spheres;
     std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
     Eigen::MatrixXd A, V, G;
+    std::vector<double> group_log_volume;  // [group * H + human sphere]
+    std::vector<int> active;               // free waypoints passed to the bound
+    std::vector<char> group_needed;        // link groups passed to the bound
+    std::vector<char> far;                 // [group * objects + object]: beyond the margin
+    collision::RobotSpheresTrajectory sub;  // their spheres at the active waypoints
+    std::vector<int> sub_spheres;          // sphere index of each sub sphere
+    std::vector<collision::WaypointBound> active_bounds;
   };
 
   struct Candidate {
@@ -168,14 +181,26 @@ struct Planner::Impl {
 
   // Minimum signed distance of all checked spheres at the FK in `data`.
   double Clearance(const RobotData& data) const {
+    // Per link, a ball around its spheres first (the signed distance is
+    // 1-Lipschitz; 1e-9 against rounding): links that cannot go below the
+    // best so far are skipped. The minimum is the same.
     double best = std::numeric_limits<double>::infinity();
-    for (int s = 0; s < static_cast<int>(radii.size()); ++s) {
-      const Eigen::Vector3d p = data.p_WS.col(s);
+    for (const std::vector<int>& grp : link_groups) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (int sp : grp) c += data.p_WS.col(sp);
+      c /= static_cast<double>(grp.size());
+      double cover = 0.0;
+      for (int sp : grp) cover = std::max(cover, (data.p_WS.col(sp) - c).norm() + radii[sp]);
       for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
-        if (!checked[s][o]) continue;
+        if (!checked[grp[0]][o]) continue;  // allowed pairs are per link
         const auto& ob = objects[o];
-        if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= best) continue;
-        best = std::min(best, internal::PointSignedDistance(ob, p, nullptr) - radii[s]);
+        if ((c - ob.centre_W).norm() - ob.bounding_radius - cover >= best + 1e-9) continue;
+        if (internal::PointSignedDistance(ob, c, nullptr) - cover >= best + 1e-9) continue;
+        for (int s : grp) {
+          const Eigen::Vector3d p = data.p_WS.col(s);
+          if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= best) continue;
+          best = std::min(best, internal::PointSignedDistance(ob, p, nullptr) - radii[s]);
+        }
       }
     }
     return best;
@@ -185,13 +210,27 @@ struct Planner::Impl {
     const int W = at.n + 1;
     while (static_cast<int>(ws->data.size()) < W) ws->data.emplace_back(robot);
     if (at.prediction != nullptr) {
-      ws->spheres.radii = radii;
-      ws->spheres.links = links;
-      ws->spheres.centres.resize(3, static_cast<Eigen::Index>(W) * radii.size());
-      ws->spheres.steps = at.steps;
+      // Only the free waypoints k..n-1 are evaluated: the others never
+      // change (FixBounds).
+      ws->sub.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
+      ws->sub.steps.reserve(at.n - at.k);
+      ws->sub.radii.reserve(radii.size());
+      ws->sub.links.reserve(radii.size());
+      ws->sub_spheres.reserve(radii.size());
+      ws->active.reserve(at.n - at.k);
+      ws->active_bounds.reserve(at.n - at.k);
       if (!ws->bound_ws)
         ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(
             static_cast<int>(radii.size()), at.prediction->num_spheres());
+      const int H = at.prediction->num_spheres();
+      ws->group_log_volume.resize(link_groups.size() * H);
+      for (std::size_t g = 0; g < link_groups.size(); ++g) {
+        double r = 0.0;
+        for (int sp : link_groups[g]) r = std::max(r, radii[sp]);
+        for (int l = 0; l < H; ++l)
+          ws->group_log_volume[g * H + l] =
+              std::log(collision::BallVolume(r + at.prediction->radius(l)));
+      }
     }
   }
 
@@ -250,30 +289,48 @@ struct Planner::Impl {
         }
       }
     }
-    // Forward kinematics (all waypoints if a prediction is present, else the free ones).
+    // Forward kinematics of the free waypoints (the only ones the costs use).
     const int S = static_cast<int>(radii.size());
-    const int first_fk = at.prediction ? 0 : k;
-    for (int i = first_fk; i <= n; ++i) {
-      collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
-      if (at.prediction)
-        ws->spheres.centres.middleCols(static_cast<Eigen::Index>(i) * S, S) = ws->data[i].p_WS;
-    }
-    // Static obstacles.
+    for (int i = k; i < n; ++i) collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
+    // Static obstacles. Per link, a ball around its spheres first: the
+    // signed distance is 1-Lipschitz, so when the ball's centre is farther
+    // than its cover radius + margin (+ 1e-9 against rounding) from an
+    // object, none of the link's spheres is within the margin of it.
     const double margin = params.obstacle_margin;
+    const int NO = static_cast<int>(objects.size());
+    const int NG = static_cast<int>(link_groups.size());
+    ws->far.resize(static_cast<std::size_t>(NG) * NO);
     for (int i = k; i < n; ++i) {
       const RobotData& d = ws->data[i];
+      for (int g = 0; g < NG; ++g) {
+        const std::vector<int>& grp = link_groups[g];
+        Eigen::Vector3d c = Eigen::Vector3d::Zero();
+        for (int sp : grp) c += d.p_WS.col(sp);
+        c /= static_cast<double>(grp.size());
+        double cover = 0.0;
+        for (int sp : grp) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+        for (int o = 0; o < NO; ++o) {
+          const auto& ob = objects[o];
+          double lower = (c - ob.centre_W).norm() - ob.bounding_radius - cover;
+          if (lower < margin + 1e-9) lower = internal::PointSignedDistance(ob, c, nullptr) - cover;
+          ws->far[g * NO + o] = lower >= margin + 1e-9;
+        }
+      }
       for (int s = 0; s < S; ++s) {
         const Eigen::Vector3d p = d.p_WS.col(s);
         Eigen::Vector3d gp = Eigen::Vector3d::Zero();
         bool any = false;
-        for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
-          if (!checked[s][o]) continue;
+        for (int o = 0; o < NO; ++o) {
+          if (!checked[s][o] || ws->far[sphere_group[s] * NO + o]) continue;
           const auto& ob = objects[o];
           if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= margin) continue;
-          Eigen::Vector3d n_W;
-          const double dist = internal::PointSignedDistance(ob, p, &n_W) - radii[s];
+          // The normal only for spheres within the margin (the same distance).
+          const double dist = internal::PointSignedDistance(ob, p, nullptr) - radii[s];
           if (dist >= margin) continue;
           ev->obstacle += w.obstacle * (margin - dist) * (margin - dist);
+          if (!G) continue;
+          Eigen::Vector3d n_W;
+          internal::PointSignedDistance(ob, p, &n_W);
           gp -= 2.0 * w.obstacle * (margin - dist) * n_W;
           any = true;
         }
@@ -282,12 +339,91 @@ struct Planner::Impl {
     }
     // Dynamic obstacle (the person).
     if (at.prediction) {
-      collision::TrajectoryBoundParams bp;
-      collision::EvaluateTrajectoryBound(*at.prediction, ws->spheres, bp, ws->bound_ws.get(),
-                                         &ev->bounds);
+      // Bounds of the free waypoints only (ev->bounds[i - k]). Pairs whose
+      // upper bound is below tau are not evaluated exactly: a waypoint whose
+      // bound is <= tau costs nothing and has no gradient, and one above tau
+      // gets the same exact value and argmax pair as with the default
+      // (see EvaluateTrajectoryBound's pruning); reported values below tau
+      // are upper bounds, which also keeps the safety test (>= 1 - delta_CL
+      // > tau) unchanged. Exact values for the result: ExactBounds.
       const double tau = params.dynamic_activation * Threshold();
+      collision::TrajectoryBoundParams bp;
+      bp.negligible = tau * (1.0 - 1e-9);
+      // Waypoints where every pair's level-1 upper bound (the library's
+      // first pruning test) is <= negligible contribute nothing; they are
+      // recognised per link group (a ball around the link's spheres; every
+      // sphere's level-1 bound is at most the group's) and not passed on.
+      const HumanPrediction& hp = *at.prediction;
+      const int H = hp.num_spheres();
+      const double log_negligible = std::log(bp.negligible);
+      const double log_psum = std::log(hp.probability_sum());
+      ws->active.clear();
+      ws->group_needed.assign(link_groups.size(), 0);
       for (int i = k; i < n; ++i) {
-        const collision::WaypointBound& wb = ev->bounds[i];
+        const int t = at.steps[i];
+        const RobotData& d = ws->data[i];
+        bool may_matter = false;
+        for (std::size_t g = 0; g < link_groups.size(); ++g) {
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (int sp : link_groups[g]) c += d.p_WS.col(sp);
+          c /= static_cast<double>(link_groups[g].size());
+          double cover = 0.0;
+          for (int sp : link_groups[g]) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+          for (int l = 0; l < H; ++l) {
+            const HumanPrediction::Summary& sm = hp.summary(t, l);
+            const double delta =
+                std::max(0.0, (sm.centre - c).norm() - sm.spread - cover - hp.radius(l));
+            const double lu = log_psum + std::min(0.0, ws->group_log_volume[g * H + l] +
+                                                           sm.max_log_peak -
+                                                           delta * delta * sm.half_inverse_max_eigenvalue);
+            if (lu > log_negligible) {
+              may_matter = true;
+              ws->group_needed[g] = 1;
+              break;
+            }
+          }
+        }
+        if (may_matter) ws->active.push_back(i);
+      }
+      const int num_active = static_cast<int>(ws->active.size());
+      ev->bounds.assign(n - k, collision::WaypointBound{});
+      for (auto& b : ev->bounds) {
+        b.bound = bp.negligible;  // an upper bound of the culled waypoints
+        b.exact = false;
+      }
+      if (num_active > 0) {
+        // Only the spheres of links that may matter at some active waypoint,
+        // in their original order: the others' pairs would all be skipped as
+        // negligible, so the maximum and its argmax pair are unchanged.
+        collision::RobotSpheresTrajectory& sub = ws->sub;
+        ws->sub_spheres.clear();
+        sub.radii.clear();
+        sub.links.clear();
+        for (int sp = 0; sp < S; ++sp) {
+          if (!ws->group_needed[sphere_group[sp]]) continue;
+          ws->sub_spheres.push_back(sp);
+          sub.radii.push_back(radii[sp]);
+          sub.links.push_back(links[sp]);
+        }
+        const int SS = static_cast<int>(ws->sub_spheres.size());
+        sub.centres.resize(3, static_cast<Eigen::Index>(num_active) * SS);
+        sub.steps.clear();
+        for (int a = 0; a < num_active; ++a) {
+          const int i = ws->active[a];
+          for (int j = 0; j < SS; ++j)
+            sub.centres.col(static_cast<Eigen::Index>(a) * SS + j) =
+                ws->data[i].p_WS.col(ws->sub_spheres[j]);
+          sub.steps.push_back(at.steps[i]);
+        }
+        collision::EvaluateTrajectoryBound(hp, sub, bp, ws->bound_ws.get(), &ws->active_bounds);
+        for (int a = 0; a < num_active; ++a) {
+          collision::WaypointBound b = ws->active_bounds[a];
+          if (b.robot_sphere >= 0) b.robot_sphere = ws->sub_spheres[b.robot_sphere];
+          ev->bounds[ws->active[a] - k] = b;
+        }
+      }
+      for (int i = k; i < n; ++i) {
+        const collision::WaypointBound& wb = ev->bounds[i - k];
         if (wb.bound <= tau) continue;
         ev->dynamic += w.dynamic * (wb.bound - tau) * (wb.bound - tau);
         if (!G || wb.robot_sphere < 0) continue;
@@ -357,7 +493,8 @@ struct Planner::Impl {
     c->max_bound = 0.0;
     c->first_unsafe = -1;
     if (at.prediction) {
-      for (const auto& b : ev.bounds) c->bounds.push_back(b.bound);
+      c->bounds = at.fixed_bounds;
+      for (int i = at.k; i < at.n; ++i) c->bounds[i] = ev.bounds[i - at.k].bound;
       for (int i = at.k; i <= at.n; ++i) {
         c->max_bound = std::max(c->max_bound, c->bounds[i]);
         if (c->first_unsafe < 0 && c->bounds[i] >= Threshold()) c->first_unsafe = i;
@@ -366,14 +503,56 @@ struct Planner::Impl {
     c->safe = c->first_unsafe < 0;
   }
 
+  // Exact bounds (default TrajectoryBoundParams) of the waypoints [from, to]
+  // of Q into (*out)[from..to]; *out must have Q.cols() entries.
+  void ExactBounds(const Attempt& at, const Eigen::MatrixXd& Q, int from, int to,
+                   std::vector<double>* out) const {
+    const int S = static_cast<int>(radii.size());
+    collision::RobotSpheresTrajectory rs;
+    rs.radii = radii;
+    rs.links = links;
+    rs.centres.resize(3, static_cast<Eigen::Index>(to - from + 1) * S);
+    RobotData d(robot);
+    for (int i = from; i <= to; ++i) {
+      collision::CalcForwardKinematics(robot, Q.col(i), &d);
+      rs.centres.middleCols(static_cast<Eigen::Index>(i - from) * S, S) = d.p_WS;
+      rs.steps.push_back(at.steps[i]);
+    }
+    collision::TrajectoryBoundWorkspace bw(S, at.prediction->num_spheres());
+    std::vector<collision::WaypointBound> wb;
+    collision::EvaluateTrajectoryBound(*at.prediction, rs, collision::TrajectoryBoundParams{}, &bw,
+                                       &wb);
+    for (int i = from; i <= to; ++i) (*out)[i] = wb[i - from].bound;
+  }
+
+  // Bounds of the frozen prefix and the goal of at->base (unchanged by the
+  // optimisers).
+  void FixBounds(Attempt* at) const {
+    at->fixed_bounds.assign(at->n + 1, 0.0);
+    if (!at->prediction) return;
+    ExactBounds(*at, at->base, 0, at->k - 1, &at->fixed_bounds);
+    ExactBounds(*at, at->base, at->n, at->n, &at->fixed_bounds);
+  }
+
   // One optimiser: initial trajectory from the base (perturbed for o > 0),
   // covariant gradient descent with backtracking, feasibility check.
-  Candidate RunOptimizer(const Attempt& at, int o, std::uint64_t seed, Workspace* ws,
-                         Clock::time_point t0) const {
-    PrepareWorkspace(at, ws);
-    std::mt19937_64 rng(SplitMix(seed ^ SplitMix(static_cast<std::uint64_t>(o) + 1)));
+  // State of one optimiser between rounds (see RunAll).
+  struct OptState {
+    Eigen::MatrixXd Q, G, G_new, Qn;
+    Eval ev, ev_new;
+    int iterations = 0;   // accepted iterations so far
+    bool started = false;
+    bool done = false;    // converged, stuck or at max_iterations
+    bool checked = false; // `c` describes the current Q
     Candidate c;
-    Eigen::MatrixXd Q = at.base;
+  };
+
+  // Initial trajectory from the base (perturbed for o > 0) and its cost.
+  void StartOptimizer(const Attempt& at, int o, std::uint64_t seed, Workspace* ws,
+                      OptState* st) const {
+    std::mt19937_64 rng(SplitMix(seed ^ SplitMix(static_cast<std::uint64_t>(o) + 1)));
+    Eigen::MatrixXd& Q = st->Q;
+    Q = at.base;
     if (o > 0 && at.perturb_base) {
       std::normal_distribution<double> nd(0.0, params.initial_perturbation);
       Eigen::VectorXd delta(at.nq);
@@ -388,56 +567,99 @@ struct Planner::Impl {
       }
       Project(at, &Q);
     }
-    Eval ev, ev_new;
-    Eigen::MatrixXd G, G_new, Qn;
-    Evaluate(at, Q, ws, &ev, &G);
+    Evaluate(at, Q, ws, &st->ev, &st->G);
+    st->started = true;
+  }
+
+  // Covariant gradient descent with backtracking until `until` accepted
+  // iterations (or convergence / no decrease / max_iterations).
+  void IterateOptimizer(const Attempt& at, int until, Workspace* ws, OptState* st) const {
     const double inv_ws = 1.0 / params.weights.smoothness;
-    for (int it = 0; it < params.max_iterations; ++it) {
-      const Eigen::MatrixXd D = G.middleCols(at.k, at.m) * at.Hinv * inv_ws;
+    until = std::min(until, params.max_iterations);
+    while (!st->done && st->iterations < until) {
+      const Eigen::MatrixXd D = st->G.middleCols(at.k, at.m) * at.Hinv * inv_ws;
       double alpha = params.step_size;
       bool accepted = false;
       for (int ls = 0; ls < 6; ++ls) {
-        Qn = Q;
-        Qn.middleCols(at.k, at.m) -= alpha * D;
-        Project(at, &Qn);
-        Evaluate(at, Qn, ws, &ev_new, &G_new);
-        if (ev_new.total < ev.total) {
+        st->Qn = st->Q;
+        st->Qn.middleCols(at.k, at.m) -= alpha * D;
+        Project(at, &st->Qn);
+        Evaluate(at, st->Qn, ws, &st->ev_new, &st->G_new);
+        if (st->ev_new.total < st->ev.total) {
           accepted = true;
           break;
         }
         alpha *= 0.5;
       }
-      if (!accepted) break;
-      const double rel = (ev.total - ev_new.total) / std::max(ev.total, 1e-12);
-      Q.swap(Qn);
-      G.swap(G_new);
-      std::swap(ev, ev_new);
-      if (rel < params.convergence_tolerance) break;
+      if (!accepted) {
+        st->done = true;
+        break;
+      }
+      const double rel = (st->ev.total - st->ev_new.total) / std::max(st->ev.total, 1e-12);
+      st->Q.swap(st->Qn);
+      st->G.swap(st->G_new);
+      std::swap(st->ev, st->ev_new);
+      st->checked = false;
+      ++st->iterations;
+      if (rel < params.convergence_tolerance) st->done = true;
     }
-    c.Q = Q;
-    c.cost = ev.total;
-    Check(at, ev, ws, &c);
-    if (c.static_ok && c.safe) c.first_feasible_time = Seconds(t0, Clock::now());
-    return c;
+    if (st->iterations >= params.max_iterations) st->done = true;
   }
 
+  // Feasibility of the current Q (once per Q).
+  void CheckOptimizer(const Attempt& at, Workspace* ws, OptState* st, Clock::time_point t0) const {
+    if (st->checked) return;
+    Candidate& c = st->c;
+    c.Q = st->Q;
+    c.cost = st->ev.total;
+    Check(at, st->ev, ws, &c);
+    if (c.static_ok && c.safe && c.first_feasible_time < 0.0)
+      c.first_feasible_time = Seconds(t0, Clock::now());
+    st->checked = true;
+  }
+
+  // Runs the optimisers on up to num_threads threads. With
+  // early_stop_interval = K > 0 they advance in rounds of K iterations; after
+  // each round (all optimisers at the same iteration budget) every optimiser
+  // is checked, and if one is feasible and safe all stop. The decision uses
+  // only the optimisers' states at the round's end, never the order in which
+  // threads finish, so the result is the same for any thread count. K = 0:
+  // one round, every optimiser runs to convergence.
   std::vector<Candidate> RunAll(const Attempt& at, int num_opt, int num_threads,
                                 std::uint64_t seed, Clock::time_point t0) const {
-    std::vector<Candidate> out(num_opt);
     const int workers = std::max(1, std::min(num_threads <= 0 ? num_opt : num_threads, num_opt));
-    std::atomic<int> next{0};
-    auto work = [&]() {
-      Workspace ws;
-      for (int o = next.fetch_add(1); o < num_opt; o = next.fetch_add(1))
-        out[o] = RunOptimizer(at, o, seed, &ws, t0);
-    };
-    if (workers == 1) {
-      work();
-    } else {
-      std::vector<std::thread> threads;
-      for (int t = 0; t < workers; ++t) threads.emplace_back(work);
-      for (auto& t : threads) t.join();
+    const int K = params.early_stop_interval > 0 ? params.early_stop_interval : params.max_iterations;
+    std::vector<OptState> st(num_opt);
+    std::vector<Workspace> wss(workers);
+    for (auto& ws : wss) PrepareWorkspace(at, &ws);
+    for (int round = 1;; ++round) {
+      const int until = round * K;
+      std::atomic<int> next{0};
+      auto work = [&](int t) {
+        Workspace* ws = &wss[t];
+        for (int o = next.fetch_add(1); o < num_opt; o = next.fetch_add(1)) {
+          OptState& s = st[o];
+          if (!s.started) StartOptimizer(at, o, seed, ws, &s);
+          IterateOptimizer(at, until, ws, &s);
+          CheckOptimizer(at, ws, &s, t0);
+        }
+      };
+      if (workers == 1) {
+        work(0);
+      } else {
+        std::vector<std::thread> threads;
+        for (int t = 0; t < workers; ++t) threads.emplace_back(work, t);
+        for (auto& t : threads) t.join();
+      }
+      bool all_done = true, any_ok = false;
+      for (const auto& s : st) {
+        all_done = all_done && s.done;
+        any_ok = any_ok || (s.c.static_ok && s.c.safe);
+      }
+      if (all_done || any_ok || until >= params.max_iterations) break;
     }
+    std::vector<Candidate> out(num_opt);
+    for (int o = 0; o < num_opt; ++o) out[o] = std::move(st[o].c);
     return out;
   }
 
@@ -499,6 +721,17 @@ Planner::Planner(RobotModel robot, collision::SceneParams scene, PlannerParams p
     I.radii.push_back(s.radius);
     I.links.push_back(s.link);
   }
+  for (std::size_t s = 0; s < I.radii.size(); ++s) {
+    auto g = std::find_if(I.link_groups.begin(), I.link_groups.end(),
+                          [&](const std::vector<int>& v) { return I.links[v[0]] == I.links[s]; });
+    if (g == I.link_groups.end())
+      I.link_groups.push_back({static_cast<int>(s)});
+    else
+      g->push_back(static_cast<int>(s));
+  }
+  I.sphere_group.assign(I.radii.size(), 0);
+  for (std::size_t g = 0; g < I.link_groups.size(); ++g)
+    for (int s : I.link_groups[g]) I.sphere_group[s] = static_cast<int>(g);
   I.checked.assign(I.radii.size(), std::vector<char>(I.objects.size(), 1));
   for (const auto& [link_name, object_name] : I.params.allowed_collisions) {
     const int link = I.robot.FindLink(link_name);
@@ -730,6 +963,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
         I.Project(at, &at.base);
       }
     }
+    I.FixBounds(&at);
     std::vector<Impl::Candidate> cands = I.RunAll(at, num_optimizers, num_threads, seed, t0);
     int win = -1, num_ok = 0;
     int ref = -1;  // lowest-cost statically feasible candidate
@@ -849,6 +1083,13 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
         << (lim.empty() ? "limits ok" : lim) << ", clearance " << best_fail.min_clearance << " m";
       result.reason = s.str();
     }
+  }
+  // The optimisers' bounds below the dynamic cost's activation are upper
+  // bounds (see Evaluate); report exact values for the returned trajectory.
+  if (at.prediction && result.positions.cols() == at.n + 1) {
+    I.ExactBounds(at, result.positions, 0, at.n, &result.bounds);
+    result.max_bound = 0.0;
+    for (int i = at.k; i <= at.n; ++i) result.max_bound = std::max(result.max_bound, result.bounds[i]);
   }
   result.planning_time = Seconds(t0, Clock::now());
   return result;

@@ -31,6 +31,8 @@ std::string PlannerParams::Validate() const {
   if (num_optimizers < 1) return "num_optimizers must be >= 1, got " + std::to_string(num_optimizers);
   if (num_threads < 0) return "num_threads must be >= 0, got " + std::to_string(num_threads);
   if (max_iterations < 1) return "max_iterations must be >= 1, got " + std::to_string(max_iterations);
+  if (early_stop_interval < 0)
+    return "early_stop_interval must be >= 0, got " + std::to_string(early_stop_interval);
   if (!nonneg(convergence_tolerance))
     return "convergence_tolerance must be >= 0, got " + Num(convergence_tolerance);
   if (!(step_size > 0.0 && step_size <= 1.0)) return "step_size must be in (0, 1], got " + Num(step_size);
@@ -109,6 +111,7 @@ PlannerParams LoadPlannerParams(const std::string& path) {
     else if (key == "seed") p.seed = Read<std::uint64_t>(v, key, path);
     else if (key == "max_iterations") ri(&p.max_iterations);
     else if (key == "convergence_tolerance") rd(&p.convergence_tolerance);
+    else if (key == "early_stop_interval") ri(&p.early_stop_interval);
     else if (key == "step_size") rd(&p.step_size);
     else if (key == "initial_perturbation") rd(&p.initial_perturbation);
     else if (key == "obstacle_margin") rd(&p.obstacle_margin);

@@ -61,6 +61,13 @@ TEST(PlannerParams, LoadsValuesAndRejectsUnknownKeys) {
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("num_optimizers"), std::string::npos) << e.what();
   }
+  EXPECT_EQ(LoadPlannerParams(Write("es.yaml", "early_stop_interval: 3\n")).early_stop_interval, 3);
+  try {
+    LoadPlannerParams(Write("bad4.yaml", "early_stop_interval: -1\n"));
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("early_stop_interval"), std::string::npos) << e.what();
+  }
   try {
     LoadPlannerParams(Write("bad3.yaml", "horizon: 0.01\n"));
     FAIL();

@@ -176,6 +176,57 @@ TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
   }
 }
 
+TEST_F(PlannerTest, EarlyStopIsBitIdenticalForAnyThreadCountAndValid) {
+  // Rounds of 2 iterations: the optimisers stop at the first round with a
+  // feasible and safe one, decided on their states only.
+  PlannerParams p;
+  p.early_stop_interval = 2;
+  const Planner planner(robot_, scene_params_, p);
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  // The person reaches on their own side of the table.
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.80, 0.0, 0.25}, {0.85, -0.2, 0.2}}, 15);
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.prediction = &pred;
+  const PlanningResult a = planner.Plan(req, 6, 1, 42);
+  ASSERT_TRUE(a.success) << a.reason;
+  ExpectValid(a, req.start_q);
+  for (double b : a.bounds) EXPECT_LT(b, 1.0 - p.delta_cl);
+  for (int threads : {2, 3, 6}) {
+    const PlanningResult b = planner.Plan(req, 6, threads, 42);
+    EXPECT_TRUE(a.positions == b.positions) << threads << " threads";
+    EXPECT_EQ(a.cost, b.cost);
+    EXPECT_EQ(a.winning_optimizer, b.winning_optimizer);
+    EXPECT_EQ(a.num_feasible, b.num_feasible);
+    EXPECT_EQ(a.bounds, b.bounds);
+  }
+}
+
+TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
+  // The prediction blocks the shelf goal: every attempt fails, so no round
+  // ends early and the result equals the run without early stop.
+  PlannerParams p;
+  p.early_stop_interval = 2;
+  const Planner planner(robot_, scene_params_, p);
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
+  req.prediction = &pred;
+  const PlanningResult a = planner.Plan(req, 4, 2, 42);
+  const PlanningResult b = planner_.Plan(req, 4, 2, 42);
+  ASSERT_FALSE(a.success);
+  EXPECT_EQ(a.status, PlanStatus::kNoSafeTrajectory);
+  EXPECT_TRUE(a.positions == b.positions);
+  EXPECT_EQ(a.cost, b.cost);
+  EXPECT_EQ(a.num_waits, b.num_waits);
+}
+
 TEST_F(PlannerTest, OneAndManyOptimisersAreValid) {
   PlanningRequest req;
   req.start_q = Ready();

@@ -1,7 +1,7 @@
-#include <stdexcept>
 #include "test_util.h"
 
 #include <cmath>
+#include <stdexcept>
 #include <string>
 
 namespace iplan::planning::testing {
@@ -40,7 +40,9 @@ collision::HumanPrediction MakeReachingPrediction(const collision::HumanBodyMode
   auto J = [&](const std::string& n) {
     for (std::size_t i = 0; i < names.size(); ++i)
       if (names[i] == n) return static_cast<int>(i);
-    return -1;
+    // A silent -1 once left the arms at the origin (the robot base) after the
+    // body model's joint names changed; fail loudly instead.
+    throw std::invalid_argument("MakeReachingPrediction: body model has no joint '" + n + "'");
   };
   Eigen::Matrix3Xd rest(3, body.num_joints());
   rest.setZero();
@@ -51,10 +53,7 @@ collision::HumanPrediction MakeReachingPrediction(const collision::HumanBodyMode
       {"shoulder_r", {1.15, -0.20, 0.55}}, {"elbow_r", {1.05, -0.25, 0.32}},
       {"hand_r", {0.95, -0.25, 0.20}}};
   for (const auto& [n, p] : pose) {
-    const int j = J(n);
-    // A silently skipped joint would leave it at the origin.
-    if (j < 0) throw std::logic_error(std::string("body model has no joint '") + n + "'");
-    rest.col(j) = p + off;
+    rest.col(J(n)) = p + off;
   }
   double wsum = 0.0;
   for (int c = 0; c < na; ++c) wsum += std::pow(0.6, c);
@@ -65,9 +64,8 @@ collision::HumanPrediction MakeReachingPrediction(const collision::HumanBodyMode
       const double u = num_steps > 1 ? static_cast<double>(s) / (num_steps - 1) : 1.0;
       Eigen::Matrix3Xd m = rest;
       const int hand = J("hand_r"), elbow = J("elbow_r"), sh = J("shoulder_r");
-      if (hand >= 0) m.col(hand) = (1.0 - u) * rest.col(hand) + u * targets[c];
-      if (elbow >= 0 && sh >= 0 && hand >= 0)
-        m.col(elbow) = 0.5 * (m.col(sh) + m.col(hand)) + Eigen::Vector3d(0.0, 0.0, -0.05);
+      m.col(hand) = (1.0 - u) * rest.col(hand) + u * targets[c];
+      m.col(elbow) = 0.5 * (m.col(sh) + m.col(hand)) + Eigen::Vector3d(0.0, 0.0, -0.05);
       const double sd = sigma0 + (sigma1 - sigma0) * u;
       for (auto& cv : covs) cv = sd * sd * Eigen::Matrix3d::Identity();
       body.FillPrediction(m, covs, c, s, &pred);

@@ -42,6 +42,14 @@ struct PlannerParams {
   /// An optimiser stops early when feasible and the relative cost decrease of
   /// an iteration is below this (>= 0).
   double convergence_tolerance = 1e-4;
+  /// Deterministic early stop (>= 0): with K > 0 the optimisers advance in
+  /// rounds of K iterations and all stop after the first round in which one
+  /// of them is feasible and safe (the winner is then chosen as usual among
+  /// the feasible ones); 0 = every optimiser runs to convergence. Rounds are
+  /// decided on the optimisers' states only, so results do not depend on the
+  /// thread count. Meant for replanning (a good warm start is usually feasible
+  /// at once); it trades final cost for time.
+  int early_stop_interval = 0;
   /// Step size of the covariant update x -= step * H^-1 grad, in (0, 1].
   double step_size = 0.5;
   /// Std-dev (rad) of the random via-point offset of optimisers 1..N-1.
