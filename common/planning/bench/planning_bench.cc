@@ -13,6 +13,9 @@
 //    (0.1 s). Every cycle (m = 0.1 s) the previous trajectory is shifted by
 //    0.1 s and warm-starts the planner with the first 3 waypoints frozen.
 //    The cycle time is the wall time of Planner::Plan.
+#include <functional>
+#include <map>
+#include <stdexcept>
 #include <algorithm>
 #include <chrono>
 #include <cstdint>
@@ -21,6 +24,7 @@
 #include <vector>
 
 #include "../test/test_util.h"
+#include "iplan/intent/skeleton_data.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/planning/planner.h"
 
@@ -57,6 +61,97 @@ struct Problem {
 };
 
 }  // namespace
+
+
+// Recorded arm motion at 10 Hz in the cell frame (W): shoulders, elbows and
+// wrists from the file, neck/head/torso derived from the shoulders.
+struct RecordedPerson {
+  std::vector<std::map<std::string, Eigen::Vector3d>> frames;  // at 0.1 s
+};
+
+RecordedPerson LoadRecordedPerson(const std::string& csv, const std::string& sequence) {
+  const intent::SkeletonDataset data = intent::LoadSkeletonCsv(csv);
+  const intent::SkeletonSequence* seq = nullptr;
+  for (const auto& s : data.sequences) {
+    if (s.id == sequence) seq = &s;
+  }
+  if (!seq) throw std::runtime_error(csv + ": no sequence " + sequence);
+  auto col = [&](const std::string& name) {
+    for (std::size_t j = 0; j < data.joint_names.size(); ++j) {
+      if (data.joint_names[j] == name) return static_cast<int>(j);
+    }
+    throw std::runtime_error(csv + ": no joint " + name);
+  };
+  const std::pair<const char*, const char*> map[] = {{"shoulder_l", "shoulder_l"}, {"elbow_l", "elbow_l"},
+                                                     {"hand_l", "wrist_l"},         {"shoulder_r", "shoulder_r"},
+                                                     {"elbow_r", "elbow_r"},        {"hand_r", "wrist_r"}};
+  // Sensor frame (optical: x right, y down, z away from the camera, which
+  // faces the person from the robot's side) to the cell: z -> +x, x -> -y,
+  // y -> -z; the mean shoulder centre goes to (1.05, 0, 0.5) m.
+  Eigen::Matrix3d R_WS;
+  R_WS << 0, 0, 1, -1, 0, 0, 0, -1, 0;
+  Eigen::Vector3d centre_S = Eigen::Vector3d::Zero();
+  int n = 0;
+  std::map<std::string, Eigen::Vector3d> last;
+  RecordedPerson out;
+  std::vector<std::map<std::string, Eigen::Vector3d>> raw;
+  for (double t = 0; t <= seq->time[seq->time.size() - 1]; t += 0.1) {
+    Eigen::Index i = 0;
+    while (i + 1 < seq->time.size() && seq->time[i + 1] <= t) ++i;
+    std::map<std::string, Eigen::Vector3d> f;
+    for (const auto& [ours, theirs] : map) {
+      const Eigen::Vector3d p = seq->positions.row(i).segment<3>(3 * col(theirs)).transpose();
+      if (intent::JointDetected(p.transpose())) last[ours] = p;
+      if (last.count(ours)) f[ours] = last[ours];  // undetected: hold the last seen position
+    }
+    if (f.size() == 6) {
+      centre_S += 0.5 * (f["shoulder_l"] + f["shoulder_r"]);
+      ++n;
+      raw.push_back(f);
+    }
+  }
+  centre_S /= n;
+  const Eigen::Vector3d centre_W(1.05, 0.0, 0.5);
+  for (auto& f : raw) {
+    std::map<std::string, Eigen::Vector3d> w;
+    for (auto& [name, p] : f) w[name] = centre_W + R_WS * (p - centre_S);
+    const Eigen::Vector3d neck = 0.5 * (w["shoulder_l"] + w["shoulder_r"]);
+    w["neck"] = neck;
+    w["head"] = neck + Eigen::Vector3d(0, 0, 0.2);
+    w["torso"] = neck + Eigen::Vector3d(0, 0, -0.3);
+    out.frames.push_back(w);
+  }
+  return out;
+}
+
+// The prediction at cycle k: the recorded future (15 steps of 0.1 s) as the
+// most likely action's means, 9 more actions shifted by a few centimetres
+// with weights 0.6^c, sigma growing from 3 to 6 cm; the person is moved by
+// `y` m sideways.
+collision::HumanPrediction RecordedPrediction(const collision::HumanBodyModel& body, const RecordedPerson& person,
+                                              int k, double y) {
+  const int na = 10, steps = 15;
+  collision::HumanPrediction pred = body.MakePrediction(na, steps);
+  double wsum = 0;
+  for (int c = 0; c < na; ++c) wsum += std::pow(0.6, c);
+  Eigen::Matrix3Xd means(3, body.num_joints());
+  std::vector<Eigen::Matrix3d> covs(static_cast<std::size_t>(body.num_joints()));
+  for (int c = 0; c < na; ++c) {
+    pred.set_action_probability(c, std::pow(0.6, c) / wsum);
+    const Eigen::Vector3d shift(-0.02 * (c % 3), 0.03 * ((c % 5) - 2), 0.02 * (c % 2));
+    for (int s = 0; s < steps; ++s) {
+      const auto& f = person.frames[std::min(person.frames.size() - 1, static_cast<std::size_t>(k + s + 1))];
+      const double sigma = 0.03 + 0.03 * s / (steps - 1);
+      for (int j = 0; j < body.num_joints(); ++j) {
+        means.col(j) = f.at(body.params().joints[static_cast<std::size_t>(j)]) + shift + Eigen::Vector3d(0, y, 0);
+        covs[static_cast<std::size_t>(j)] = sigma * sigma * Eigen::Matrix3d::Identity();
+      }
+      body.FillPrediction(means, covs, c, s, &pred);
+    }
+  }
+  pred.UpdateSummaries();
+  return pred;
+}
 
 int main(int argc, char** argv) {
   const int num_problems = argc > 1 ? std::atoi(argv[1]) : 60;
@@ -147,48 +242,61 @@ int main(int argc, char** argv) {
   replan_params.max_iterations = 30;
   replan_params.early_stop_interval = 3;
   Planner replanner(robot, testing::LoadCell(), replan_params);
-  std::vector<double> cycle;
-  int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
-  const int cycles_per_task = 25;
-  for (std::size_t i = 0; i < problems.size() && tasks < 12; i += 5, ++tasks) {
-    PlanningRequest req;
-    req.start_q = problems[i].start;
-    req.goal = problems[i].goal;
-    PlanningResult prev;
-    bool task_ok = true;
-    for (int k = 0; k < cycles_per_task; ++k) {
-      const double y = -0.5 + 1.0 * k / (cycles_per_task - 1);
-      const collision::HumanPrediction pred = testing::MakeReachingPrediction(
-          body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
-      req.prediction = &pred;
-      req.prediction_dt = 0.1;
-      req.prediction_start = 0.0;
-      if (k > 0 && prev.positions.cols() > 1) {
-        req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
-        req.start_q = req.warm_start.col(0);
-        req.start_qdot = (prev.positions.col(2) - prev.positions.col(1)) / prev.dt;
-        req.num_frozen = 3;
-        req.goal = Goal::Joint(prev.goal_q);
+  // Runs 12 tasks x 25 replanning cycles; `make(k)` is the prediction at cycle k.
+  auto run_replanning = [&](const char* label,
+                            const std::function<collision::HumanPrediction(int)>& make) {
+    std::vector<double> cycle;
+    int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
+    const int cycles_per_task = 25;
+    for (std::size_t i = 0; i < problems.size() && tasks < 12; i += 5, ++tasks) {
+      PlanningRequest req;
+      req.start_q = problems[i].start;
+      req.goal = problems[i].goal;
+      PlanningResult prev;
+      bool task_ok = true;
+      for (int k = 0; k < cycles_per_task; ++k) {
+        const collision::HumanPrediction pred = make(k);
+        req.prediction = &pred;
+        req.prediction_dt = 0.1;
+        req.prediction_start = 0.0;
+        if (k > 0 && prev.positions.cols() > 1) {
+          req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
+          req.start_q = req.warm_start.col(0);
+          req.start_qdot = (prev.positions.col(2) - prev.positions.col(1)) / prev.dt;
+          req.num_frozen = 3;
+          req.goal = Goal::Joint(prev.goal_q);
+        }
+        const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
+        cycle.push_back(r.planning_time);
+        Fingerprint(r, &fingerprint);
+        total_waits += r.num_waits;
+        if (!r.success) {
+          ++cycles_failed;
+          task_ok = false;
+          if (r.positions.cols() == 0) break;
+        }
+        prev = r;
       }
-      const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
-      cycle.push_back(r.planning_time);
-      Fingerprint(r, &fingerprint);
-      total_waits += r.num_waits;
-      if (!r.success) {
-        ++cycles_failed;
-        task_ok = false;
-        if (r.positions.cols() == 0) break;
-      }
-      prev = r;
+      tasks_ok += task_ok;
     }
-    tasks_ok += task_ok;
-  }
-  std::printf("replanning (max_waits 1, max_iterations 30, early_stop_interval 3): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
-              tasks, cycles_per_task, threads, body.num_spheres());
-  std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
-              1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
-  std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
-              cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+    std::printf("replanning, %s (max_waits 1, max_iterations 30, early_stop_interval 3): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
+                label, tasks, cycles_per_task, threads, body.num_spheres());
+    std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
+                1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
+    std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
+                cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+  };
+  run_replanning("synthesised reaching person", [&](int k) {
+    const double y = -0.5 + 1.0 * k / 24;
+    return testing::MakeReachingPrediction(body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
+  });
+  // A recorded person: arm motion of assembly.csv (RealSense + OpenPose,
+  // human1, task1 trial1) placed across the table and walking sideways.
+  const RecordedPerson person = LoadRecordedPerson(std::string(IPLAN_SHARED_DIR) + "/data/assembly.csv",
+                                                   "task1_human1_trial1");
+  run_replanning("recorded person (assembly.csv task1_human1_trial1)", [&](int k) {
+    return RecordedPrediction(body, person, k, -0.5 + 1.0 * k / 24);
+  });
   std::printf("results fingerprint %016llx (same seeds and results => same value)\n",
               static_cast<unsigned long long>(fingerprint));
   return 0;
