@@ -13,6 +13,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/framework/node.h"
+#include "test_node.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -61,13 +62,8 @@ TEST_F(CellFault, KillNineOfEachServiceStopsTheRobotAndTheCellResumes) {
                                                      {"supervisor", "fastdds"}};
   for (const auto& [name, v] : vendor) svc[name] = Start(name, v);
 
-  dds::ParticipantOptions o;
-  o.vendor = dds::Vendor::kCyclone;
-  o.domain_id = std::stoi(domain_);
-  auto p = dds::Participant::Create(o);
-  framework::NodeOptions no;
-  no.diagnostics_period = 0;
-  framework::Node node("observer", *p, no);
+  TestNode observer("observer", dds::Vendor::kCyclone, std::stoi(domain_));
+  framework::Node& node = *observer.node;
   struct Cmd {
     Clock::time_point at;
     msg::SafetyCommand c;

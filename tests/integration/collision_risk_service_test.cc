@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/framework/node.h"
+#include "test_node.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -42,13 +43,8 @@ struct Scenario {
 std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
   const int domain = UniqueDomain(41 + static_cast<int>(sc.velocity.norm() * 10));
   Process svc({BinPath("iplan-collision-risk"), "--dds", "fastdds", "--domain", std::to_string(domain)});
-  dds::ParticipantOptions o;
-  o.vendor = dds::Vendor::kCyclone;
-  o.domain_id = domain;
-  auto p = dds::Participant::Create(o);
-  framework::NodeOptions no;
-  no.diagnostics_period = 0;
-  framework::Node node("scripted_cell", *p, no);
+  TestNode cell("scripted_cell", dds::Vendor::kCyclone, domain);
+  framework::Node& node = *cell.node;
   auto& js = node.Advertise(framework::topics::JointStates());
   auto& traj = node.Advertise(framework::topics::RobotTrajectory());
   auto& skel = node.Advertise(framework::topics::HumanSkeleton());

@@ -26,6 +26,7 @@
 #include "iplan/intent/model_io.h"
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/msg/time.h"
+#include "test_node.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -134,24 +135,10 @@ void SpinFor(framework::Node& node, std::chrono::milliseconds d) {
   while (std::chrono::steady_clock::now() < end) node.SpinOnce(10ms);
 }
 
-std::unique_ptr<dds::Participant> MakeParticipant(dds::Vendor vendor, int domain) {
-  dds::ParticipantOptions o;
-  o.vendor = vendor;
-  o.domain_id = domain;
-  o.name = "intent_service_test";
-  return dds::Participant::Create(o);
-}
-
-framework::NodeOptions Quiet() {
-  framework::NodeOptions o;
-  o.diagnostics_period = 0;
-  return o;
-}
-
 TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) {
   const int domain = UniqueDomain(11);
-  auto participant = MakeParticipant(dds::Vendor::kCyclone, domain);
-  framework::Node node("observer", *participant, Quiet());
+  TestNode observer("observer", dds::Vendor::kCyclone, domain);
+  framework::Node& node = *observer.node;
   Diagnostics diag;
   diag.Subscribe(node);
   std::map<int64_t, msg::HumanSkeleton> skeletons;  // by stamp (ns)
@@ -324,8 +311,8 @@ msg::HumanSkeleton Skeleton(uint32_t body, const std::vector<std::string>& names
 
 TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
   const int domain = UniqueDomain(12);
-  auto participant = MakeParticipant(dds::Vendor::kFastDds, domain);
-  framework::Node node("garbage", *participant, Quiet());
+  TestNode garbage("garbage", dds::Vendor::kFastDds, domain);
+  framework::Node& node = *garbage.node;
   Diagnostics diag;
   diag.Subscribe(node);
   std::multiset<uint32_t> belief_bodies, prediction_bodies;
@@ -338,8 +325,8 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
                        prediction_bodies.insert(p.body_id);
                      }));
   const auto topic = framework::topics::HumanSkeleton();
-  dds::Writer<msg::HumanSkeleton> a(*participant, topic.name, topic.qos);
-  dds::Writer<msg::HumanSkeleton> b(*participant, topic.name, topic.qos);
+  dds::Writer<msg::HumanSkeleton> a(*garbage.participant, topic.name, topic.qos);
+  dds::Writer<msg::HumanSkeleton> b(*garbage.participant, topic.name, topic.qos);
 
   const std::vector<std::string>& joints = model_->config.joints.joints;
   Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",

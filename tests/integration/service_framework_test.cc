@@ -15,6 +15,7 @@
 
 #include "iplan/dds/participant.h"
 #include "iplan/framework/node.h"
+#include "test_node.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -83,13 +84,8 @@ TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
 TEST(ServiceFramework, PublishesDiagnosticsAndStopsCleanlyOnSigterm) {
   const int domain = UniqueDomain(6);
   Process svc({BinPath("iplan-perception"), "--domain", std::to_string(domain), "--dds", "fastdds"});
-  dds::ParticipantOptions o;
-  o.vendor = dds::Vendor::kCyclone;
-  o.domain_id = domain;
-  auto p = dds::Participant::Create(o);
-  framework::NodeOptions no;
-  no.diagnostics_period = 0;
-  framework::Node node("observer", *p, no);
+  TestNode observer("observer", dds::Vendor::kCyclone, domain);
+  framework::Node& node = *observer.node;
   std::string state;
   int skeletons = 0;
   node.Subscribe(framework::topics::Diagnostics(),

@@ -12,6 +12,7 @@
 
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "test_node.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -42,13 +43,8 @@ Result RunTask(double block_for_s) {
   const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10));
   Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain)});
   Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain)});
-  dds::ParticipantOptions o;
-  o.vendor = dds::Vendor::kCyclone;
-  o.domain_id = domain;
-  auto p = dds::Participant::Create(o);
-  framework::NodeOptions no;
-  no.diagnostics_period = 0;
-  framework::Node node("test_cell", *p, no);
+  TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
+  framework::Node& node = *cell.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
   auto& pred = node.Advertise(framework::topics::HumanPrediction());
   auto& truth = node.Advertise(framework::topics::HumanTruth());
