@@ -29,9 +29,11 @@ class CellFault : public ::testing::Test {
     std::filesystem::create_directories(dir_);
     const std::string cfg = std::string(IPLAN_SOURCE_DIR) + "/config/";
     // The person stands far from the robot so the risk verdict stays OK and
-    // only the faults stop the cell.
+    // only the faults stop the cell: about 1.4 m of separation, beyond S_p
+    // plus the slow-down margin even at the ISO default speed of 1.6 m/s
+    // (S_p 0.96 m), which the monitor uses whenever a speed sample is missing.
     Write("perception.yaml", "perception:\n  provider: synthetic\n  publish_truth: true\n  synthetic:\n"
-                             "    torso: [1.8, 0.0, 1.05]\n    reach_target: [1.45, 0.1, 0.95]\n");
+                             "    torso: [2.3, 0.0, 1.05]\n    reach_target: [1.95, 0.1, 0.95]\n");
     Write("supervisor.yaml", "supervisor:\n  task_graph: " + cfg + "tasks/table_top.yaml\n  q_table: " +
                                  (dir_ / "q.bin").string() + "\n  pause_between_tasks: 0.2\n"
                                  "  watch: [human_skeleton, joint_states, robot_trajectory, collision_risk]\n");
