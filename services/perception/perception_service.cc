@@ -6,8 +6,8 @@
 #include <filesystem>
 
 #include "core/skeleton_replay.h"
-#include "core/synthetic_person.h"
 #include "iplan/framework/service.h"
+#include "synthetic_config.h"
 
 namespace iplan::perception {
 namespace {
@@ -23,27 +23,29 @@ class PerceptionService : public framework::Service {
     config.Read("rate_hz", &rate_hz_, framework::InRange(0.5, 1000.0));
     config.Read("frame_id", &frame_id_);
     config.Read("publish_truth", &publish_truth_);
+    start_ = std::chrono::system_clock::now();
     ConfigSection syn = config.Section("synthetic");
-    std::vector<double> torso = {params_.torso_W.x(), params_.torso_W.y(), params_.torso_W.z()};
-    std::vector<double> target = {params_.reach_target_W.x(), params_.reach_target_W.y(), params_.reach_target_W.z()};
-    auto three = [](const std::vector<double>& v) {
-      return v.size() == 3 ? std::string() : "must have 3 numbers (x, y, z in m)";
-    };
-    if (syn.Read("torso", &torso, framework::Check<std::vector<double>>(three))) {
-      params_.torso_W = {torso[0], torso[1], torso[2]};
-    }
-    if (syn.Read("reach_target", &target, framework::Check<std::vector<double>>(three))) {
-      params_.reach_target_W = {target[0], target[1], target[2]};
-    }
-    syn.Read("facing_yaw", &params_.facing_yaw);
-    syn.Read("reach_period", &params_.reach_period, framework::Positive<double>());
-    syn.Read("noise_stddev", &params_.noise_stddev, framework::NonNegative<double>());
-    int seed = static_cast<int>(params_.seed);
-    syn.Read("seed", &seed, framework::NonNegative<int>());
-    params_.seed = static_cast<uint64_t>(seed);
-    if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
+    params_ = ReadSyntheticPerson(syn, &script_start_);
     if (Result r = ConfigureReplay(config); !r.ok) return r;
-    if (provider_ == "synthetic") person_ = std::make_unique<SyntheticPerson>(params_);
+    if (provider_ == "synthetic") {
+      try {
+        person_ = std::make_unique<SyntheticPerson>(params_);
+      } catch (const std::exception& e) {
+        return Result::Fail(config.file() + ": key 'perception.synthetic': " + e.what());
+      }
+      if (script_start_ == ScriptStart::kEpisodes) {
+        // The person starts their part of the task with each episode.
+        using SI = const dds::SampleInfo&;
+        node.Subscribe(framework::topics::TaskCommand(),
+                       std::function<void(const msg::TaskCommand&, SI)>([this, &node](const msg::TaskCommand& m, SI) {
+                         if (m.command != msg::TaskCommand::START || m.episode == 0 || m.episode == episode_) return;
+                         episode_ = m.episode;
+                         person_->StartScript(Seconds());
+                         node.log().info("episode {}: the person starts their script", episode_);
+                       }),
+                       framework::SubscribeOptions{false});
+      }
+    }
     skeleton_writer_ = &node.Advertise(framework::topics::HumanSkeleton());
     if (publish_truth_) truth_writer_ = &node.Advertise(framework::topics::HumanTruth());
     node.SetDiagnosticValue("provider", provider_);
@@ -165,10 +167,11 @@ class PerceptionService : public framework::Service {
     return s;
   }
 
+  double Seconds() const { return std::chrono::duration<double>(std::chrono::system_clock::now() - start_).count(); }
+
   void Tick(Node& node) {
     const auto tick_start = std::chrono::steady_clock::now();
-    const auto now = std::chrono::system_clock::now();
-    const double t = std::chrono::duration<double>(now - start_).count();
+    const double t = Seconds();
     const msg::Time stamp = msg::Now();
     std::string err;
     if (!skeleton_writer_->Write(ToMessage(person_->Observe(t), stamp), &err)) {
@@ -177,6 +180,11 @@ class PerceptionService : public framework::Service {
     if (truth_writer_) truth_writer_->Write(ToMessage(person_->TruePose(t), stamp));
     ++published_;
     node.SetDiagnosticValue("published", std::to_string(published_));
+    const std::string& action = person_->ActionAt(t);
+    if (action != action_) {
+      action_ = action;
+      node.SetDiagnosticValue("action", action_);  // the simulated person's true action
+    }
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - tick_start).count());
   }
 
@@ -186,6 +194,9 @@ class PerceptionService : public framework::Service {
   bool publish_truth_ = false;
   SyntheticPersonParams params_;
   std::unique_ptr<SyntheticPerson> person_;
+  ScriptStart script_start_ = ScriptStart::kLoop;
+  uint32_t episode_ = 0;
+  std::string action_;
   dds::Writer<msg::HumanSkeleton>* skeleton_writer_ = nullptr;
   dds::Writer<msg::HumanSkeleton>* truth_writer_ = nullptr;
   std::chrono::system_clock::time_point start_;

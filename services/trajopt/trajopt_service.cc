@@ -44,6 +44,7 @@ class TrajoptService : public framework::Service {
     }
     trajectory_writer_ = &node.Advertise(framework::topics::RobotTrajectory());
     outcome_writer_ = &node.Advertise(framework::topics::TaskOutcome());
+    status_writer_ = &node.Advertise(framework::topics::PlanStatus());
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
                    std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
@@ -131,9 +132,27 @@ class TrajoptService : public framework::Service {
   void Step(Node& node) {
     const auto t0 = std::chrono::steady_clock::now();
     const CycleResult r = replanner_->Cycle(msg::ToNanoseconds(msg::Now()));
+    msg::PlanStatus status;
     if (r.publish) {
       trajectory_writer_->Write(services::ToTrajectory(msg::TimeFromNanoseconds(r.start_ns), replanner_->joint_names(),
                                                        r.positions, r.dt));
+      // End-to-end latency: from the observation behind the prediction this
+      // plan avoided to the moment the plan is out.
+      const int64_t published_ns = msg::ToNanoseconds(msg::Now());
+      status.trajectory_stamp = msg::TimeFromNanoseconds(r.start_ns);
+      if (r.prediction_t0_ns > 0) {
+        status.skeleton_stamp = msg::TimeFromNanoseconds(r.prediction_t0_ns);
+        status.latency = std::max(0.0, 1e-9 * static_cast<double>(published_ns - r.prediction_t0_ns));
+      }
+    }
+    if (r.publish || r.planning_time > 0) {
+      status.header.stamp = msg::Now();
+      status.planning_time = r.planning_time;
+      status.task_id = replanner_->current_task_id().value_or(0);
+      status.waiting = r.waiting;
+      status.max_bound = std::clamp(r.max_bound, 0.0, 1.0);
+      status.status = r.status;
+      status_writer_->Write(status);
     }
     if (r.outcome) Publish(node, *r.outcome);
     if (r.status != last_status_) {
@@ -150,6 +169,7 @@ class TrajoptService : public framework::Service {
   std::unique_ptr<Replanner> replanner_;
   dds::Writer<msg::JointTrajectory>* trajectory_writer_ = nullptr;
   dds::Writer<msg::TaskOutcome>* outcome_writer_ = nullptr;
+  dds::Writer<msg::PlanStatus>* status_writer_ = nullptr;
   std::string last_status_;
   int timer_ = 0;
 };

@@ -33,7 +33,7 @@ class CellFault : public ::testing::Test {
     // plus the slow-down margin even at the ISO default speed of 1.6 m/s
     // (S_p 0.96 m), which the monitor uses whenever a speed sample is missing.
     Write("perception.yaml", "perception:\n  provider: synthetic\n  publish_truth: true\n  synthetic:\n"
-                             "    torso: [2.3, 0.0, 1.05]\n    reach_target: [1.95, 0.1, 0.95]\n");
+                             "    torso: [2.3, 0.0, 1.05]\n    actions:\n      reach: {motion: reach, target: [1.95, 0.1, 0.95], period: 4.0}\n");
     Write("supervisor.yaml", "supervisor:\n  task_graph: " + cfg + "tasks/table_top.yaml\n  q_table: " +
                                  (dir_ / "q.bin").string() + "\n  pause_between_tasks: 0.2\n"
                                  "  watch: [human_skeleton, joint_states, robot_trajectory, collision_risk]\n");

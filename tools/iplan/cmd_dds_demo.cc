@@ -1,30 +1,40 @@
-// iplan demo: starts the cell's services as separate processes on loopback
-// DDS and reports what flows between them.
-//
-// Today the cell is the DDS spine: the perception service (synthetic person)
-// publishes skeletons, and this process subscribes through the service
-// framework (boundary checks, diagnostics) on the same or the other vendor.
+// iplan demo: the working cell. Starts every service as a separate process on
+// loopback DDS (perception with the synthetic person, intent, collision risk,
+// trajectory optimisation, the robot simulator and the supervisor), runs
+// collaborative episodes of the task graph, shows live progress, and prints a
+// summary (also as JSON with --summary): tasks, completion and waiting times,
+// separation, collision bound, protective stops, true contacts, end-to-end
+// latency and the learning curve over episodes.
 #include <signal.h>
+#include <stdlib.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
 #include <map>
+#include <sstream>
 
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "core/task_planner.h"
+#include "dds_cell_model.h"
 #include "dds_common.h"
 #include "iplan/core/process.h"
 #include "iplan/core/stats.h"
+#include "iplan/framework/config.h"
 #include "iplan/framework/node.h"
+#include "iplan/framework/service.h"
 
 namespace iplan::cli {
 namespace {
 
+namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 using namespace std::chrono_literals;
 
@@ -34,28 +44,262 @@ struct DemoOptions {
   std::string vendor;
   bool mixed = false;
   int domain = -1;
-  double duration = 5.0;
-  std::string summary_file;
+  int episodes = 6;
+  double timeout = 170;
+  std::string summary_file, config_dir, state_dir;
+  bool keep_learning = false, retrain = false;
 };
 
+// The services in start order (executable suffix, config name).
+const std::vector<std::pair<std::string, std::string>> kServices = {
+    {"robot-sim", "robot_sim"},           {"perception", "perception"}, {"intent", "intent"},
+    {"collision-risk", "collision_risk"}, {"trajopt", "trajopt"},       {"supervisor", "supervisor"}};
+
+struct Episode {
+  int number = 0;
+  double start = -1, end = -1;  // s since the demo started
+  int succeeded = 0, failed = 0;
+  double waiting = 0;            // s, sum of the tasks' delays
+  std::vector<std::string> order;
+  bool done = false;
+  double completion() const { return end - start; }
+};
+
+std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+class CellMonitor {
+ public:
+  CellMonitor(framework::Node& node, int num_tasks, Clock::time_point t0) : num_tasks_(num_tasks), t0_(t0) {
+    using SI = const dds::SampleInfo&;
+    namespace topics = framework::topics;
+    const framework::SubscribeOptions any_order{false};
+    node.Subscribe(topics::TaskCommand(), std::function<void(const msg::TaskCommand&, SI)>(
+                                              [this](const msg::TaskCommand& m, SI) { OnCommand(m); }),
+                   any_order);
+    node.Subscribe(topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>(
+                                              [this](const msg::TaskOutcome& m, SI) { OnOutcome(m); }),
+                   any_order);
+    node.Subscribe(topics::PlanStatus(), std::function<void(const msg::PlanStatus&, SI)>([this](const msg::PlanStatus& m, SI) {
+                     if (m.latency > 0) latency_ms_.push_back(1e3 * m.latency);
+                     waiting_ = m.waiting;
+                     max_plan_bound_ = std::max(max_plan_bound_, m.max_bound);
+                   }));
+    node.Subscribe(topics::CollisionRisk(),
+                   std::function<void(const msg::CollisionRisk&, SI)>([this](const msg::CollisionRisk& m, SI) {
+                     max_bound_ = std::max(max_bound_, m.max_bound);
+                     separation_ = m.min_separation;
+                     min_observed_separation_ = std::min(min_observed_separation_, m.min_separation);
+                   }));
+    node.Subscribe(topics::SafetyCommand(),
+                   std::function<void(const msg::SafetyCommand&, SI)>([this](const msg::SafetyCommand& m, SI) {
+                     if (m.command == msg::SafetyCommand::PROTECTIVE_STOP && !stopped_) {
+                       ++stops_;
+                       stop_reasons_.push_back(m.source + ": " + m.reason);
+                     }
+                     stopped_ = m.command == msg::SafetyCommand::PROTECTIVE_STOP;
+                   }),
+                   any_order);
+    node.Subscribe(topics::Diagnostics(),
+                   std::function<void(const msg::DiagnosticArray& a, SI)>([this](const msg::DiagnosticArray& a, SI) {
+                     for (const auto& st : a.status) {
+                       for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
+                     }
+                   }),
+                   any_order);
+  }
+
+  double Now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
+  const std::map<int, Episode>& episodes() const { return episodes_; }
+  int completed_episodes() const {
+    return static_cast<int>(std::count_if(episodes_.begin(), episodes_.end(), [](const auto& e) { return e.second.done; }));
+  }
+  std::string Diag(const std::string& service, const std::string& key, const std::string& otherwise = "") const {
+    auto s = diag_.find(service);
+    if (s == diag_.end()) return otherwise;
+    auto k = s->second.find(key);
+    return k == s->second.end() ? otherwise : k->second;
+  }
+  double DiagNumber(const std::string& service, const std::string& key, double otherwise) const {
+    const std::string v = Diag(service, key);
+    try {
+      return v.empty() ? otherwise : std::stod(v);
+    } catch (...) {
+      return otherwise;
+    }
+  }
+
+  // The progress line.
+  std::string Progress(int total_episodes) const {
+    std::ostringstream s;
+    const int e = current_episode_;
+    s << "  [" << std::setw(4) << Fixed(Now(), 0) << " s] ";
+    if (e == 0) {
+      s << "waiting for the cell (supervisor: " << Diag("supervisor", "safety", "starting") << ")";
+    } else {
+      s << "episode " << e << "/" << total_episodes << ": " << (current_task_.empty() ? "-" : current_task_)
+        << (waiting_ ? " (waiting)" : "");
+    }
+    s << " | person: " << Diag("perception", "action", "?") << " | separation "
+      << (separation_ < 1e9 ? Fixed(separation_, 2) + " m" : "-") << " | bound " << Fixed(max_bound_, 3)
+      << " | stops " << stops_ << " | contacts " << Diag("robot_sim", "true_contacts", "0");
+    return s.str();
+  }
+
+  std::vector<std::string> TakeEvents() { return std::exchange(events_, {}); }
+
+  std::vector<double> latency_ms_;
+  double max_bound_ = 0, max_plan_bound_ = 0;
+  double separation_ = 1e18, min_observed_separation_ = 1e18;
+  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0;
+  std::vector<std::string> stop_reasons_;
+
+ private:
+  void OnCommand(const msg::TaskCommand& m) {
+    if (m.command != msg::TaskCommand::START || m.episode == 0) return;
+    const int e = static_cast<int>(m.episode);
+    if (task_episode_.count(m.task_id)) return;  // a re-sent command
+    task_episode_[m.task_id] = e;
+    Episode& ep = episodes_[e];
+    if (ep.start < 0) {
+      ep.number = e;
+      ep.start = Now();
+    }
+    current_episode_ = e;
+    current_task_ = m.task_name;
+  }
+  void OnOutcome(const msg::TaskOutcome& m) {
+    auto it = task_episode_.find(m.task_id);
+    if (it == task_episode_.end()) return;
+    Episode& ep = episodes_[it->second];
+    ep.waiting += m.delay;
+    if (m.status == msg::TaskOutcome::SUCCEEDED) {
+      ++ep.succeeded;
+      ++succeeded_tasks_;
+      ep.order.push_back(m.task_name);
+    } else {
+      ++ep.failed;
+      ++failed_tasks_;
+      events_.push_back("task '" + m.task_name + "' " + (m.status == msg::TaskOutcome::FAILED ? "failed" : "cancelled") +
+                        (m.reason.empty() ? "" : ": " + m.reason));
+    }
+    current_task_.clear();
+    if (!ep.done && ep.succeeded == num_tasks_) {
+      ep.done = true;
+      ep.end = Now();
+      std::ostringstream s;
+      s << "episode " << ep.number << " done in " << Fixed(ep.completion(), 1) << " s, robot waiting "
+        << Fixed(ep.waiting, 1) << " s:";
+      for (const auto& t : ep.order) s << " " << t;
+      events_.push_back(s.str());
+    }
+  }
+
+  int num_tasks_;
+  Clock::time_point t0_;
+  std::map<uint32_t, int> task_episode_;
+  std::map<int, Episode> episodes_;
+  int current_episode_ = 0;
+  std::string current_task_;
+  bool waiting_ = false, stopped_ = false;
+  std::map<std::string, std::map<std::string, std::string>> diag_;
+  std::vector<std::string> events_;
+};
+
+std::string Tail(const std::string& text, size_t lines) {
+  size_t pos = text.size();
+  for (size_t n = 0; n <= lines && pos > 0; ++n) {
+    pos = text.rfind('\n', pos - 1);
+    if (pos == std::string::npos) return text;
+  }
+  return text.substr(pos + 1);
+}
+
 int RunDemo(const DemoOptions& o) {
-  const dds::Vendor service_vendor = o.vendor.empty() ? dds::DefaultVendor() : dds::ParseVendor(o.vendor);
-  const dds::Vendor monitor_vendor =
-      o.mixed ? (service_vendor == dds::Vendor::kCyclone ? dds::Vendor::kFastDds : dds::Vendor::kCyclone)
-              : service_vendor;
+  const dds::Vendor vendor_a = o.vendor.empty() ? dds::DefaultVendor() : dds::ParseVendor(o.vendor);
+  const dds::Vendor vendor_b = vendor_a == dds::Vendor::kCyclone ? dds::Vendor::kFastDds : dds::Vendor::kCyclone;
   // A domain of its own so that the demo never talks to a running cell.
   const int domain = o.domain >= 0 ? o.domain : 100 + static_cast<int>(getpid() % 100);
-  std::cout << "iplan demo: DDS spine on loopback, domain " << domain << "\n"
-            << "  perception service: " << dds::ToString(service_vendor) << " (separate process)\n"
-            << "  monitor (this process): " << dds::ToString(monitor_vendor) << "\n"
-            << "  duration: " << o.duration << " s" << std::endl;
+  std::string config_dir = o.config_dir;
+  if (config_dir.empty()) {
+    const std::string f = framework::DefaultConfigFile("supervisor");
+    if (f.empty()) {
+      std::cerr << "iplan demo: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+      return 2;
+    }
+    config_dir = fs::path(f).parent_path().string();
+  }
+  std::string state_dir = o.state_dir;
+  if (state_dir.empty()) {
+    std::string tmpl = (fs::temp_directory_path() / "iplan-demo-XXXXXX").string();
+    if (!mkdtemp(tmpl.data())) {
+      std::cerr << "iplan demo: cannot create a state folder in " << fs::temp_directory_path() << "\n";
+      return 1;
+    }
+    state_dir = tmpl;
+  }
+  fs::create_directories(state_dir);
+  auto cfg = [&](const std::string& name) { return (fs::path(config_dir) / (name + ".yaml")).string(); };
 
+  std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain << "\n"
+            << "  configuration " << config_dir << "\n  state and logs " << state_dir << "\n";
+
+  // The intent model: trained from the synthetic person's demonstrations once.
+  CellModelResult model;
+  supervisor::TaskGraph graph;
+  try {
+    if (!fs::exists(fs::path(config_dir) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir);
+    std::cout << "  intent model: checking ..." << std::flush;
+    model = EnsureCellModel(cfg("perception"), cfg("intent"), state_dir, o.retrain);
+    std::cout << "\r  " << model.summary << "\n";
+    framework::ConfigSection sup = framework::ConfigSection::Load(cfg("supervisor"));
+    std::string graph_file = "tasks/table_top.yaml";
+    sup.Section("supervisor").Read("task_graph", &graph_file);
+    if (fs::path(graph_file).is_relative()) graph_file = (fs::path(config_dir) / graph_file).string();
+    graph = supervisor::LoadTaskGraph(graph_file);
+  } catch (const std::exception& e) {
+    std::cerr << "\niplan demo: " << e.what() << "\n";
+    return 2;
+  }
+
+  // Start the services.
+  const auto t0 = Clock::now();
+  std::vector<std::unique_ptr<core::Process>> procs;
+  std::vector<std::string> names;
   const std::string bin = core::ExecutableDir();
-  core::Process perception({bin + "/iplan-perception", "--dds", dds::ToString(service_vendor), "--domain",
-                            std::to_string(domain)});
+  std::cout << "  services:";
+  for (size_t i = 0; i < kServices.size(); ++i) {
+    const auto& [exe, name] = kServices[i];
+    // --mixed: perception, collision risk and the supervisor on one vendor,
+    // intent, trajectory optimisation and the simulator on the other.
+    const dds::Vendor v = o.mixed && (name == "intent" || name == "trajopt" || name == "robot_sim") ? vendor_b : vendor_a;
+    std::vector<std::string> argv = {bin + "/iplan-" + exe, "--config", cfg(name), "--dds", dds::ToString(v),
+                                     "--domain", std::to_string(domain)};
+    if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model.path});
+    if (name == "perception") argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set",
+                                                       "perception.publish_truth=true"});
+    if (name == "supervisor") {
+      argv.insert(argv.end(), {"--set", "supervisor.max_episodes=" + std::to_string(o.episodes)});
+      if (!o.keep_learning) argv.insert(argv.end(), {"--set", "supervisor.q_table=" + state_dir + "/q_table.bin"});
+    }
+    try {
+      procs.push_back(std::make_unique<core::Process>(argv));
+    } catch (const std::exception& e) {
+      std::cerr << "\niplan demo: cannot start iplan-" << exe << ": " << e.what() << "\n";
+      return 1;
+    }
+    names.push_back(name);
+    std::cout << " " << name << " (" << dds::ToString(v) << ")";
+  }
+  std::cout << "\n  episodes: " << o.episodes << " of " << graph.tasks.size() << " robot tasks; Q-table "
+            << (o.keep_learning ? "from the configuration (keeps learning)" : "fresh (learns from scratch)") << "\n"
+            << std::endl;
 
   dds::ParticipantOptions popts;
-  popts.vendor = monitor_vendor;
+  popts.vendor = vendor_a;
   popts.domain_id = domain;
   popts.name = "iplan-demo";
   auto participant = dds::Participant::Create(popts);
@@ -63,98 +307,150 @@ int RunDemo(const DemoOptions& o) {
   framework::NodeOptions nopts;
   nopts.diagnostics_period = 0;
   framework::Node node("demo", *participant, nopts);
-  std::vector<double> latency_ms;
-  uint64_t skeletons = 0;
-  Clock::time_point first{}, last{};
-  std::map<std::string, std::string> perception_diag;
-  node.Subscribe(framework::topics::HumanSkeleton(),
-                 std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
-                     [&](const msg::HumanSkeleton& s, const dds::SampleInfo& info) {
-                       if (skeletons++ == 0) first = Clock::now();
-                       last = Clock::now();
-                       latency_ms.push_back((info.reception_ns - msg::ToNanoseconds(s.header.stamp)) * 1e-6);
-                     }));
-  node.Subscribe(framework::topics::Diagnostics(),
-                 std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
-                     [&](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
-                       for (const auto& st : a.status) {
-                         if (st.name != "perception") continue;
-                         for (const auto& kv : st.values) perception_diag[kv.key] = kv.value;
-                       }
-                     }));
+  CellMonitor mon(node, static_cast<int>(graph.tasks.size()), t0);
 
   g_stop = 0;
   signal(SIGINT, [](int) { g_stop = 1; });
-  const auto start = Clock::now();
-  auto next_report = start + 1s;
-  uint64_t last_count = 0;
-  while (!g_stop && Clock::now() - start < std::chrono::duration<double>(o.duration)) {
+  signal(SIGTERM, [](int) { g_stop = 1; });
+  auto next_report = Clock::now() + 2s;
+  std::string failure;
+  while (!g_stop) {
     node.SpinOnce(50ms);
-    if (!perception.Running()) break;
+    for (const auto& e : mon.TakeEvents()) std::cout << "  [" << std::setw(4) << Fixed(mon.Now(), 0) << " s] " << e << std::endl;
+    if (mon.completed_episodes() >= o.episodes) break;
+    for (size_t i = 0; i < procs.size() && failure.empty(); ++i) {
+      if (!procs[i]->Running()) failure = "iplan-" + kServices[i].first + " exited unexpectedly:\n" + Tail(procs[i]->Stderr(), 15);
+    }
+    if (!failure.empty()) break;
+    if (mon.Now() > o.timeout) {
+      failure = "time limit of " + Fixed(o.timeout, 0) + " s reached";
+      break;
+    }
     if (Clock::now() >= next_report) {
-      next_report += 1s;
-      const auto s = core::Summarize(latency_ms);
-      std::cout << "  t=" << std::fixed << std::setprecision(0)
-                << std::chrono::duration<double>(Clock::now() - start).count() << " s  skeletons " << skeletons
-                << " (+" << skeletons - last_count << "/s)  latency p50 " << std::setprecision(2) << s.p50
-                << " ms  perception: " << (perception_diag.count("state") ? perception_diag["state"] : "starting")
-                << std::endl;
-      last_count = skeletons;
+      next_report += 2s;
+      std::cout << mon.Progress(o.episodes) << std::endl;
     }
   }
-  const double elapsed = std::chrono::duration<double>(Clock::now() - start).count();
-  // Rate over the time messages flowed (discovery takes a moment at start).
-  const double flowing = std::chrono::duration<double>(last - first).count();
-  const double rate = skeletons > 1 && flowing > 0 ? (skeletons - 1) / flowing : 0.0;
-  perception.Signal(SIGTERM);
-  const auto rc = perception.Wait(10s);
-  const auto lat = core::Summarize(latency_ms);
-  const auto stats = node.stats(framework::topics::HumanSkeleton().name);
+  if (g_stop && failure.empty()) failure = "interrupted";
+  // Let the last diagnostics arrive, then stop every service.
+  for (int k = 0; k < 25; ++k) node.SpinOnce(40ms);
+  const double elapsed = mon.Now();
+  for (auto& p : procs) p->Signal(SIGTERM);
+  std::vector<int> exit_codes;
+  for (size_t i = 0; i < procs.size(); ++i) {
+    const auto rc = procs[i]->Wait(10s);
+    exit_codes.push_back(rc ? *rc : -1);
+    if (rc && *rc != 0 && failure.empty()) failure = "iplan-" + kServices[i].first + " exited with " + std::to_string(*rc);
+  }
 
-  std::cout << "\nSummary\n"
-            << "  skeletons received        " << skeletons << "\n"
-            << "  rate                      " << std::setprecision(1) << rate << " Hz\n"
-            << "  latency stamp->receive    p50 " << std::setprecision(3) << lat.p50 << " ms, p99 " << lat.p99
-            << " ms, max " << lat.max << " ms\n"
-            << "  rejected messages         " << stats.rejected << "\n"
-            << "  deadline misses           " << stats.deadline_misses << "\n"
-            << "  perception exit code      " << (rc ? std::to_string(*rc) : "did not stop") << std::endl;
+  // Summary.
+  const auto lat = core::Summarize(mon.latency_ms_);
+  const double contacts = mon.DiagNumber("robot_sim", "true_contacts", -1);
+  const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
+  std::vector<const Episode*> done;
+  double waiting_total = 0;
+  for (const auto& [n, e] : mon.episodes()) {
+    waiting_total += e.waiting;
+    if (e.done) done.push_back(&e);
+  }
+  std::cout << "\nSummary (" << Fixed(elapsed, 0) << " s)\n"
+            << "  episodes completed            " << done.size() << " / " << o.episodes << "\n"
+            << "  tasks completed               " << mon.succeeded_tasks_ << " (failed or cancelled: " << mon.failed_tasks_
+            << ")\n";
+  if (!done.empty()) {
+    std::vector<double> times;
+    for (const auto* e : done) times.push_back(e->completion());
+    const auto s = core::Summarize(times);
+    std::cout << "  completion time per episode   mean " << Fixed(s.mean, 1) << " s (min " << Fixed(s.min, 1) << ", max "
+              << Fixed(s.max, 1) << "); first " << Fixed(times.front(), 1) << " s, last " << Fixed(times.back(), 1)
+              << " s\n";
+  }
+  std::cout << "  robot waiting time            " << Fixed(waiting_total, 1) << " s in total\n"
+            << "  minimum separation            " << (min_true_sep >= 0 ? Fixed(min_true_sep, 3) + " m (true body)" : "-")
+            << (mon.min_observed_separation_ < 1e9 ? ", " + Fixed(mon.min_observed_separation_, 3) + " m (observed)" : "")
+            << "\n"
+            << "  maximum collision bound       " << Fixed(mon.max_bound_, 4) << " (executing trajectory), "
+            << Fixed(mon.max_plan_bound_, 4) << " (plans)\n"
+            << "  protective stops              " << mon.stops_ << "\n"
+            << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
+            << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
+            << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
+  for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
+  std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
+  for (const auto& [n, e] : mon.episodes()) {
+    std::cout << "  " << std::setw(7) << n << "  " << std::setw(6) << (e.done ? Fixed(e.completion(), 1) : "-") << "  "
+              << std::setw(9) << Fixed(e.waiting, 1) << " ";
+    for (const auto& t : e.order) std::cout << " " << t;
+    std::cout << (e.done ? "" : " (incomplete)") << "\n";
+  }
 
   if (!o.summary_file.empty()) {
     nlohmann::json j;
     j["domain"] = domain;
-    j["service_vendor"] = dds::ToString(service_vendor);
-    j["monitor_vendor"] = dds::ToString(monitor_vendor);
+    j["vendors"] = nlohmann::json::object();
+    for (size_t i = 0; i < names.size(); ++i) {
+      const bool b = o.mixed && (names[i] == "intent" || names[i] == "trajopt" || names[i] == "robot_sim");
+      j["vendors"][names[i]] = dds::ToString(b ? vendor_b : vendor_a);
+    }
+    j["monitor_vendor"] = dds::ToString(vendor_a);
     j["duration_s"] = elapsed;
-    j["skeletons_received"] = skeletons;
-    j["rate_hz"] = rate;
-    j["latency_ms"] = {{"p50", lat.p50}, {"p99", lat.p99}, {"max", lat.max}};
-    j["rejected_messages"] = stats.rejected;
-    j["deadline_misses"] = stats.deadline_misses;
-    j["perception_exit_code"] = rc ? *rc : -1;
+    j["episodes_requested"] = o.episodes;
+    j["episodes_completed"] = done.size();
+    j["tasks_completed"] = mon.succeeded_tasks_;
+    j["tasks_failed_or_cancelled"] = mon.failed_tasks_;
+    j["robot_waiting_time_s"] = waiting_total;
+    j["min_separation_m"] = min_true_sep;
+    j["min_observed_separation_m"] = mon.min_observed_separation_ < 1e9 ? mon.min_observed_separation_ : -1.0;
+    j["max_collision_bound"] = mon.max_bound_;
+    j["max_plan_collision_bound"] = mon.max_plan_bound_;
+    j["protective_stops"] = mon.stops_;
+    j["true_contacts"] = contacts;
+    j["latency_ms"] = {{"p50", lat.p50}, {"p99", lat.p99}, {"max", lat.max}, {"count", lat.count}};
+    j["learning_curve"] = nlohmann::json::array();
+    for (const auto& [n, e] : mon.episodes()) {
+      j["learning_curve"].push_back({{"episode", n},
+                                     {"completion_time_s", e.done ? e.completion() : -1.0},
+                                     {"waiting_time_s", e.waiting},
+                                     {"tasks_completed", e.succeeded},
+                                     {"order", e.order}});
+    }
+    j["intent_model"] = {{"path", model.path}, {"trained_now", model.trained}, {"training_s", model.seconds}};
+    j["service_exit_codes"] = exit_codes;
+    j["failure"] = failure;
     std::ofstream(o.summary_file) << j.dump(2) << "\n";
-    std::cout << "  summary written to " << o.summary_file << std::endl;
+    std::cout << "\nsummary written to " << o.summary_file << "\n";
   }
-  if (!rc || *rc != 0) {
-    std::cerr << "iplan demo: the perception service failed:\n" << perception.Stderr();
+  if (!failure.empty()) {
+    std::cerr << "\niplan demo: " << failure << "\n";
     return 1;
   }
-  if (skeletons == 0) {
-    std::cerr << "iplan demo: no skeleton arrived\n" << perception.Stderr();
+  if (contacts != 0) {
+    std::cerr << "\niplan demo: the robot touched the person (" << contacts << " true contacts)\n";
     return 1;
   }
+  std::cout << std::flush;
   return 0;
 }
 
 void Register(CLI::App& app) {
   static DemoOptions o;
-  auto* d = app.add_subcommand("demo", "Run the cell's services as separate processes on loopback DDS and report");
+  auto* d = app.add_subcommand(
+      "demo",
+      "Run the collaborative cell: every service as a separate process on loopback DDS, the synthetic person "
+      "across the table, the robot learning its task order; live progress and a summary");
   d->add_option("--dds", o.vendor, "DDS vendor of the services: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
-  d->add_flag("--mixed", o.mixed, "run the monitor on the other vendor (cross-vendor interop)");
+  d->add_flag("--mixed", o.mixed,
+              "run half the services on each vendor (intent, trajopt and robot_sim on the other one)");
+  d->add_option("--episodes", o.episodes, "collaborative episodes to run")->capture_default_str()->check(CLI::Range(1, 1000));
+  d->add_option("--timeout", o.timeout, "give up after this many seconds")->capture_default_str()->check(CLI::PositiveNumber);
   d->add_option("--domain", o.domain, "DDS domain (default: 100 + pid % 100, to stay apart from a running cell)")
       ->check(CLI::Range(0, 232));
-  d->add_option("--duration", o.duration, "seconds to run")->capture_default_str()->check(CLI::PositiveNumber);
   d->add_option("--summary", o.summary_file, "write the summary as JSON to this file");
+  d->add_option("--config-dir", o.config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
+  d->add_option("--state-dir", o.state_dir, "folder for the Q-table and a fallback model (default: a new temporary folder)");
+  d->add_flag("--keep-learning", o.keep_learning,
+              "use the Q-table of supervisor.yaml (learning carries over between runs) instead of a fresh one");
+  d->add_flag("--retrain", o.retrain, "train the intent model again even if a cached one fits");
   d->callback([] { SetExitCode(RunDemo(o)); });
 }
 

@@ -100,6 +100,44 @@ bool ConfigSection::Has(const std::string& key) const {
   return node_.IsMap() && node_[key].IsDefined() && !node_[key].IsNull();
 }
 
+std::vector<std::string> ConfigSection::Keys() const {
+  std::vector<std::string> keys;
+  if (!node_.IsMap()) return keys;
+  for (const auto& kv : node_) keys.push_back(kv.first.as<std::string>());
+  return keys;
+}
+
+void ConfigSection::Override(const std::string& dotted_key, const std::string& yaml) {
+  YAML::Node value;
+  try {
+    value = YAML::Load(yaml);
+  } catch (const YAML::Exception& e) {
+    throw ConfigError("--set " + dotted_key + "=" + yaml + ": the value is not valid YAML: " + e.msg);
+  }
+  std::vector<std::string> parts;
+  for (size_t b = 0;;) {
+    const size_t e = dotted_key.find('.', b);
+    parts.push_back(dotted_key.substr(b, e == std::string::npos ? std::string::npos : e - b));
+    if (e == std::string::npos) break;
+    b = e + 1;
+  }
+  YAML::Node n = node_;
+  for (size_t i = 0; i < parts.size(); ++i) {
+    if (parts[i].empty()) throw ConfigError("--set " + dotted_key + ": empty key");
+    if (!n.IsMap() && !n.IsNull()) throw ConfigError("--set " + dotted_key + ": '" + parts[i] + "' is not inside a mapping");
+    if (i + 1 == parts.size()) {
+      n[parts[i]] = value;
+    } else {
+      YAML::Node next = n[parts[i]];
+      if (!next.IsDefined() || next.IsNull()) {
+        n[parts[i]] = YAML::Node(YAML::NodeType::Map);
+        next = n[parts[i]];
+      }
+      n.reset(next);
+    }
+  }
+}
+
 ConfigSection ConfigSection::Section(const std::string& key) {
   state_->consumed.insert(Full(key));
   state_->sections.insert(Full(key));

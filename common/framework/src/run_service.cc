@@ -45,6 +45,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   int domain = -1;
   std::string log_level = "info";
   bool check_only = false;
+  std::vector<std::string> overrides;
   app.add_option("-c,--config", config_file, "YAML configuration file")
       ->capture_default_str();
   app.add_option("--dds", vendor_text,
@@ -53,6 +54,9 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
+  app.add_option("--set", overrides,
+                 "override a setting of the configuration file: KEY=VALUE with a dotted key from the "
+                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable)");
   app.add_flag("--check-config", check_only, "validate the configuration file and exit");
   try {
     app.parse(argc, argv);
@@ -79,6 +83,11 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     config = std::make_unique<ConfigSection>(
         config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
                             : ConfigSection::Load(config_file));
+    for (const std::string& o : overrides) {
+      const size_t eq = o.find('=');
+      if (eq == std::string::npos || eq == 0) throw ConfigError("--set " + o + ": expected KEY=VALUE");
+      config->Override(o.substr(0, eq), o.substr(eq + 1));
+    }
     ConfigSection node_section = config->Section("node");
     node_section.Read("diagnostics_period", &nopts.diagnostics_period, NonNegative<double>());
     node_section.Read("hardware_id", &nopts.hardware_id);

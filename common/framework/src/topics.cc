@@ -33,6 +33,9 @@ Topic<msg::TaskCommand> TaskCommand() {
 Topic<msg::TaskOutcome> TaskOutcome() {
   return {"rt/iplan/task/outcome", Q::Command(milliseconds(1000))};
 }
+Topic<msg::PlanStatus> PlanStatus() {
+  return {"rt/iplan/robot/plan_status", Q::SensorStream(milliseconds(300), milliseconds(300))};
+}
 Topic<msg::CollisionRisk> CollisionRisk() {
   return {"rt/iplan/collision_risk", Q::SensorStream(milliseconds(200), milliseconds(300))};
 }
@@ -63,6 +66,7 @@ std::vector<TopicDescription> All() {
       Describe(RobotTrajectory(), "trajectory the robot executes (trajectory optimisation)"),
       Describe(TaskCommand(), "robot task commands (supervisor)"),
       Describe(TaskOutcome(), "robot task outcomes (trajectory optimisation)"),
+      Describe(PlanStatus(), "one status per replanning cycle, with end-to-end latency (trajectory optimisation)"),
       Describe(CollisionRisk(), "collision bound and separation monitoring (collision risk)"),
       Describe(SafetyCommand(), "protective stop / resume (supervisor, collision risk)"),
       Describe(Diagnostics(), "per-service diagnostics (every service)"),

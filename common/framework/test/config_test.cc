@@ -90,5 +90,30 @@ TEST(Config, SyntaxErrorNamesLine) {
   EXPECT_THROW(ConfigSection::Load("/nonexistent/x.yaml"), ConfigError);
 }
 
+TEST(Config, OverridesReplaceAndCreateValuesAndAreCheckedLikeTheFile) {
+  auto c = ConfigSection::FromString("svc:\n  rate_hz: 30\n  sub:\n    a: 1\n", "svc.yaml");
+  c.Override("svc.rate_hz", "15");
+  c.Override("svc.sub.b", "[1, 2]");
+  c.Override("svc.new.deep", "x");
+  EXPECT_THROW(c.Override("svc.rate_hz.x", "1"), ConfigError);  // a scalar is not a mapping
+  EXPECT_THROW(c.Override("svc.sub.a", "[1,"), ConfigError);      // not YAML
+  EXPECT_THROW(c.Override("svc..a", "1"), ConfigError);
+  auto s = c.Section("svc");
+  EXPECT_EQ(s.Keys(), (std::vector<std::string>{"rate_hz", "sub", "new"}));
+  double rate = 0;
+  std::vector<double> b;
+  int a = 0;
+  std::string deep;
+  s.Read("rate_hz", &rate);
+  auto sub = s.Section("sub");
+  sub.Read("a", &a);
+  sub.Read("b", &b);
+  EXPECT_EQ(rate, 15);
+  EXPECT_EQ(a, 1);
+  EXPECT_EQ(b, (std::vector<double>{1, 2}));
+  // An overridden key nobody reads is reported like a typo in the file.
+  EXPECT_NE(FinishError(c).find("svc.new"), std::string::npos);
+}
+
 }  // namespace
 }  // namespace iplan::framework

@@ -183,6 +183,14 @@ std::optional<std::string> CheckSemantics(const TaskOutcome& m) {
   return std::nullopt;
 }
 
+std::optional<std::string> CheckSemantics(const PlanStatus& m) {
+  if (auto e = CheckSemantics(m.header)) return e;
+  if (m.latency < 0) return "latency " + Num(m.latency) + " is negative";
+  if (m.planning_time < 0) return "planning_time " + Num(m.planning_time) + " is negative";
+  if (auto e = CheckUnit(m.max_bound, [] { return std::string("max_bound"); })) return e;
+  return std::nullopt;
+}
+
 std::optional<std::string> CheckSemantics(const CollisionRisk& m) {
   if (auto e = CheckSemantics(m.header)) return e;
   if (m.verdict > CollisionRisk::PROTECTIVE_STOP) return "verdict " + std::to_string(m.verdict) + " unknown";

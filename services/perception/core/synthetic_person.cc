@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <stdexcept>
 
 #include <Eigen/Geometry>
 
@@ -10,9 +12,17 @@ namespace {
 
 constexpr double kUpperArm = 0.30;   // m
 constexpr double kForearm = 0.28;    // m
+constexpr double kMaxReach = 0.97 * (kUpperArm + kForearm);
 constexpr double kShoulderHalfWidth = 0.18;
 constexpr double kTorsoToNeck = 0.30;
 constexpr double kNeckToHead = 0.18;
+constexpr double kShoulderBelowNeck = 0.05;
+constexpr double kPi = 3.14159265358979323846;
+// Hands at rest, in the person frame P (x forward, y to their left, z up),
+// relative to the torso joint.
+const Eigen::Vector3d kRestLeft_P{0.25, 0.20, -0.25};
+const Eigen::Vector3d kRestRight_P{0.25, -0.20, -0.25};
+constexpr double kWorkHalfSpread = 0.10;  // m, each hand from the work centre
 
 // Minimum-jerk position profile s(u), u in [0, 1].
 double MinJerk(double u) {
@@ -34,12 +44,43 @@ Eigen::Vector3d Elbow(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& ha
   return shoulder + a * dir + h * down;
 }
 
+// Keeps a hand within arm's reach of its shoulder.
+Eigen::Vector3d WithinReach(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& hand) {
+  const Eigen::Vector3d d = hand - shoulder;
+  return d.norm() > kMaxReach ? Eigen::Vector3d(shoulder + d.normalized() * kMaxReach) : hand;
+}
+
+uint64_t Mix(uint64_t x) {  // splitmix64 finaliser
+  x += 0x9e3779b97f4a7c15ULL;
+  x = (x ^ (x >> 30)) * 0xbf58476d1ce4e5b9ULL;
+  x = (x ^ (x >> 27)) * 0x94d049bb133111ebULL;
+  return x ^ (x >> 31);
+}
+
 }  // namespace
 
 std::string SyntheticPersonParams::Validate() const {
-  if (!(reach_period > 0)) return "reach_period must be > 0";
   if (!(noise_stddev >= 0)) return "noise_stddev must be >= 0";
-  if (!torso_W.allFinite() || !reach_target_W.allFinite()) return "positions must be finite";
+  if (!(variation >= 0)) return "variation must be >= 0";
+  if (!(transition >= 0)) return "transition must be >= 0";
+  if (!torso_W.allFinite() || !std::isfinite(facing_yaw)) return "torso and facing_yaw must be finite";
+  if (actions.empty()) return "at least one action is needed";
+  for (size_t i = 0; i < actions.size(); ++i) {
+    const ActionMotion& a = actions[i];
+    if (a.name.empty()) return "action " + std::to_string(i) + " has no name";
+    for (size_t j = 0; j < i; ++j) {
+      if (actions[j].name == a.name) return "action '" + a.name + "' is defined twice";
+    }
+    if (!(a.period > 0)) return "action '" + a.name + "': period must be > 0";
+    if (!(a.amplitude >= 0)) return "action '" + a.name + "': amplitude must be >= 0";
+    if (!a.target_W.allFinite()) return "action '" + a.name + "': target must be finite";
+  }
+  for (const ScriptStep& s : script) {
+    if (std::none_of(actions.begin(), actions.end(), [&](const ActionMotion& a) { return a.name == s.action; })) {
+      return "script step '" + s.action + "' names no defined action";
+    }
+    if (!(s.duration > 0) || !std::isfinite(s.duration)) return "script step '" + s.action + "': duration must be > 0";
+  }
   return "";
 }
 
@@ -49,31 +90,129 @@ const std::vector<std::string>& UpperBodyJointNames() {
   return kNames;
 }
 
-SyntheticPerson::SyntheticPerson(const SyntheticPersonParams& params) : params_(params), rng_(params.seed) {}
+SyntheticPerson::SyntheticPerson(const SyntheticPersonParams& params)
+    : params_(params), script_start_(params.loop ? 0.0 : std::numeric_limits<double>::quiet_NaN()), rng_(params.seed) {
+  if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  for (const ScriptStep& s : params_.script) {
+    const auto it = std::find_if(params_.actions.begin(), params_.actions.end(),
+                                 [&](const ActionMotion& a) { return a.name == s.action; });
+    step_action_.push_back(static_cast<int>(it - params_.actions.begin()));
+    script_length_ += s.duration;
+  }
+}
+
+void SyntheticPerson::StartScript(double t) {
+  script_start_ = t;
+  ++episode_;
+}
+
+SyntheticPerson::Phase SyntheticPerson::PhaseAt(double t) const {
+  Phase p;
+  const int n = static_cast<int>(params_.script.size());
+  if (n == 0) {
+    p.since = t;
+    return p;
+  }
+  if (std::isnan(script_start_) || t < script_start_) {  // not started: the last step's action
+    p.step = n - 1;
+    p.action = step_action_[n - 1];
+    p.since = t;
+    return p;
+  }
+  double u = t - script_start_;
+  if (params_.loop) {
+    p.cycle = static_cast<long>(std::floor(u / script_length_));
+    u -= static_cast<double>(p.cycle) * script_length_;
+  }
+  double begin = 0;
+  int k = 0;
+  for (; k < n - 1 && u >= begin + params_.script[k].duration; ++k) begin += params_.script[k].duration;
+  p.step = k;
+  p.action = step_action_[k];
+  p.since = u - begin;
+  if (k > 0 || p.cycle > 0) {
+    p.previous = k > 0 ? k - 1 : n - 1;
+    p.previous_end = params_.script[p.previous].duration;
+  }
+  return p;
+}
+
+const std::string& SyntheticPerson::ActionAt(double t) const { return params_.actions[PhaseAt(t).action].name; }
+
+void SyntheticPerson::Hands(int action, double since, long key, Eigen::Vector3d* left, Eigen::Vector3d* right) const {
+  const ActionMotion& a = params_.actions[action];
+  const Eigen::Matrix3d R_WP = Eigen::AngleAxisd(params_.facing_yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3d rest_l = params_.torso_W + R_WP * kRestLeft_P;
+  const Eigen::Vector3d rest_r = params_.torso_W + R_WP * kRestRight_P;
+  const long repetition = static_cast<long>(std::floor(since / a.period));
+  // Per-repetition offset of the target: seeded by the person, the episode
+  // and script position (key) and the repetition.
+  Eigen::Vector3d offset = Eigen::Vector3d::Zero();
+  if (params_.variation > 0) {
+    std::mt19937_64 g(Mix(params_.seed ^ Mix(static_cast<uint64_t>(key) ^ Mix(static_cast<uint64_t>(
+                                                  a.kind == MotionKind::kWork ? 0 : repetition)))));
+    std::normal_distribution<double> n(0.0, params_.variation);
+    offset = {n(g), n(g), 0.5 * n(g)};
+  }
+  const double phase = std::fmod(since, a.period) / a.period;
+  switch (a.kind) {
+    case MotionKind::kReach: {
+      // Out in the first 40 % of the period, hold, back in the next 40 %, hold.
+      const double s = phase < 0.5 ? MinJerk(phase / 0.4) : 1.0 - MinJerk((phase - 0.5) / 0.4);
+      const Eigen::Vector3d target = a.target_W + offset;
+      *left = rest_l;
+      *right = rest_r;
+      Eigen::Vector3d& hand = a.right_hand ? *right : *left;
+      hand += s * (target - hand);
+      break;
+    }
+    case MotionKind::kWork: {
+      const Eigen::Vector3d centre = a.target_W + offset;
+      const Eigen::Vector3d side = R_WP * Eigen::Vector3d::UnitY();  // to the person's left
+      const Eigen::Vector3d fwd = R_WP * Eigen::Vector3d::UnitX();
+      const double w = 2 * kPi * phase;
+      *left = centre + kWorkHalfSpread * side + a.amplitude * (std::cos(w) * fwd + std::sin(w) * side);
+      *right = centre - kWorkHalfSpread * side + a.amplitude * (std::cos(w + kPi) * fwd + std::sin(w + kPi) * side);
+      break;
+    }
+    case MotionKind::kRest: {
+      const double s = a.amplitude * std::sin(2 * kPi * phase);
+      *left = rest_l + Eigen::Vector3d(0, 0, s) + 0.3 * offset;
+      *right = rest_r + Eigen::Vector3d(0, 0, -s) + 0.3 * offset;
+      break;
+    }
+  }
+}
 
 std::vector<JointSample> SyntheticPerson::TruePose(double t) const {
   const Eigen::Matrix3d R_WP = Eigen::AngleAxisd(params_.facing_yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  // Person frame P: x forward (where they face), y to their left, z up.
   auto W = [&](const Eigen::Vector3d& p_P) -> Eigen::Vector3d { return params_.torso_W + R_WP * p_P; };
   const Eigen::Vector3d neck = W({0, 0, kTorsoToNeck});
   const Eigen::Vector3d head = W({0, 0, kTorsoToNeck + kNeckToHead});
-  const Eigen::Vector3d shoulder_l = W({0, kShoulderHalfWidth, kTorsoToNeck - 0.05});
-  const Eigen::Vector3d shoulder_r = W({0, -kShoulderHalfWidth, kTorsoToNeck - 0.05});
-  const Eigen::Vector3d hand_l = W({0.15, 0.25, -0.10});
-  const Eigen::Vector3d rest_r = W({0.15, -0.25, -0.10});
-  // Out in the first half of the period, back in the second, with a pause.
-  const double phase = std::fmod(t, params_.reach_period) / params_.reach_period;
-  const double s = phase < 0.5 ? MinJerk(phase / 0.4) : 1.0 - MinJerk((phase - 0.5) / 0.4);
-  Eigen::Vector3d hand_r = rest_r + s * (params_.reach_target_W - rest_r);
-  // Keep the hand within arm's reach.
-  const Eigen::Vector3d d = hand_r - shoulder_r;
-  if (d.norm() > 0.97 * (kUpperArm + kForearm)) hand_r = shoulder_r + d.normalized() * 0.97 * (kUpperArm + kForearm);
-  const std::array<Eigen::Vector3d, 9> p = {head,   neck,       params_.torso_W, shoulder_l,
-                                            Elbow(shoulder_l, hand_l), hand_l, shoulder_r,
-                                            Elbow(shoulder_r, hand_r), hand_r};
+  const Eigen::Vector3d shoulder_l = W({0, kShoulderHalfWidth, kTorsoToNeck - kShoulderBelowNeck});
+  const Eigen::Vector3d shoulder_r = W({0, -kShoulderHalfWidth, kTorsoToNeck - kShoulderBelowNeck});
+
+  const Phase p = PhaseAt(t);
+  const auto key = [&](long cycle, int step) {
+    return (static_cast<long>(episode_) << 40) ^ (cycle << 8) ^ static_cast<long>(step + 1);
+  };
+  Eigen::Vector3d hand_l, hand_r;
+  Hands(p.action, p.since, key(p.cycle, p.step), &hand_l, &hand_r);
+  if (p.previous >= 0 && p.since < params_.transition) {
+    Eigen::Vector3d prev_l, prev_r;
+    const long prev_cycle = p.step > 0 ? p.cycle : p.cycle - 1;
+    Hands(step_action_[p.previous], p.previous_end, key(prev_cycle, p.previous), &prev_l, &prev_r);
+    const double s = MinJerk(p.since / params_.transition);
+    hand_l = prev_l + s * (hand_l - prev_l);
+    hand_r = prev_r + s * (hand_r - prev_r);
+  }
+  hand_l = WithinReach(shoulder_l, hand_l);
+  hand_r = WithinReach(shoulder_r, hand_r);
+  const Eigen::Vector3d p9[9] = {head,   neck,   params_.torso_W,        shoulder_l, Elbow(shoulder_l, hand_l),
+                                 hand_l, shoulder_r, Elbow(shoulder_r, hand_r), hand_r};
   std::vector<JointSample> out;
   out.reserve(9);
-  for (int i = 0; i < 9; ++i) out.push_back({UpperBodyJointNames()[i], p[i], 0.0});
+  for (int i = 0; i < 9; ++i) out.push_back({UpperBodyJointNames()[i], p9[i], 0.0});
   return out;
 }
 
@@ -85,6 +224,52 @@ std::vector<JointSample> SyntheticPerson::Observe(double t) {
     j.variance = params_.noise_stddev * params_.noise_stddev;
   }
   return out;
+}
+
+intent::SkeletonDataset RecordDemonstrations(const SyntheticPersonParams& params, int subjects, int repetitions,
+                                             double seconds, double rate_hz) {
+  if (subjects < 1 || repetitions < 1 || !(seconds > 0) || !(rate_hz > 0)) {
+    throw std::invalid_argument("RecordDemonstrations: subjects, repetitions, seconds and rate must be positive");
+  }
+  intent::SkeletonDataset data;
+  data.joint_names = UpperBodyJointNames();
+  const int frames = std::max(2, static_cast<int>(std::floor(seconds * rate_hz)));
+  std::mt19937_64 g(Mix(params.seed * 7919 + 17));
+  std::normal_distribution<double> jitter(0.0, 1.0);
+  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  for (int s = 1; s <= subjects; ++s) {
+    // Each subject stands a little differently and moves at their own pace.
+    SyntheticPersonParams p = params;
+    p.torso_W += Eigen::Vector3d(0.03 * jitter(g), 0.03 * jitter(g), 0.02 * jitter(g));
+    const double pace = 0.85 + 0.3 * unit(g);
+    for (ActionMotion& a : p.actions) a.period *= pace;
+    p.loop = false;
+    char subject[16];
+    std::snprintf(subject, sizeof(subject), "s%02d", s);
+    for (const ActionMotion& a : p.actions) {
+      for (int r = 1; r <= repetitions; ++r) {
+        SyntheticPersonParams q = p;
+        q.seed = Mix(params.seed ^ Mix(static_cast<uint64_t>(s * 1000 + r)));
+        q.script = {ScriptStep{a.name, frames / rate_hz + 100.0}};
+        SyntheticPerson person(q);
+        person.StartScript(0.0);
+        const double t0 = unit(g) * a.period * pace;  // start anywhere in the motion
+        intent::SkeletonSequence seq;
+        seq.id = "synthetic_" + a.name + "_" + subject + "_e" + std::to_string(r);
+        seq.subject = subject;
+        seq.action = a.name;
+        seq.time.resize(frames);
+        seq.positions.resize(frames, 3 * static_cast<Eigen::Index>(data.joint_names.size()));
+        for (int k = 0; k < frames; ++k) {
+          seq.time[k] = k / rate_hz;
+          const auto pose = person.Observe(t0 + k / rate_hz);
+          for (size_t j = 0; j < pose.size(); ++j) seq.positions.block<1, 3>(k, 3 * j) = pose[j].position_W.transpose();
+        }
+        data.sequences.push_back(std::move(seq));
+      }
+    }
+  }
+  return data;
 }
 
 }  // namespace iplan::perception

@@ -164,6 +164,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (predicted) {
     req.prediction = &*prediction_;
     req.prediction_dt = prediction_meta_.time_step;
+    r.prediction_t0_ns = prediction_meta_.t0_ns;
     // Step 0 of the prediction is at t0 + time_step.
     req.prediction_start = (prediction_meta_.t0_ns - start_ns) * 1e-9 + prediction_meta_.time_step;
   }
@@ -191,7 +192,9 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (res.success) {
     r.positions = res.positions;
     t.max_bound = std::max(t.max_bound, res.max_bound);
+    r.max_bound = res.max_bound;
     if (res.num_waits > 0) {
+      r.waiting = true;
       t.waiting = true;
       ++t.waits;
       r.status = prefix + "planned with " + std::to_string(res.num_waits) + " wait(s)";
@@ -206,6 +209,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     r.positions.resize(base.rows(), keep + 1);
     r.positions.leftCols(keep) = base.leftCols(keep);
     r.positions.col(keep) = base.col(keep - 1);
+    r.waiting = true;
     t.waiting = true;
     ++t.waits;
     r.status = prefix + "no safe trajectory: holding (" + res.reason + ")";

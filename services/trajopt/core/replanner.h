@@ -65,6 +65,9 @@ struct CycleResult {
   double dt = 0;
   Eigen::MatrixXd positions;         ///< nq x (n + 1)
   double planning_time = 0;          ///< s, 0 when nothing was planned
+  int64_t prediction_t0_ns = 0;      ///< stamp of the observation behind the prediction planned against (0: none)
+  bool waiting = false;              ///< the plan holds the robot (waits inserted or no safe trajectory)
+  double max_bound = 0;              ///< highest per-waypoint collision bound of the plan
   std::optional<TaskOutcome> outcome;
   std::string status;                ///< what happened, for logs/diagnostics
 };

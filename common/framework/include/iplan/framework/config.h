@@ -67,6 +67,14 @@ class ConfigSection {
   ConfigSection Section(const std::string& key);
   /// True when the key is present.
   bool Has(const std::string& key) const;
+  /// The keys of this mapping, in file order.
+  std::vector<std::string> Keys() const;
+  /// Overrides one value before it is read: `dotted_key` is a path of
+  /// mapping keys from this section (e.g. "supervisor.max_episodes"), `yaml`
+  /// the new value as YAML text ("3", "[1, 2]", "true"). Missing mappings on
+  /// the path are created. Throws ConfigError when `yaml` does not parse or
+  /// the path runs through a non-mapping.
+  void Override(const std::string& dotted_key, const std::string& yaml);
   /// Records a problem found by the caller (cross-field checks).
   void AddError(const std::string& key, const std::string& problem);
   /// Throws ConfigError if any key anywhere in the file was not read, or any

@@ -48,6 +48,8 @@ Topic<msg::JointTrajectory> RobotTrajectory();
 Topic<msg::TaskCommand> TaskCommand();
 /// Task outcomes from the trajectory optimiser.
 Topic<msg::TaskOutcome> TaskOutcome();
+/// One status per replanning cycle (with the end-to-end latency).
+Topic<msg::PlanStatus> PlanStatus();
 /// Collision risk of the executing trajectory.
 Topic<msg::CollisionRisk> CollisionRisk();
 /// Protective stop / resume (latched).

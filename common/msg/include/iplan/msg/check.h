@@ -22,6 +22,7 @@ std::optional<std::string> CheckSemantics(const JointTrajectory& m);
 std::optional<std::string> CheckSemantics(const PointCloud2& m);
 std::optional<std::string> CheckSemantics(const TaskCommand& m);
 std::optional<std::string> CheckSemantics(const TaskOutcome& m);
+std::optional<std::string> CheckSemantics(const PlanStatus& m);
 std::optional<std::string> CheckSemantics(const CollisionRisk& m);
 std::optional<std::string> CheckSemantics(const SafetyCommand& m);
 std::optional<std::string> CheckSemantics(const DiagnosticArray& m);

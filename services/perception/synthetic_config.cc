@@ -1,0 +1,62 @@
+#include "synthetic_config.h"
+
+namespace iplan::perception {
+namespace {
+
+std::string Three(const std::vector<double>& v) {
+  return v.size() == 3 ? std::string() : "must have 3 numbers (x, y, z in m)";
+}
+
+}  // namespace
+
+SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& syn, ScriptStart* start) {
+  SyntheticPersonParams p;
+  std::vector<double> torso = {p.torso_W.x(), p.torso_W.y(), p.torso_W.z()};
+  if (syn.Read("torso", &torso, framework::Check<std::vector<double>>(Three))) p.torso_W = {torso[0], torso[1], torso[2]};
+  syn.Read("facing_yaw", &p.facing_yaw);
+  syn.Read("noise_stddev", &p.noise_stddev, framework::NonNegative<double>());
+  syn.Read("variation", &p.variation, framework::NonNegative<double>());
+  syn.Read("transition", &p.transition, framework::NonNegative<double>());
+  int seed = static_cast<int>(p.seed);
+  syn.Read("seed", &seed, framework::NonNegative<int>());
+  p.seed = static_cast<uint64_t>(seed);
+  std::string start_text = "loop";
+  syn.Read("start", &start_text, framework::OneOf({"loop", "episodes"}));
+  *start = start_text == "episodes" ? ScriptStart::kEpisodes : ScriptStart::kLoop;
+  p.loop = *start == ScriptStart::kLoop;
+
+  if (syn.Has("actions")) {
+    framework::ConfigSection actions = syn.Section("actions");
+    p.actions.clear();
+    for (const std::string& name : actions.Keys()) {
+      framework::ConfigSection a = actions.Section(name);
+      ActionMotion m;
+      m.name = name;
+      std::string motion = "reach", hand = "right";
+      a.Require("motion", &motion, framework::OneOf({"reach", "work", "rest"}));
+      a.Read("hand", &hand, framework::OneOf({"left", "right"}));
+      m.kind = motion == "reach" ? MotionKind::kReach : motion == "work" ? MotionKind::kWork : MotionKind::kRest;
+      m.right_hand = hand == "right";
+      std::vector<double> target = {m.target_W.x(), m.target_W.y(), m.target_W.z()};
+      if (m.kind != MotionKind::kRest) a.Require("target", &target, framework::Check<std::vector<double>>(Three));
+      if (target.size() == 3) m.target_W = {target[0], target[1], target[2]};
+      a.Read("period", &m.period, framework::Positive<double>());
+      a.Read("amplitude", &m.amplitude, framework::NonNegative<double>());
+      p.actions.push_back(m);
+    }
+    if (p.actions.empty()) syn.AddError("actions", "at least one action is needed");
+  }
+  std::vector<std::string> script;
+  std::vector<double> durations;
+  syn.Read("script", &script);
+  syn.Read("durations", &durations);
+  if (script.size() != durations.size()) {
+    syn.AddError("durations", "must have one duration (s) per script step (" + std::to_string(script.size()) + ")");
+  } else {
+    for (size_t i = 0; i < script.size(); ++i) p.script.push_back({script[i], durations[i]});
+  }
+  if (const std::string why = p.Validate(); !why.empty() && !p.actions.empty()) syn.AddError("script", why);
+  return p;
+}
+
+}  // namespace iplan::perception

@@ -1,0 +1,22 @@
+// Reads the synthetic person's settings (perception.synthetic in
+// perception.yaml). Shared by the perception service and `iplan demo`, which
+// records the same person's demonstrations to train the intent models.
+#pragma once
+
+#include "core/synthetic_person.h"
+#include "iplan/framework/config.h"
+
+namespace iplan::perception {
+
+/// How the synthetic person's script is started.
+enum class ScriptStart {
+  kLoop,      ///< at start-up, repeated for ever
+  kEpisodes,  ///< with each task-planning episode (the first task command of an episode)
+};
+
+/// Reads `section` (perception.synthetic) into params; problems are recorded
+/// in the configuration (reported by Finish()). Keys: torso, facing_yaw,
+/// noise_stddev, variation, transition, seed, start, actions, script, durations.
+SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& section, ScriptStart* start);
+
+}  // namespace iplan::perception

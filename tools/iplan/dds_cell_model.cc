@@ -1,0 +1,124 @@
+#include "dds_cell_model.h"
+
+#include <chrono>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "core/synthetic_person.h"
+#include "iplan/core/atomic_file.h"
+#include "iplan/framework/config.h"
+#include "iplan/intent/intent_model.h"
+#include "iplan/intent/model_io.h"
+#include "synthetic_config.h"
+
+namespace iplan::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// Demonstrations: 6 simulated people x 2 recordings x every action, 4 s each.
+constexpr int kSubjects = 6;
+constexpr int kRepetitions = 2;
+constexpr double kSeconds = 4.0;
+
+std::string ReadFile(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+// Everything the trained model depends on, as text: a changed person, joint
+// set or rate makes the cached model stale.
+std::string ModelKey(const perception::SyntheticPersonParams& p, const std::vector<std::string>& joints, double rate) {
+  std::ostringstream k;
+  k.precision(17);
+  k << "iplan cell intent model v1\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
+    << kSeconds << "\nrate " << rate << "\njoints";
+  for (const auto& j : joints) k << " " << j;
+  k << "\ntorso " << p.torso_W.transpose() << " yaw " << p.facing_yaw << " noise " << p.noise_stddev << " variation "
+    << p.variation << " transition " << p.transition << " seed " << p.seed << "\n";
+  for (const auto& a : p.actions) {
+    k << "action " << a.name << " " << static_cast<int>(a.kind) << " " << a.right_hand << " " << a.target_W.transpose()
+      << " " << a.period << " " << a.amplitude << "\n";
+  }
+  return k.str();
+}
+
+}  // namespace
+
+CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::string& intent_yaml,
+                                const std::string& fallback_dir, bool force) {
+  // The person, as the perception service will simulate it.
+  framework::ConfigSection pconf = framework::ConfigSection::Load(perception_yaml);
+  framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
+  perception::ScriptStart start;
+  const perception::SyntheticPersonParams person = perception::ReadSyntheticPerson(syn, &start);
+  if (const std::string why = person.Validate(); !why.empty()) {
+    throw std::runtime_error(perception_yaml + ": key 'perception.synthetic': " + why);
+  }
+  // What the intent service expects.
+  framework::ConfigSection iconf = framework::ConfigSection::Load(intent_yaml);
+  framework::ConfigSection isec = iconf.Section("intent");
+  std::string model_file;
+  std::vector<std::string> joints;
+  double rate = 15;
+  isec.Read("model", &model_file);
+  isec.Read("joints", &joints);
+  isec.Read("rate_hz", &rate);
+  if (model_file.empty() || joints.empty()) {
+    throw std::runtime_error(intent_yaml + ": keys 'intent.model' and 'intent.joints' are required");
+  }
+  fs::path path(model_file);
+  if (path.is_relative()) path = fs::path(intent_yaml).parent_path() / path;
+  path = path.lexically_normal();
+  const std::string key = ModelKey(person, joints, rate);
+
+  CellModelResult result;
+  for (const fs::path& candidate : {path, fs::path(fallback_dir) / path.filename()}) {
+    if (!force && fs::exists(candidate) && ReadFile(candidate.string() + ".key") == key) {
+      result.path = candidate.string();
+      result.summary = "intent model " + result.path + " (cached; trained for this person)";
+      return result;
+    }
+  }
+
+  const auto t0 = std::chrono::steady_clock::now();
+  const intent::SkeletonDataset data =
+      perception::RecordDemonstrations(person, kSubjects, kRepetitions, kSeconds, 30.0);
+  intent::IntentModelConfig config;
+  config.joints = intent::DefaultJointConfig(data.joint_names);
+  config.joints.joints = joints;
+  for (const auto& a : person.actions) {
+    if (a.kind != perception::MotionKind::kRest) config.joints.objects.push_back(a.target_W);
+  }
+  config.rate = rate;
+  intent::TrainParams params;
+  params.seed = person.seed;
+  const intent::IntentModel model = intent::TrainIntentModel(data, config, params, nullptr);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.trained = true;
+
+  std::string first_error;
+  for (const fs::path& candidate : {path, fs::path(fallback_dir) / path.filename()}) {
+    try {
+      fs::create_directories(candidate.parent_path());
+      intent::SaveIntentModel(model, candidate.string());
+      core::WriteFileAtomically(candidate.string() + ".key", key);
+      result.path = candidate.string();
+      break;
+    } catch (const std::exception& e) {
+      if (first_error.empty()) first_error = e.what();
+    }
+  }
+  if (result.path.empty()) throw std::runtime_error("cannot write the intent model: " + first_error);
+  std::ostringstream s;
+  s.precision(3);
+  s << "intent model trained in " << result.seconds << " s from " << data.sequences.size()
+    << " demonstrations of the synthetic person (" << person.actions.size() << " actions), written to " << result.path;
+  result.summary = s.str();
+  return result;
+}
+
+}  // namespace iplan::cli
