@@ -35,6 +35,8 @@ class SupervisorService : public framework::Service {
     config.Read("seed", &seed, framework::NonNegative<int>());
     config.Read("watch", &watched);
     config.Read("pause_between_tasks", &pause_, framework::NonNegative<double>());
+    double resume_delay = 0.5;
+    config.Read("resume_delay", &resume_delay, framework::InRange(0.0, 10.0));
     config.Read("max_episodes", &max_episodes_, framework::NonNegative<int>());
     q.learning = mode == "learning";
     q.seed = static_cast<uint64_t>(seed);
@@ -67,6 +69,7 @@ class SupervisorService : public framework::Service {
                                "' (human_skeleton, human_prediction, action_belief, joint_states, robot_trajectory, collision_risk)");
     }
     monitor_ = std::make_unique<SafetyMonitor>(names);
+    monitor_->SetResumeDelay(resume_delay);
     node.OnReaderEvent([this](const std::string& topic, const dds::ReaderEvent& e) {
       if (e.kind == dds::EventKind::kDeadlineMissed) monitor_->OnDeadlineMissed(topic);
       if (e.kind == dds::EventKind::kLivelinessLost) monitor_->OnLivelinessLost(topic, e.current);
@@ -112,7 +115,7 @@ class SupervisorService : public framework::Service {
 
   void Tick(Node& node) {
     bool changed = false;
-    const SafetyDecision d = monitor_->Evaluate(&changed);
+    const SafetyDecision d = monitor_->Evaluate(&changed, msg::ToNanoseconds(msg::Now()));
     if (changed) {
       msg::SafetyCommand c;
       c.header.stamp = msg::Now();

@@ -55,6 +55,12 @@ class TrajoptService : public framework::Service {
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      node.CountRejection("prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
                    }));
+    node.Subscribe(framework::topics::SafetyCommand(),
+                   std::function<void(const msg::SafetyCommand&, SI)>([this](const msg::SafetyCommand& m, SI) {
+                     // Only the supervisor's commands are latched decisions for the cell.
+                     if (m.source == "supervisor") replanner_->SetRobotStopped(m.command == msg::SafetyCommand::PROTECTIVE_STOP);
+                   }),
+                   framework::SubscribeOptions{false});
     node.Subscribe(framework::topics::TaskCommand(),
                    std::function<void(const msg::TaskCommand& m, SI)>([this, &node](const msg::TaskCommand& m, SI) {
                      OnCommand(node, m);

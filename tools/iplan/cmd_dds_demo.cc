@@ -245,7 +245,7 @@ int RunDemo(const DemoOptions& o) {
   auto cfg = [&](const std::string& name) { return (fs::path(config_dir) / (name + ".yaml")).string(); };
 
   std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain << "\n"
-            << "  configuration " << config_dir << "\n  state and logs " << state_dir << "\n";
+            << "  configuration " << config_dir << "\n  state and service logs (<service>.err) " << state_dir << "\n";
 
   // The intent model: trained from the synthetic person's demonstrations once.
   CellModelResult model;
@@ -286,7 +286,8 @@ int RunDemo(const DemoOptions& o) {
       if (!o.keep_learning) argv.insert(argv.end(), {"--set", "supervisor.q_table=" + state_dir + "/q_table.bin"});
     }
     try {
-      procs.push_back(std::make_unique<core::Process>(argv));
+      procs.push_back(std::make_unique<core::Process>(argv, std::map<std::string, std::string>{}, false,
+                                                      state_dir + "/" + name));
     } catch (const std::exception& e) {
       std::cerr << "\niplan demo: cannot start iplan-" << exe << ": " << e.what() << "\n";
       return 1;

@@ -27,11 +27,14 @@ std::string ReadFile(const std::string& path) {
 
 }  // namespace
 
-Process::Process(std::vector<std::string> argv, std::map<std::string, std::string> env, bool inherit_output) {
+Process::Process(std::vector<std::string> argv, std::map<std::string, std::string> env, bool inherit_output,
+                 const std::string& log_base) {
   static int counter = 0;
   const char* tmp = std::getenv("TMPDIR");
-  const std::string base = std::string(tmp && *tmp ? tmp : "/tmp") + "/iplan-test-" +
-                           std::to_string(getpid()) + "-" + std::to_string(counter++);
+  keep_logs_ = !log_base.empty();
+  const std::string base = keep_logs_ ? log_base
+                                      : std::string(tmp && *tmp ? tmp : "/tmp") + "/iplan-test-" +
+                                            std::to_string(getpid()) + "-" + std::to_string(counter++);
   out_path_ = base + ".out";
   err_path_ = base + ".err";
 
@@ -66,8 +69,10 @@ Process::~Process() {
     kill(pid_, SIGKILL);
     Wait(std::chrono::milliseconds(5000));
   }
-  std::remove(out_path_.c_str());
-  std::remove(err_path_.c_str());
+  if (!keep_logs_) {
+    std::remove(out_path_.c_str());
+    std::remove(err_path_.c_str());
+  }
 }
 
 void Process::Signal(int sig) {

@@ -24,7 +24,7 @@ void SafetyMonitor::OnRiskVerdict(uint8_t verdict, const std::string& reason) {
   risk_cause_ = verdict == 2 ? "collision risk: " + reason : "";
 }
 
-SafetyDecision SafetyMonitor::Evaluate(bool* changed) {
+SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {
   SafetyDecision d;
   std::string reason;
   for (const auto& t : topics_) {
@@ -34,6 +34,15 @@ SafetyDecision SafetyMonitor::Evaluate(bool* changed) {
   if (!risk_cause_.empty()) reason += (reason.empty() ? "" : "; ") + risk_cause_;
   d.stop = !reason.empty();
   d.reason = d.stop ? reason : "all inputs healthy";
+  if (d.stop) {
+    clear_since_ns_.reset();
+  } else if (last_ && last_->stop && resume_delay_ns_ > 0) {
+    if (!clear_since_ns_) clear_since_ns_ = now_ns;
+    if (now_ns - *clear_since_ns_ < resume_delay_ns_) {
+      if (changed) *changed = false;
+      return *last_;  // still stopped until the causes have stayed clear
+    }
+  }
   if (changed) *changed = !last_ || last_->stop != d.stop || (d.stop && last_->reason != d.reason);
   last_ = d;
   return d;

@@ -30,8 +30,12 @@ class SafetyMonitor {
   /// verdict: 0 OK, 1 SLOW_DOWN, 2 PROTECTIVE_STOP (CollisionRisk constants).
   void OnRiskVerdict(uint8_t verdict, const std::string& reason);
 
-  /// The decision now; `changed` is set when it differs from the last call.
-  SafetyDecision Evaluate(bool* changed);
+  /// The decision at `now_ns`; `changed` is set when it differs from the
+  /// last call. After a stop, the cell resumes only once every cause has been
+  /// clear for the resume delay (no stop/resume chatter at a threshold).
+  SafetyDecision Evaluate(bool* changed, int64_t now_ns = 0);
+  /// Seconds every cause must stay clear before resuming (default 0).
+  void SetResumeDelay(double seconds) { resume_delay_ns_ = static_cast<int64_t>(seconds * 1e9); }
   /// Causes per topic ("late", "lost", "never seen").
   const std::map<std::string, std::string>& causes() const { return causes_; }
 
@@ -40,6 +44,8 @@ class SafetyMonitor {
   std::map<std::string, std::string> causes_;
   std::string risk_cause_;
   std::optional<SafetyDecision> last_;
+  int64_t resume_delay_ns_ = 0;
+  std::optional<int64_t> clear_since_ns_;
 };
 
 }  // namespace iplan::supervisor

@@ -150,5 +150,30 @@ TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {
   EXPECT_FALSE(changed);
 }
 
+TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
+  SafetyMonitor m({"rt/a"});
+  m.SetResumeDelay(0.5);
+  bool changed = false;
+  const int64_t s = 1'000'000'000;
+  m.OnData("rt/a");
+  EXPECT_FALSE(m.Evaluate(&changed, 10 * s).stop);  // a first start needs no delay
+  m.OnRiskVerdict(2, "too close");
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s).stop);
+  EXPECT_TRUE(changed);
+  m.OnRiskVerdict(0, "");
+  SafetyDecision d = m.Evaluate(&changed, 11 * s + s / 10);
+  EXPECT_TRUE(d.stop);  // clear for 0 s
+  EXPECT_FALSE(changed);
+  EXPECT_EQ(d.reason, "collision risk: too close");
+  m.OnRiskVerdict(2, "too close again");  // chatter restarts the clock
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 3 * s / 10).stop);
+  m.OnRiskVerdict(0, "");
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 4 * s / 10).stop);
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 8 * s / 10).stop);
+  d = m.Evaluate(&changed, 11 * s + 9 * s / 10);
+  EXPECT_FALSE(d.stop);
+  EXPECT_TRUE(changed);
+}
+
 }  // namespace
 }  // namespace iplan::supervisor

@@ -59,7 +59,7 @@ std::optional<std::string> Replanner::UpdatePrediction(const collision::JointMix
 }
 
 TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int64_t now_ns) {
-  if (task_->waiting) task_->delay += (now_ns - task_->last_cycle_ns) * 1e-9;
+  if (task_->waiting || task_->stopped) task_->delay += (now_ns - task_->last_cycle_ns) * 1e-9;
   TaskOutcome o;
   o.id = task_->spec.id;
   o.name = task_->spec.name;
@@ -115,8 +115,9 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   const double dt = planner_.params().dt;
   // The robot waited from the previous cycle until now (cycles can be longer
   // than the planning step while the planner inserts waits).
-  if (t.waiting) t.delay += (now_ns - t.last_cycle_ns) * 1e-9;
+  if (t.waiting || t.stopped) t.delay += (now_ns - t.last_cycle_ns) * 1e-9;
   t.waiting = false;
+  t.stopped = robot_stopped_;
   t.last_cycle_ns = now_ns;
 
   // Arrived?

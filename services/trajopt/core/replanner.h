@@ -53,7 +53,8 @@ struct TaskOutcome {
   TaskStatus status = TaskStatus::kFailed;
   std::string reason;
   double duration = 0;       ///< s, command to arrival (or to the end)
-  double delay = 0;          ///< s from each cycle whose plan waited to the next cycle (wall time)
+  double delay = 0;          ///< s from each cycle whose plan waited, or during which the robot was
+                             ///< in protective stop, to the next cycle (wall time)
   uint32_t num_waits = 0;    ///< cycles whose plan had to insert a wait
   double planning_time_p50 = 0, planning_time_p99 = 0;  ///< s per cycle
   double max_collision_bound = 0;
@@ -84,6 +85,9 @@ class Replanner {
   /// Cancels the current task if it has this id.
   std::optional<TaskOutcome> CancelTask(uint32_t id, int64_t now_ns);
   bool busy() const { return task_.has_value(); }
+  /// The robot is in (or left) protective stop: time stopped counts as the
+  /// running task's delay, like waiting.
+  void SetRobotStopped(bool stopped) { robot_stopped_ = stopped; }
   std::optional<uint32_t> current_task_id() const { return task_ ? std::optional<uint32_t>(task_->spec.id) : std::nullopt; }
 
   /// Newest robot state (model joint order). Returns why it was refused.
@@ -106,6 +110,7 @@ class Replanner {
   ReplannerParams params_;
   std::optional<std::pair<int64_t, Eigen::VectorXd>> q_;
   Eigen::VectorXd qd_;
+  bool robot_stopped_ = false;
   std::optional<collision::HumanPrediction> prediction_;
   collision::JointMixture prediction_meta_;
   struct Active {
@@ -117,6 +122,7 @@ class Replanner {
     double max_bound = 0;
     std::vector<double> planning_times;
     bool waiting = false;        // the last cycle's plan made the robot wait
+    bool stopped = false;        // the robot was in protective stop at the last cycle
     int64_t last_cycle_ns = 0;
   };
   std::optional<Active> task_;

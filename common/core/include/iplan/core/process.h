@@ -17,9 +17,11 @@ class Process {
  public:
   /// Starts `argv[0]` (a path) with `argv`, the current environment plus
   /// `env`. stdout and stderr go to files under $TMPDIR, or are inherited
-  /// when `inherit_output`. Throws std::runtime_error on failure.
+  /// when `inherit_output`; with a `log_base` they go to `log_base`.out and
+  /// .err and are kept after the process object is gone. Throws
+  /// std::runtime_error on failure.
   Process(std::vector<std::string> argv, std::map<std::string, std::string> env = {},
-          bool inherit_output = false);
+          bool inherit_output = false, const std::string& log_base = "");
   ~Process();  // SIGKILL if still running
   Process(const Process&) = delete;
   Process& operator=(const Process&) = delete;
@@ -40,6 +42,7 @@ class Process {
   pid_t pid_ = -1;
   std::optional<int> exit_code_;
   std::string out_path_, err_path_;
+  bool keep_logs_ = false;
 };
 
 /// The folder of the running executable (from /proc/self/exe).
