@@ -19,7 +19,7 @@ grep -q '^Type=notify$' "$units/iplan-trajopt.service" || { echo "FAIL units are
 grep -q '^WatchdogSec=' "$units/iplan-trajopt.service" || { echo "FAIL units have no watchdog"; failures=$((failures+1)); }
 # shellcheck disable=SC1091
 set -a; . "$prefix/etc/iplan/iplan.env"; set +a
-for svc in perception collision_risk trajopt robot_sim; do
+for svc in perception collision_risk trajopt robot_sim supervisor; do
   exe="$prefix/bin/iplan-${svc//_/-}"
   if out="$("$exe" --config "$IPLAN_CONFIG_DIR/$svc.yaml" --check-config 2>&1)"; then
     echo "ok   $svc accepts its installed configuration"
