@@ -242,6 +242,11 @@ int RunDemo(const DemoOptions& o) {
     state_dir = tmpl;
   }
   fs::create_directories(state_dir);
+  // --mixed: perception, collision risk and the supervisor on one vendor,
+  // intent, trajectory optimisation and the simulator on the other.
+  auto vendor_of = [&](const std::string& name) {
+    return o.mixed && (name == "intent" || name == "trajopt" || name == "robot_sim") ? vendor_b : vendor_a;
+  };
   auto cfg = [&](const std::string& name) { return (fs::path(config_dir) / (name + ".yaml")).string(); };
 
   std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain << "\n"
@@ -273,9 +278,7 @@ int RunDemo(const DemoOptions& o) {
   std::cout << "  services:";
   for (size_t i = 0; i < kServices.size(); ++i) {
     const auto& [exe, name] = kServices[i];
-    // --mixed: perception, collision risk and the supervisor on one vendor,
-    // intent, trajectory optimisation and the simulator on the other.
-    const dds::Vendor v = o.mixed && (name == "intent" || name == "trajopt" || name == "robot_sim") ? vendor_b : vendor_a;
+    const dds::Vendor v = vendor_of(name);
     std::vector<std::string> argv = {bin + "/iplan-" + exe, "--config", cfg(name), "--dds", dds::ToString(v),
                                      "--domain", std::to_string(domain)};
     if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model.path});
@@ -389,10 +392,7 @@ int RunDemo(const DemoOptions& o) {
     nlohmann::json j;
     j["domain"] = domain;
     j["vendors"] = nlohmann::json::object();
-    for (size_t i = 0; i < names.size(); ++i) {
-      const bool b = o.mixed && (names[i] == "intent" || names[i] == "trajopt" || names[i] == "robot_sim");
-      j["vendors"][names[i]] = dds::ToString(b ? vendor_b : vendor_a);
-    }
+    for (const std::string& name : names) j["vendors"][name] = dds::ToString(vendor_of(name));
     j["monitor_vendor"] = dds::ToString(vendor_a);
     j["duration_s"] = elapsed;
     j["episodes_requested"] = o.episodes;
