@@ -15,12 +15,6 @@ using framework::ConfigSection;
 using framework::Node;
 using framework::Result;
 
-std::string Resolve(const std::string& path, const std::string& config_file) {
-  if (path.empty() || path[0] == '/') return path;
-  const std::filesystem::path base = std::filesystem::path(config_file).parent_path();
-  return (base / path).lexically_normal().string();
-}
-
 class CollisionRiskService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
@@ -48,8 +42,8 @@ class CollisionRiskService : public framework::Service {
     iso.Read("robot_uncertainty", &s.robot_uncertainty, framework::NonNegative<double>());
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(config.file() + ": " + why);
     try {
-      const std::string robot_path = Resolve(robot_file, config.file());
-      const std::string body_path = Resolve(body_file, config.file());
+      const std::string robot_path = config.ResolvePath(robot_file);
+      const std::string body_path = config.ResolvePath(body_file);
       monitor_ = std::make_unique<RiskMonitor>(collision::LoadRobotModelFromYaml(robot_path),
                                                collision::LoadHumanBodyParams(body_path), params_);
       node.log().info("robot {} ({} spheres), human body {} ({} spheres)", robot_path,

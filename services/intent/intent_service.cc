@@ -35,19 +35,17 @@ class IntentService : public framework::Service {
     if (!have_model || !have_joints || !have_rate) return Result::Fail("incomplete configuration");
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
 
-    // Relative model paths are relative to the configuration file's folder.
-    std::filesystem::path path(model_path);
-    if (path.is_relative()) path = std::filesystem::path(config.file()).parent_path() / path;
+    const std::string path = config.ResolvePath(model_path);
     intent::ModelExpectation expected;
     expected.joints = joints;
     expected.rate = rate;
     try {
-      model_ = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(path.string(), expected));
+      model_ = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(path, expected));
       estimator_ = std::make_unique<IntentEstimator>(model_, params_);
     } catch (const std::exception& e) {
       return Result::Fail(config.file() + ": key 'intent.model': " + e.what());
     }
-    node.log().info("model {}: {} actions, {} joints, {} Hz, window {} frames, horizon {} steps", path.string(),
+    node.log().info("model {}: {} actions, {} joints, {} Hz, window {} frames, horizon {} steps", path,
                     model_->actions.size(), joints.size(), rate, model_->config.window, model_->config.horizon);
 
     belief_writer_ = &node.Advertise(framework::topics::ActionBelief());
@@ -62,7 +60,7 @@ class IntentService : public framework::Service {
     prediction_.joint_names = model_->config.joints.joints;
     prediction_.actions.resize(model_->actions.size());
     for (std::size_t c = 0; c < model_->actions.size(); ++c) prediction_.actions[c].action = model_->actions[c];
-    node.SetDiagnosticValue("model", path.string());
+    node.SetDiagnosticValue("model", path);
     UpdateDiagnostics(node);
     return Result::Ok();
   }

@@ -105,9 +105,7 @@ class PerceptionService : public framework::Service {
       rep.AddError("file", "required with provider replay");
       return Result::Ok();  // reported by the configuration check
     }
-    std::filesystem::path file(p.file);
-    if (file.is_relative()) file = std::filesystem::path(config.file()).parent_path() / file;
-    p.file = file.string();
+    p.file = config.ResolvePath(p.file);
     try {
       intent::SkeletonDataset data = intent::LoadSkeletonCsv(p.file);
       ConfigSection map = rep.Section("joint_map");

@@ -29,12 +29,11 @@ class RobotSimService : public framework::Service {
     config.Read("publish_rate_hz", &publish_rate_hz_, framework::InRange(1.0, 1000.0));
     config.Read("stopping_time", &params.stopping_time, framework::Positive<double>());
     config.Read("contact_margin", &params.contact_margin, framework::NonNegative<double>());
-    const auto base = std::filesystem::path(config.file()).parent_path();
     try {
-      auto robot = collision::LoadRobotModelFromYaml((base / robot_file).lexically_normal().string());
+      auto robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));
       sim_ = std::make_unique<RobotSimulator>(std::move(robot), Eigen::Map<const Eigen::VectorXd>(q0.data(), static_cast<Eigen::Index>(q0.size())), params);
       body_ = std::make_unique<collision::HumanBodyModel>(
-          collision::LoadHumanBodyParams((base / body_file).lexically_normal().string()));
+          collision::LoadHumanBodyParams(config.ResolvePath(body_file)));
     } catch (const std::exception& e) {
       return Result::Fail(e.what());
     }

@@ -40,10 +40,9 @@ class SupervisorService : public framework::Service {
     config.Read("max_episodes", &max_episodes_, framework::NonNegative<int>());
     q.learning = mode == "learning";
     q.seed = static_cast<uint64_t>(seed);
-    const auto base = std::filesystem::path(config.file()).parent_path();
-    if (!q_table_.empty() && q_table_[0] != '/') q_table_ = (base / q_table_).lexically_normal().string();
+    q_table_ = config.ResolvePath(q_table_);
     try {
-      planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph((base / graph_file).lexically_normal().string()), q);
+      planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph(config.ResolvePath(graph_file)), q);
       if (!q_table_.empty()) {
         std::string note;
         planner_->Load(q_table_, &note);

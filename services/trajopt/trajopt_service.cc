@@ -31,8 +31,7 @@ class TrajoptService : public framework::Service {
     config.Read("settle_speed", &params_.settle_speed, framework::Positive<double>());
     config.Read("stale_after", &params_.stale_after, framework::Positive<double>());
     config.Read("max_tracking_error", &params_.max_tracking_error, framework::Positive<double>());
-    const auto base = std::filesystem::path(config.file()).parent_path();
-    auto path = [&](const std::string& f) { return (base / f).lexically_normal().string(); };
+    auto path = [&](const std::string& f) { return config.ResolvePath(f); };
     try {
       planner_ = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(path(robot_file)),
                                                      collision::LoadSceneParams(path(scene_file)),

@@ -263,8 +263,7 @@ int RunDemo(const DemoOptions& o) {
     framework::ConfigSection sup = framework::ConfigSection::Load(cfg("supervisor"));
     std::string graph_file = "tasks/table_top.yaml";
     sup.Section("supervisor").Read("task_graph", &graph_file);
-    if (fs::path(graph_file).is_relative()) graph_file = (fs::path(config_dir) / graph_file).string();
-    graph = supervisor::LoadTaskGraph(graph_file);
+    graph = supervisor::LoadTaskGraph(sup.ResolvePath(graph_file));
   } catch (const std::exception& e) {
     std::cerr << "\niplan demo: " << e.what() << "\n";
     return 2;

@@ -70,9 +70,7 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   if (model_file.empty() || joints.empty()) {
     throw std::runtime_error(intent_yaml + ": keys 'intent.model' and 'intent.joints' are required");
   }
-  fs::path path(model_file);
-  if (path.is_relative()) path = fs::path(intent_yaml).parent_path() / path;
-  path = path.lexically_normal();
+  const fs::path path = iconf.ResolvePath(model_file);
   const std::string key = ModelKey(person, joints, rate);
 
   CellModelResult result;

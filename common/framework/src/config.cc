@@ -1,6 +1,7 @@
 #include "iplan/framework/config.h"
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 
@@ -269,6 +270,16 @@ void ConfigSection::Finish() const {
   std::string msg;
   for (const auto& p : problems) msg += (msg.empty() ? "" : "\n") + p;
   throw ConfigError(msg);
+}
+
+}  // namespace iplan::framework
+
+namespace iplan::framework {
+
+std::string ConfigSection::ResolvePath(const std::string& path) const {
+  const std::filesystem::path p(path);
+  if (path.empty() || p.is_absolute()) return path;
+  return (std::filesystem::path(file()).parent_path() / p).lexically_normal().string();
 }
 
 }  // namespace iplan::framework

@@ -115,5 +115,15 @@ TEST(Config, OverridesReplaceAndCreateValuesAndAreCheckedLikeTheFile) {
   EXPECT_NE(FinishError(c).find("svc.new"), std::string::npos);
 }
 
+TEST(Config, PathsResolveAgainstTheFilesFolder) {
+  const auto c = ConfigSection::FromString("a: 1", "/etc/iplan/supervisor.yaml");
+  EXPECT_EQ(c.ResolvePath("tasks/table_top.yaml"), "/etc/iplan/tasks/table_top.yaml");
+  EXPECT_EQ(c.ResolvePath("../shared/x.csv"), "/etc/shared/x.csv");
+  EXPECT_EQ(c.ResolvePath("/var/lib/iplan/q_table.bin"), "/var/lib/iplan/q_table.bin");
+  EXPECT_EQ(c.ResolvePath(""), "");
+  const auto rel = ConfigSection::FromString("a: 1", "config/intent.yaml");
+  EXPECT_EQ(rel.ResolvePath("models/m.model"), "config/models/m.model");
+}
+
 }  // namespace
 }  // namespace iplan::framework

@@ -81,6 +81,10 @@ class ConfigSection {
   /// Read/Require/AddError recorded a problem.
   void Finish() const;
   const std::string& file() const { return state_->file; }
+  /// `path` as written in this file, resolved the way every iplan config
+  /// documents it: relative paths are relative to the folder of file();
+  /// absolute and empty paths are returned unchanged.
+  std::string ResolvePath(const std::string& path) const;
 
  private:
   struct State {
