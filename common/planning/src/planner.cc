@@ -18,6 +18,11 @@
 namespace iplan::planning {
 
 using collision::HumanPrediction;
+
+// Actions predicted with less probability than this do not shape the
+// keep-out (PlannerParams::human_separation); each other action's mean
+// weighs in with its probability.
+constexpr double kSeparationMinProbability = 0.3;
 using collision::RobotData;
 using collision::RobotModel;
 using Clock = std::chrono::steady_clock;
@@ -148,7 +153,7 @@ struct Planner::Impl {
   };
 
   struct Eval {
-    double total = 0.0, smooth = 0.0, obstacle = 0.0, dynamic = 0.0, goal = 0.0, limits = 0.0;
+    double total = 0.0, smooth = 0.0, obstacle = 0.0, dynamic = 0.0, goal = 0.0, limits = 0.0, separation = 0.0;
     std::vector<collision::WaypointBound> bounds;
   };
 
@@ -240,7 +245,7 @@ struct Planner::Impl {
     const CostWeights& w = params.weights;
     const int n = at.n, k = at.k, nq = at.nq;
     const double dt = at.dt;
-    ev->smooth = ev->obstacle = ev->dynamic = ev->goal = ev->limits = 0.0;
+    ev->smooth = ev->obstacle = ev->dynamic = ev->goal = ev->limits = ev->separation = 0.0;
     if (G) G->setZero(nq, n + 1);
     // Accelerations a_i, i = 0..n, and velocities v_i, i = 0..n-1.
     Eigen::MatrixXd& A = ws->A;
@@ -460,7 +465,46 @@ struct Planner::Impl {
         chains->AddPointGradient(ws->data[i], links[s], b, gp, G->col(i));
       }
     }
-    ev->total = ev->smooth + ev->obstacle + ev->dynamic + ev->goal + ev->limits;
+    // Keep-out from the predicted person (PlannerParams::human_separation).
+    if (at.prediction && params.human_separation > 0.0) {
+      const HumanPrediction& hp = *at.prediction;
+      const int H = hp.num_spheres();
+      const double D = params.human_separation;
+      for (int i = k; i < n; ++i) {
+        const RobotData& d = ws->data[i];
+        const int t = at.steps[i];
+        for (std::size_t g = 0; g < link_groups.size(); ++g) {
+          // A ball around the link's spheres first, as for the obstacles.
+          Eigen::Vector3d c = Eigen::Vector3d::Zero();
+          for (int sp : link_groups[g]) c += d.p_WS.col(sp);
+          c /= static_cast<double>(link_groups[g].size());
+          double cover = 0.0;
+          for (int sp : link_groups[g]) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+          for (int l = 0; l < H; ++l) {
+            // The bounding ball of the actions' means bounds every mean.
+            const HumanPrediction::Summary& sm = hp.summary(t, l);
+            if ((c - sm.centre).norm() - sm.spread - cover - hp.radius(l) >= D) continue;
+            for (int a = 0; a < hp.num_actions(); ++a) {
+              const double pa = hp.action_probability(a);
+              if (pa < kSeparationMinProbability) continue;
+              const Eigen::Vector3d& mu = hp.sphere(a, t, l).mean;
+              for (int s : link_groups[g]) {
+                const Eigen::Vector3d p = d.p_WS.col(s);
+                const Eigen::Vector3d diff = p - mu;
+                const double len = diff.norm();
+                const double dist = len - radii[s] - hp.radius(l);
+                if (dist >= D) continue;
+                ev->separation += w.separation * pa * (D - dist) * (D - dist);
+                if (!G || len < 1e-9) continue;
+                const Eigen::Vector3d gp = -2.0 * w.separation * pa * (D - dist) * diff / len;
+                chains->AddPointGradient(d, links[s], p, gp, G->col(i));
+              }
+            }
+          }
+        }
+      }
+    }
+    ev->total = ev->smooth + ev->obstacle + ev->dynamic + ev->goal + ev->limits + ev->separation;
   }
 
   void Project(const Attempt& at, Eigen::MatrixXd* Q) const {
@@ -501,6 +545,27 @@ struct Planner::Impl {
       }
     }
     c->safe = c->first_unsafe < 0;
+  }
+
+  // Smallest surface distance (m) between the robot's spheres and the
+  // predicted human spheres' means (actions with probability >=
+  // kSeparationMinProbability) over the waypoints [from, to].
+  double HumanSeparation(const Attempt& at, const Eigen::MatrixXd& Q, int from, int to) const {
+    double best = std::numeric_limits<double>::infinity();
+    const HumanPrediction& hp = *at.prediction;
+    RobotData d(robot);
+    for (int i = from; i <= to; ++i) {
+      collision::CalcForwardKinematics(robot, Q.col(i), &d);
+      for (int a = 0; a < hp.num_actions(); ++a) {
+        if (hp.action_probability(a) < kSeparationMinProbability) continue;
+        for (int l = 0; l < hp.num_spheres(); ++l) {
+          const Eigen::Vector3d& mu = hp.sphere(a, at.steps[i], l).mean;
+          for (int s = 0; s < static_cast<int>(radii.size()); ++s)
+            best = std::min(best, (d.p_WS.col(s) - mu).norm() - radii[s] - hp.radius(l));
+        }
+      }
+    }
+    return best;
   }
 
   // Exact bounds (default TrajectoryBoundParams) of the waypoints [from, to]
@@ -1090,6 +1155,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     I.ExactBounds(at, result.positions, 0, at.n, &result.bounds);
     result.max_bound = 0.0;
     for (int i = at.k; i <= at.n; ++i) result.max_bound = std::max(result.max_bound, result.bounds[i]);
+    result.human_separation = I.HumanSeparation(at, result.positions, at.k, at.n - 1);
   }
   result.planning_time = Seconds(t0, Clock::now());
   return result;

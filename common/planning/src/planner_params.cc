@@ -48,6 +48,7 @@ std::string PlannerParams::Validate() const {
   if (!(std::isfinite(wait_duration) && wait_duration >= dt))
     return "wait_duration must be >= dt, got " + Num(wait_duration);
   if (max_waits < 0) return "max_waits must be >= 0, got " + std::to_string(max_waits);
+  if (!nonneg(human_separation)) return "human_separation must be >= 0, got " + Num(human_separation);
   if (!nonneg(position_margin)) return "position_margin must be >= 0, got " + Num(position_margin);
   if (!(limit_scale > 0.0 && limit_scale <= 1.0))
     return "limit_scale must be in (0, 1], got " + Num(limit_scale);
@@ -66,7 +67,8 @@ std::string PlannerParams::Validate() const {
                                               {"obstacle", weights.obstacle},
                                               {"dynamic", weights.dynamic},
                                               {"goal", weights.goal},
-                                              {"limits", weights.limits}};
+                                              {"limits", weights.limits},
+                                              {"separation", weights.separation}};
   for (const auto& [name, v] : w)
     if (!nonneg(v)) return std::string("weights.") + name + " must be >= 0, got " + Num(v);
   if (!(weights.smoothness > 0.0)) return "weights.smoothness must be > 0 (it is the metric)";
@@ -119,6 +121,7 @@ PlannerParams LoadPlannerParams(const std::string& path) {
     else if (key == "collision_check_substeps") ri(&p.collision_check_substeps);
     else if (key == "wait_duration") rd(&p.wait_duration);
     else if (key == "max_waits") ri(&p.max_waits);
+    else if (key == "human_separation") rd(&p.human_separation);
     else if (key == "position_margin") rd(&p.position_margin);
     else if (key == "limit_scale") rd(&p.limit_scale);
     else if (key == "end_effector_link") p.end_effector_link = Read<std::string>(v, key, path);
@@ -151,6 +154,7 @@ PlannerParams LoadPlannerParams(const std::string& path) {
         else if (wk == "dynamic") p.weights.dynamic = wv;
         else if (wk == "goal") p.weights.goal = wv;
         else if (wk == "limits") p.weights.limits = wv;
+        else if (wk == "separation") p.weights.separation = wv;
         else throw std::runtime_error(path + ": unknown key 'weights." + wk + "'");
       }
     } else {

@@ -33,6 +33,9 @@ TEST(PlannerParams, ValidateNamesTheField) {
   p = PlannerParams{};
   p.weights.obstacle = -1;
   EXPECT_NE(p.Validate().find("weights.obstacle"), std::string::npos);
+  p = PlannerParams{};
+  p.human_separation = -0.1;
+  EXPECT_NE(p.Validate().find("human_separation must be >= 0, got -0.1"), std::string::npos);
 }
 
 TEST(PlannerParams, LoadsTheRepositoryConfig) {

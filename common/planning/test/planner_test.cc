@@ -151,6 +151,44 @@ TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
   EXPECT_GE(r.max_bound, 1.0 - planner_.params().delta_cl);
 }
 
+TEST_F(PlannerTest, SeparationKeepOutHoldsPlansAwayFromThePredictedPerson) {
+  // A hand held still 0.30 m beside the middle of the straight path: far
+  // enough for a negligible collision bound, too close for the ISO/TS 15066
+  // protective separation the keep-out stands for.
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  collision::HumanPrediction hand(1, 31, {0.05});
+  hand.set_action_probability(0, 1.0);
+  for (int k = 0; k < 31; ++k)
+    ASSERT_TRUE(hand.SetSphere(0, k, 0, {0.75, -0.10, 0.30}, 0.0004 * Eigen::Matrix3d::Identity()));
+  hand.UpdateSummaries();
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.prediction = &hand;
+  const PlanningResult off = planner_.Plan(req);
+  ExpectValid(off, req.start_q);
+  EXPECT_LT(off.max_bound, 1.0 - planner_.params().delta_cl);
+  EXPECT_LT(off.human_separation, 0.25);  // the free path passes close by
+
+  PlannerParams p;
+  p.human_separation = 0.30;
+  const Planner keep_out(robot_, scene_params_, p);
+  const PlanningResult on = keep_out.Plan(req);
+  ExpectValid(on, req.start_q);
+  // Soft: the plan goes round at about the keep-out distance.
+  EXPECT_GT(on.human_separation, off.human_separation + 0.03);
+  EXPECT_GT(on.human_separation, 0.25);
+  // An unlikely action does not shape plans (below 30 %).
+  hand.set_action_probability(0, 0.2);
+  hand.UpdateSummaries();
+  const PlanningResult unlikely = keep_out.Plan(req);
+  ExpectValid(unlikely, req.start_q);
+  EXPECT_EQ(unlikely.positions, planner_.Plan(req).positions);
+  EXPECT_EQ(unlikely.human_separation, std::numeric_limits<double>::infinity());  // no action counted
+}
+
 TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
   PlanningRequest req;
   req.start_q = Ready();

@@ -53,8 +53,9 @@ struct TaskOutcome {
   TaskStatus status = TaskStatus::kFailed;
   std::string reason;
   double duration = 0;       ///< s, command to arrival (or to the end)
-  double delay = 0;          ///< s from each cycle whose plan waited, or during which the robot was
-                             ///< in protective stop, to the next cycle (wall time)
+  double delay = 0;          ///< s from each cycle whose plan waited or was held off by the person's
+                             ///< keep-out, or during which the robot was in protective stop, to the
+                             ///< next cycle (wall time)
   uint32_t num_waits = 0;    ///< cycles whose plan had to insert a wait
   double planning_time_p50 = 0, planning_time_p99 = 0;  ///< s per cycle
   double max_collision_bound = 0;
@@ -68,6 +69,7 @@ struct CycleResult {
   double planning_time = 0;          ///< s, 0 when nothing was planned
   int64_t prediction_t0_ns = 0;      ///< stamp of the observation behind the prediction planned against (0: none)
   bool waiting = false;              ///< the plan holds the robot (waits inserted or no safe trajectory)
+  bool held_off = false;             ///< the plan keeps out of the person's space (PlannerParams::human_separation)
   double max_bound = 0;              ///< highest per-waypoint collision bound of the plan
   std::optional<TaskOutcome> outcome;
   std::string status;                ///< what happened, for logs/diagnostics

@@ -124,6 +124,51 @@ TEST_F(ReplannerTest, ReachesAJointGoalWithoutDelay) {
   EXPECT_FALSE(replanner_.busy());
 }
 
+TEST_F(ReplannerTest, MotionLongerThanTheHorizonAllowsStillArrives) {
+  // The service's replanning horizon (1.5 s) is too short for 2.8 rad of
+  // joint 1 within its 2.175 rad/s limit: the task gets a longer plan
+  // instead of holding for ever.
+  const planning::Planner short_horizon(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                        collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
+                                        planning::LoadPlannerParams(kConfig + "planner_replanning.yaml"));
+  ASSERT_LT(short_horizon.params().horizon * 2.175, 2.8 * 1.2);
+  Replanner replanner(short_horizon, body_, ReplannerParams{});
+  Eigen::VectorXd from(7), to(7);
+  from << -1.4, 0.0, 0.0, -2.2, 0.0, 2.2, 0.8;
+  to << 1.4, 0.0, 0.0, -2.2, 0.0, 2.2, 0.8;
+  int64_t t = 100 * kSec;
+  std::optional<CycleResult> last;
+  auto state = [&](int64_t at) {
+    const Eigen::VectorXd q = last ? At(*last, at) : from;
+    const Eigen::VectorXd q2 = last ? At(*last, at + kSec / 100) : from;
+    const Eigen::VectorXd qd = (q2 - q) / 0.01;
+    ASSERT_EQ(replanner.UpdateRobotState(at, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7),
+                                         std::vector<double>(qd.data(), qd.data() + 7)),
+              std::nullopt);
+  };
+  state(t);
+  ASSERT_EQ(replanner.StartTask({3, "across", planning::Goal::Joint(to), 0}, t), std::nullopt);
+  std::optional<TaskOutcome> outcome;
+  for (int k = 0; k < 80 && !outcome; ++k) {
+    CycleResult c = replanner.Cycle(t);
+    outcome = c.outcome;
+    if (c.publish) {
+      EXPECT_FALSE(c.waiting) << "cycle " << k << ": " << c.status;
+      for (int i = 0; i + 1 < c.positions.cols(); ++i) {  // within the velocity limits (2.175 rad/s, joints 1-4)
+        EXPECT_LE((c.positions.col(i + 1) - c.positions.col(i)).head(4).cwiseAbs().maxCoeff() / c.dt, 2.175 + 1e-6)
+            << "cycle " << k << " waypoint " << i;
+      }
+      last = c;
+    }
+    t += kSec / 10;
+    state(t);
+  }
+  ASSERT_TRUE(outcome.has_value()) << "no outcome in 8 s";
+  EXPECT_EQ(outcome->status, TaskStatus::kSucceeded) << outcome->reason;
+  EXPECT_EQ(outcome->delay, 0.0);
+  EXPECT_GT(outcome->duration, 2.8 / 2.175);
+}
+
 TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {
   int64_t t = 100 * kSec;
   SetState(t, Ready(), Eigen::VectorXd::Zero(7));

@@ -30,6 +30,7 @@
 // assumed to stay where last predicted, rather than to vanish).
 #pragma once
 
+#include <limits>
 #include <memory>
 #include <string>
 #include <vector>
@@ -105,6 +106,9 @@ struct PlanningResult {
   std::vector<double> bounds;    ///< P_i per waypoint (empty without prediction)
   double cost = 0.0;             ///< final total cost
   double min_clearance = 0.0;    ///< m, at the interpolated check points
+  /// m, smallest distance of the free waypoints to the predicted person
+  /// (as the human_separation cost measures it; +inf without prediction).
+  double human_separation = std::numeric_limits<double>::infinity();
   int winning_optimizer = -1;
   int num_feasible = 0;          ///< optimisers feasible and safe in the last attempt
 };

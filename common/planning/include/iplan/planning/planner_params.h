@@ -18,6 +18,7 @@ struct CostWeights {
   double dynamic = 1e4;      ///< x sum_i max(0, P_i - threshold)^2
   double goal = 0.5;         ///< x sum_i dt ||q_i - q_goal||^2 (rad^2 s)
   double limits = 50.0;      ///< x squared velocity/acceleration limit excess (normalised)
+  double separation = 2000.0; ///< x sum max(0, human_separation - d)^2 (d in m), per robot/human sphere pair
 };
 
 struct PlannerParams {
@@ -67,6 +68,15 @@ struct PlannerParams {
   /// >= dt) and the maximum number of waits before giving up (>= 0).
   double wait_duration = 0.5;
   int max_waits = 6;
+  /// Keep-out from the predicted person (m, >= 0; 0 = off): the separation
+  /// cost pushes every free waypoint's robot spheres this far from the
+  /// predicted human spheres (surface to surface, from each action's mean
+  /// at that waypoint's time, weighted by the action's probability; actions
+  /// below 30 % are ignored, so an unlikely action never blocks a goal). Set it near the ISO/TS
+  /// 15066 protective separation distance so that plans go around the
+  /// person, or hold off, before the separation monitor has to stop the
+  /// robot. A soft cost: it shapes plans but never makes one infeasible.
+  double human_separation = 0.0;
   /// Joint limits are shrunk by this margin (rad) for the optimiser (>= 0).
   double position_margin = 1e-3;
   /// Velocity/acceleration limits are scaled by this factor in (0, 1] for the
