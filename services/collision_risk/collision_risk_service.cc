@@ -6,6 +6,7 @@
 
 #include "common/adapters.h"
 #include "core/risk_monitor.h"
+#include "risk_config.h"
 #include "iplan/framework/service.h"
 
 namespace iplan::collision_risk {
@@ -18,36 +19,14 @@ using framework::Result;
 class CollisionRiskService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml";
-    config.Read("robot", &robot_file);
-    config.Read("human_body", &body_file);
-    config.Read("rate_hz", &rate_hz_, framework::InRange(1.0, 1000.0));
-    config.Read("delta_cl", &params_.delta_cl, framework::Check<double>([](const double& v) {
-                  return v > 0 && v < 1 ? std::string() : std::string("must be in (0, 1)");
-                }));
-    config.Read("stop_horizon", &params_.stop_horizon, framework::NonNegative<double>());
-    config.Read("slow_down_fraction", &params_.slow_down_fraction, framework::InRange(0.01, 1.0));
-    config.Read("slow_down_margin", &params_.slow_down_margin, framework::NonNegative<double>());
-    config.Read("stale_after", &params_.stale_after, framework::Positive<double>());
-    ConfigSection iso = config.Section("iso_ts_15066");
-    SsmParams& s = params_.ssm;
-    iso.Read("measure_human_speed", &s.measure_human_speed);
-    iso.Read("default_human_speed", &s.default_human_speed, framework::NonNegative<double>());
-    iso.Read("speed_window", &s.speed_window, framework::Positive<double>());
-    iso.Read("reaction_time", &s.reaction_time, framework::NonNegative<double>());
-    iso.Read("stopping_time", &s.stopping_time, framework::NonNegative<double>());
-    iso.Read("stopping_distance", &s.stopping_distance, framework::NonNegative<double>());
-    iso.Read("intrusion_distance", &s.intrusion_distance, framework::NonNegative<double>());
-    iso.Read("sensing_uncertainty", &s.sensing_uncertainty, framework::NonNegative<double>());
-    iso.Read("robot_uncertainty", &s.robot_uncertainty, framework::NonNegative<double>());
+    const RiskConfig rc = ReadRiskConfig(config);
+    params_ = rc.params;
+    rate_hz_ = rc.rate_hz;
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(config.file() + ": " + why);
     try {
-      const std::string robot_path = config.ResolvePath(robot_file);
-      const std::string body_path = config.ResolvePath(body_file);
-      monitor_ = std::make_unique<RiskMonitor>(collision::LoadRobotModelFromYaml(robot_path),
-                                               collision::LoadHumanBodyParams(body_path), params_);
-      node.log().info("robot {} ({} spheres), human body {} ({} spheres)", robot_path,
-                      monitor_->robot().spheres.size(), body_path, monitor_->body().num_spheres());
+      monitor_ = std::make_unique<RiskMonitor>(MakeRiskMonitor(rc));
+      node.log().info("robot {} ({} spheres), human body {} ({} spheres)", rc.robot_file,
+                      monitor_->robot().spheres.size(), rc.human_body_file, monitor_->body().num_spheres());
     } catch (const std::exception& e) {
       return Result::Fail(e.what());
     }

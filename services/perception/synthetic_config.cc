@@ -17,6 +17,11 @@ SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& syn, ScriptS
   syn.Read("noise_stddev", &p.noise_stddev, framework::NonNegative<double>());
   syn.Read("variation", &p.variation, framework::NonNegative<double>());
   syn.Read("transition", &p.transition, framework::NonNegative<double>());
+  std::vector<double> rest;
+  if (syn.Read("rest_hand", &rest)) {
+    if (rest.size() == 3) p.rest_left_P = {rest[0], rest[1], rest[2]};
+    else syn.AddError("rest_hand", "must be [x, y, z] (m)");
+  }
   int seed = static_cast<int>(p.seed);
   syn.Read("seed", &seed, framework::NonNegative<int>());
   p.seed = static_cast<uint64_t>(seed);

@@ -16,7 +16,7 @@ enum class ScriptStart {
 
 /// Reads `section` (perception.synthetic) into params; problems are recorded
 /// in the configuration (reported by Finish()). Keys: torso, facing_yaw,
-/// noise_stddev, variation, transition, seed, start, actions, script, durations.
+/// noise_stddev, variation, transition, rest_hand, seed, start, actions, script, durations.
 SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& section, ScriptStart* start);
 
 }  // namespace iplan::perception

@@ -37,7 +37,7 @@ std::string ModelKey(const perception::SyntheticPersonParams& p, const std::vect
   k << "iplan cell intent model v1\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
     << kSeconds << "\nrate " << rate << "\njoints";
   for (const auto& j : joints) k << " " << j;
-  k << "\ntorso " << p.torso_W.transpose() << " yaw " << p.facing_yaw << " noise " << p.noise_stddev << " variation "
+  k << "\ntorso " << p.torso_W.transpose() << " rest " << p.rest_left_P.transpose() << " yaw " << p.facing_yaw << " noise " << p.noise_stddev << " variation "
     << p.variation << " transition " << p.transition << " seed " << p.seed << "\n";
   for (const auto& a : p.actions) {
     k << "action " << a.name << " " << static_cast<int>(a.kind) << " " << a.right_hand << " " << a.target_W.transpose()
@@ -55,6 +55,7 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
   perception::ScriptStart start;
   const perception::SyntheticPersonParams person = perception::ReadSyntheticPerson(syn, &start);
+  if (!pconf.Problems().empty()) throw std::runtime_error(pconf.Problems().front());
   if (const std::string why = person.Validate(); !why.empty()) {
     throw std::runtime_error(perception_yaml + ": key 'perception.synthetic': " + why);
   }

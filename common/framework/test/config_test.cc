@@ -54,6 +54,8 @@ TEST(Config, MistypedValueIsNamed) {
   EXPECT_FALSE(s.Read("count", &count));
   EXPECT_FALSE(s.Read("on", &on));
   EXPECT_EQ(rate, 1);  // unchanged on error
+  ASSERT_EQ(c.Problems().size(), 3u);  // recorded at once, for tools that never call Finish
+  EXPECT_NE(c.Problems()[0].find("svc.rate_hz"), std::string::npos);
   const std::string err = FinishError(c);
   EXPECT_NE(err.find("svc.yaml: key 'svc.rate_hz': expected a finite number, got 'fast'"), std::string::npos) << err;
   EXPECT_NE(err.find("key 'svc.count': expected an integer, got '1.5'"), std::string::npos) << err;
@@ -121,6 +123,7 @@ TEST(Config, PathsResolveAgainstTheFilesFolder) {
   EXPECT_EQ(c.ResolvePath("../shared/x.csv"), "/etc/shared/x.csv");
   EXPECT_EQ(c.ResolvePath("/var/lib/iplan/q_table.bin"), "/var/lib/iplan/q_table.bin");
   EXPECT_EQ(c.ResolvePath(""), "");
+  EXPECT_TRUE(c.Problems().empty());
   const auto rel = ConfigSection::FromString("a: 1", "config/intent.yaml");
   EXPECT_EQ(rel.ResolvePath("models/m.model"), "config/models/m.model");
 }

@@ -18,10 +18,6 @@ constexpr double kTorsoToNeck = 0.30;
 constexpr double kNeckToHead = 0.18;
 constexpr double kShoulderBelowNeck = 0.05;
 constexpr double kPi = 3.14159265358979323846;
-// Hands at rest, in the person frame P (x forward, y to their left, z up),
-// relative to the torso joint.
-const Eigen::Vector3d kRestLeft_P{0.25, 0.20, -0.25};
-const Eigen::Vector3d kRestRight_P{0.25, -0.20, -0.25};
 constexpr double kWorkHalfSpread = 0.10;  // m, each hand from the work centre
 
 // Minimum-jerk position profile s(u), u in [0, 1].
@@ -63,7 +59,9 @@ std::string SyntheticPersonParams::Validate() const {
   if (!(noise_stddev >= 0)) return "noise_stddev must be >= 0";
   if (!(variation >= 0)) return "variation must be >= 0";
   if (!(transition >= 0)) return "transition must be >= 0";
-  if (!torso_W.allFinite() || !std::isfinite(facing_yaw)) return "torso and facing_yaw must be finite";
+  if (!torso_W.allFinite() || !rest_left_P.allFinite() || !std::isfinite(facing_yaw)) {
+    return "torso, rest_hand and facing_yaw must be finite";
+  }
   if (actions.empty()) return "at least one action is needed";
   for (size_t i = 0; i < actions.size(); ++i) {
     const ActionMotion& a = actions[i];
@@ -142,8 +140,9 @@ const std::string& SyntheticPerson::ActionAt(double t) const { return params_.ac
 void SyntheticPerson::Hands(int action, double since, long key, Eigen::Vector3d* left, Eigen::Vector3d* right) const {
   const ActionMotion& a = params_.actions[action];
   const Eigen::Matrix3d R_WP = Eigen::AngleAxisd(params_.facing_yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix();
-  const Eigen::Vector3d rest_l = params_.torso_W + R_WP * kRestLeft_P;
-  const Eigen::Vector3d rest_r = params_.torso_W + R_WP * kRestRight_P;
+  const Eigen::Vector3d rest_l = params_.torso_W + R_WP * params_.rest_left_P;
+  const Eigen::Vector3d rest_r =
+      params_.torso_W + R_WP * Eigen::Vector3d(params_.rest_left_P.x(), -params_.rest_left_P.y(), params_.rest_left_P.z());
   const long repetition = static_cast<long>(std::floor(since / a.period));
   // Per-repetition offset of the target: seeded by the person, the episode
   // and script position (key) and the repetition.

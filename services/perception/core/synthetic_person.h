@@ -44,6 +44,9 @@ struct SyntheticPersonParams {
   Eigen::Vector3d torso_W{1.0, 0.0, 1.05};     ///< m, torso joint in the world frame
   double facing_yaw = 3.14159265358979;        ///< rad, direction the person faces (pi: towards -x)
   double noise_stddev = 0.01;                  ///< m, per coordinate sensor noise
+  /// m, the left hand at rest relative to the torso joint, in the person
+  /// frame (x forward, y to their left, z up); the right hand is mirrored.
+  Eigen::Vector3d rest_left_P{0.25, 0.20, -0.25};
   uint64_t seed = 1;                           ///< noise and variation seed
   /// The actions the person can do. Default: a single right-hand reach.
   std::vector<ActionMotion> actions = {ActionMotion{"reach"}};

@@ -80,6 +80,9 @@ class ConfigSection {
   /// Throws ConfigError if any key anywhere in the file was not read, or any
   /// Read/Require/AddError recorded a problem.
   void Finish() const;
+  /// The problems recorded so far by Read/Require/AddError (not the unread
+  /// keys): for tools that read only part of a service's file.
+  const std::vector<std::string>& Problems() const { return state_->errors; }
   const std::string& file() const { return state_->file; }
   /// `path` as written in this file, resolved the way every iplan config
   /// documents it: relative paths are relative to the folder of file();

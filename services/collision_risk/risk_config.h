@@ -1,0 +1,33 @@
+// Reads the collision-risk settings (section collision_risk of
+// collision_risk.yaml). Shared by the collision-risk service and
+// `iplan cell-check`, which evaluates the same monitor offline.
+#pragma once
+
+#include <string>
+
+#include "core/risk_monitor.h"
+#include "iplan/framework/config.h"
+
+namespace iplan::collision_risk {
+
+struct RiskConfig {
+  RiskParams params;
+  double rate_hz = 15;        ///< evaluations per second between predictions
+  std::string robot_file;     ///< resolved against the configuration file
+  std::string human_body_file;
+};
+
+/// Reads `section` (collision_risk); problems with single keys are recorded
+/// in the configuration (reported by Finish()), cross-key ones are left to
+/// RiskParams::Validate(). Keys: robot, human_body, rate_hz,
+/// delta_cl, stop_horizon, slow_down_fraction, slow_down_margin, stale_after,
+/// iso_ts_15066.{measure_human_speed, default_human_speed, speed_window,
+/// reaction_time, stopping_time, stopping_distance, intrusion_distance,
+/// sensing_uncertainty, robot_uncertainty}.
+RiskConfig ReadRiskConfig(framework::ConfigSection& section);
+
+/// Loads the robot and human models named by `config` and builds the
+/// monitor. Throws std::exception (invalid params, unreadable models).
+RiskMonitor MakeRiskMonitor(const RiskConfig& config);
+
+}  // namespace iplan::collision_risk

@@ -1,0 +1,116 @@
+// `iplan cell-check` on real configuration folders (copies of config/ with
+// the geometry edited as an integrator would): a cell whose task graph agrees
+// with its person and ISO/TS 15066 monitor passes; a task declared harmless
+// that the monitor would stop, and a goal inside a scene object, are found and
+// named; a broken configuration is refused.
+#include <filesystem>
+#include <fstream>
+#include <regex>
+#include <sstream>
+
+#include <gtest/gtest.h>
+
+#include "test_paths.h"
+
+namespace iplan::testing {
+namespace {
+
+namespace fs = std::filesystem;
+using namespace std::chrono_literals;
+
+std::string Read(const fs::path& p) {
+  std::ifstream in(p);
+  std::stringstream s;
+  s << in.rdbuf();
+  return s.str();
+}
+
+void Write(const fs::path& p, const std::string& text) { std::ofstream(p) << text; }
+
+// Replaces the one match of `pattern` in `file`.
+void Edit(const fs::path& file, const std::string& pattern, const std::string& replacement) {
+  const std::string text = Read(file);
+  const std::regex re(pattern);
+  ASSERT_EQ(std::distance(std::sregex_iterator(text.begin(), text.end(), re), std::sregex_iterator()), 1)
+      << pattern << " in " << file;
+  Write(file, std::regex_replace(text, re, replacement));
+}
+
+class CellCheck : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = fs::temp_directory_path() / ("iplan-cell-check-" + std::to_string(getpid()));
+    fs::remove_all(dir_);
+    fs::copy(fs::path(IPLAN_SOURCE_DIR) / "config", dir_, fs::copy_options::recursive);
+    fs::remove_all(dir_ / "state");
+    fs::remove_all(dir_ / "models");
+    // A consistent cell: the person works at a fixture on the robot's right
+    // and rests close to the body; each task reaches into the person's space
+    // only during the actions it declares.
+    const fs::path person = dir_ / "perception.yaml", tasks = dir_ / "tasks" / "table_top.yaml";
+    Edit(person, R"(transition: 0\.5 )", "rest_hand: [0.10, 0.22, -0.30]\n    transition: 0.5 ");
+    Edit(person, R"(target: \[0\.89, 0\.36, 0\.17\], period: 3\.0)", "target: [0.88, 0.45, 0.17], period: 4.0");
+    Edit(person, R"(target: \[0\.98, 0\.0, 0\.15\])", "target: [0.95, -0.40, 0.15]");
+    Edit(tasks, R"(goal: \[0\.7, -0\.3, 0\.0, -2\.2, 0\.0, 1\.9, 0\.8\])", "goal: [0.7, 0.4, 0.0, -1.6, 0.0, 2.4, 0.8]");
+    Edit(tasks, R"(goal: \[-0\.7, -0\.3, 0\.0, -2\.2, 0\.0, 1\.9, 0\.8\])", "goal: [-1.4, 0.0, 0.0, -2.2, 0.0, 2.2, 0.8]");
+    Edit(tasks, R"(goal: \[-0\.3, 0\.0, 0\.0, -2\.0, 0\.0, 2\.0, 0\.8\])", "goal: [-0.9, 0.4, 0.0, -1.8, 0.0, 2.3, 0.8]");
+  }
+  void TearDown() override { fs::remove_all(dir_); }
+
+  // Runs the check; returns the exit code, output in *out.
+  int Run(std::string* out, const std::vector<std::string>& extra = {}) {
+    std::vector<std::string> argv = {BinPath("iplan"), "cell-check", "--config-dir", dir_.string(), "--repetitions", "3"};
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    Process p(argv);
+    const auto rc = p.Wait(120s);
+    *out = p.Stdout() + p.Stderr();
+    return rc.value_or(-1);
+  }
+
+  fs::path dir_;
+};
+
+TEST_F(CellCheck, ConsistentCellPassesWithItsMarginTable) {
+  std::string out;
+  EXPECT_EQ(Run(&out), 0) << out;
+  EXPECT_NE(out.find("consistent: every task the graph calls harmless"), std::string::npos) << out;
+  // One row per task with a margin per human action and the goal's clearance;
+  // declared conflicts are marked and negative (the monitor would stop).
+  const std::regex row(R"(fetch_left\s+(-0\.\d\d)\*\s+\+0\.\d\d\s+\+0\.\d\d\s+0\.\d{3})");
+  EXPECT_TRUE(std::regex_search(out, row)) << out;
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(hand_over\s+\+0\.\d\d\s+-0\.\d\d\*)"))) << out;
+}
+
+TEST_F(CellCheck, UndeclaredConflictIsNamed) {
+  // hand_over no longer declares the assembly it reaches into.
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(    conflicts_with: \[assemble\]\n)", "");
+  std::string out;
+  EXPECT_EQ(Run(&out), 1) << out;
+  EXPECT_NE(out.find("inconsistent: 'hand_over' is declared harmless during 'assemble'"), std::string::npos) << out;
+  EXPECT_NE(out.find("the monitor would stop the robot there"), std::string::npos) << out;
+}
+
+TEST_F(CellCheck, GoalInsideASceneObjectIsNamed) {
+  // fetch_left's tool down into the parts bin.
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(goal: \[0\.7, 0\.4, 0\.0, -1\.6, 0\.0, 2\.4, 0\.8\])",
+       "goal: [0.8, 0.4, 0.0, -1.9, 0.0, 2.25, 0.8]");
+  std::string out;
+  EXPECT_EQ(Run(&out), 1) << out;
+  EXPECT_NE(out.find("'fetch_left' has its goal in the static scene"), std::string::npos) << out;
+}
+
+TEST_F(CellCheck, UnknownHumanActionAndBrokenConfigAreRefused) {
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(human_actions: \[reach_parts, assemble, idle\])",
+       "human_actions: [reach_parts, assemble, idle, sweep]");
+  std::string out;
+  EXPECT_EQ(Run(&out), 1) << out;
+  EXPECT_NE(out.find("human action 'sweep' of the task graph is not an action of the synthetic person"),
+            std::string::npos)
+      << out;
+  Write(dir_ / "collision_risk.yaml", "collision_risk: {delta_cl: 2}\n");
+  EXPECT_EQ(Run(&out), 2) << out;
+  EXPECT_NE(out.find("delta_cl"), std::string::npos) << out;
+}
+
+}  // namespace
+}  // namespace iplan::testing

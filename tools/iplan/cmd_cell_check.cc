@@ -1,0 +1,252 @@
+// `iplan cell-check`: does the cell's geometry agree with its task graph?
+//
+// The task graph declares which robot tasks conflict with which human
+// actions; the supervisor's reward and the learned task order rest on those
+// declarations. This command puts the robot at every task's goal, lets the
+// configured synthetic person do every action (several repetitions, with the
+// configured variation and sensor noise), and runs the collision-risk
+// service's own ISO/TS 15066 monitor on it. A task the graph calls harmless
+// that the monitor would stop is an inconsistency: the robot would wait there
+// whatever the task planner learns. Each goal's clearance from the static
+// scene is checked against the trajectory optimiser's minimum too: a goal
+// inside an obstacle fails every time it is commanded. Offline, no DDS.
+#include <algorithm>
+#include <cmath>
+#include <filesystem>
+#include <iomanip>
+#include <iostream>
+#include <limits>
+#include <sstream>
+
+#include "command_registry.h"
+#include "core/synthetic_person.h"
+#include "core/task_planner.h"
+#include "iplan/framework/config.h"
+#include "iplan/framework/service.h"
+#include "iplan/planning/planner.h"
+#include "risk_config.h"
+#include "synthetic_config.h"
+
+namespace iplan::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+struct CheckOptions {
+  std::string config_dir;
+  double margin = 0.05;  // m, clearance required beyond S_p for harmless pairs
+  int repetitions = 5;
+};
+
+// Worst moment of one (task, action) pair.
+struct PairResult {
+  double margin = std::numeric_limits<double>::infinity();  // separation - S_p, m
+  double separation = 0, protective = 0, human_speed = 0, time = 0;
+  std::string robot_link, human_segment;
+};
+
+std::string Fixed(double v, int digits, bool sign = false) {
+  std::ostringstream s;
+  if (sign) s << std::showpos;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+// The monitor's view while the person does `action` (repeated, each
+// repetition with its own variation) and the robot rests at `goal`.
+PairResult Evaluate(const collision_risk::RiskConfig& rc, const perception::SyntheticPersonParams& person_params,
+                    const std::string& action, const std::vector<double>& goal, int repetitions) {
+  perception::SyntheticPersonParams p = person_params;
+  const auto it = std::find_if(p.actions.begin(), p.actions.end(), [&](const auto& a) { return a.name == action; });
+  const double period = it->period;
+  p.script = {perception::ScriptStep{action, 2 * period}};
+  p.loop = false;
+  perception::SyntheticPerson person(p);
+  collision_risk::RiskMonitor monitor = collision_risk::MakeRiskMonitor(rc);
+  std::vector<std::string> robot_joints;
+  for (int j : monitor.robot().q_joints) robot_joints.push_back(monitor.robot().joints[static_cast<std::size_t>(j)].name);
+  if (goal.size() != robot_joints.size()) {
+    throw std::runtime_error("goal has " + std::to_string(goal.size()) + " joints, the robot " +
+                             std::to_string(robot_joints.size()));
+  }
+  PairResult worst;
+  const double dt = 1.0 / 30;
+  const double length = 2 * period;
+  for (int rep = 0; rep < repetitions; ++rep) {
+    const double start = rep * (length + 1.0);
+    person.StartScript(start);
+    // Skip the first speed window: the monitor uses the ISO default speed
+    // until it has seen enough skeletons, which is not the action's speed.
+    const double settle = rc.params.ssm.speed_window;
+    for (double t = start; t < start + length; t += dt) {
+      const auto stamp = static_cast<int64_t>(std::llround(t * 1e9));
+      monitor.UpdateRobotState(stamp, robot_joints, goal);
+      std::vector<std::string> names;
+      std::vector<Eigen::Vector3d> pos;
+      for (const auto& j : person.Observe(t)) {
+        names.push_back(j.name);
+        pos.push_back(j.position_W);
+      }
+      if (auto why = monitor.UpdateSkeleton(stamp, names, pos)) throw std::runtime_error(*why);
+      if (t < start + settle) continue;
+      const collision_risk::RiskReport r = monitor.Evaluate(stamp);
+      const double m = r.min_separation - r.protective_separation;
+      if (m < worst.margin) {
+        worst.margin = m;
+        worst.separation = r.min_separation;
+        worst.protective = r.protective_separation;
+        worst.human_speed = r.human_speed;
+        worst.time = t - start;
+        worst.robot_link = r.separation_robot_link;
+        worst.human_segment = r.separation_human_segment;
+      }
+    }
+  }
+  return worst;
+}
+
+int RunCellCheck(const CheckOptions& o) {
+  std::string dir = o.config_dir;
+  if (dir.empty()) {
+    const std::string f = framework::DefaultConfigFile("supervisor");
+    if (f.empty()) {
+      std::cerr << "iplan cell-check: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+      return 2;
+    }
+    dir = fs::path(f).parent_path().string();
+  }
+  auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
+  perception::SyntheticPersonParams person;
+  collision_risk::RiskConfig risk;
+  supervisor::TaskGraph graph;
+  std::unique_ptr<planning::Planner> planner;
+  // Tools read part of each service's file: its values are checked, its other
+  // keys are the services' business.
+  auto check = [](const framework::ConfigSection& c) {
+    if (c.Problems().empty()) return;
+    std::string msg;
+    for (const auto& p : c.Problems()) msg += (msg.empty() ? "" : "\n") + p;
+    throw std::runtime_error(msg);
+  };
+  try {
+    framework::ConfigSection pconf = framework::ConfigSection::Load(cfg("perception"));
+    framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
+    perception::ScriptStart start;
+    person = perception::ReadSyntheticPerson(syn, &start);
+    check(pconf);
+    if (const std::string why = person.Validate(); !why.empty()) {
+      throw std::runtime_error(cfg("perception") + ": key 'perception.synthetic': " + why);
+    }
+    framework::ConfigSection rconf = framework::ConfigSection::Load(cfg("collision_risk"));
+    framework::ConfigSection rsec = rconf.Section("collision_risk");
+    risk = collision_risk::ReadRiskConfig(rsec);
+    check(rconf);
+    if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
+    framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
+    framework::ConfigSection ssec = sconf.Section("supervisor");
+    std::string graph_file = "tasks/table_top.yaml";
+    ssec.Read("task_graph", &graph_file);
+    check(sconf);
+    graph = supervisor::LoadTaskGraph(sconf.ResolvePath(graph_file));
+    // The static scene, as the trajectory optimiser sees it.
+    framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
+    framework::ConfigSection tsec = tconf.Section("trajopt");
+    std::string robot_file = "robots/panda.yaml", scene_file = "scenes/cell.yaml", planner_file = "planner.yaml";
+    tsec.Read("robot", &robot_file);
+    tsec.Read("scene", &scene_file);
+    tsec.Read("planner", &planner_file);
+    check(tconf);
+    planner = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(tconf.ResolvePath(robot_file)),
+                                                  collision::LoadSceneParams(tconf.ResolvePath(scene_file)),
+                                                  planning::LoadPlannerParams(tconf.ResolvePath(planner_file)));
+  } catch (const std::exception& e) {
+    std::cerr << "iplan cell-check: " << e.what() << "\n";
+    return 2;
+  }
+
+  // The graph's human actions must be actions the person can do.
+  std::vector<std::string> problems;
+  std::vector<std::string> actions;
+  for (const auto& a : graph.human_actions) {
+    if (std::any_of(person.actions.begin(), person.actions.end(), [&](const auto& m) { return m.name == a; })) {
+      actions.push_back(a);
+    } else {
+      problems.push_back("human action '" + a + "' of the task graph is not an action of the synthetic person (perception.yaml)");
+    }
+  }
+
+  std::cout << "ISO/TS 15066 margin (separation - protective separation, m) with the robot at each task's goal\n"
+            << "and the person doing each action (worst of " << o.repetitions
+            << " repetitions, sensor noise included; * = declared conflict), and the goal's clearance from\n"
+            << "the static scene (m; the trajectory optimiser needs at least " << Fixed(planner->params().min_clearance, 3)
+            << "):\n\n";
+  std::size_t w = 6;
+  for (const auto& t : graph.tasks) w = std::max(w, t.name.size() + 2);
+  std::cout << std::left << std::setw(static_cast<int>(w)) << "task";
+  for (const auto& a : actions) std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(a.size(), 8) + 3)) << a;
+  std::cout << std::right << std::setw(12) << "clearance" << "\n";
+  std::vector<std::string> notes;
+  for (const auto& task : graph.tasks) {
+    std::cout << std::left << std::setw(static_cast<int>(w)) << task.name;
+    for (const auto& a : actions) {
+      PairResult r;
+      try {
+        r = Evaluate(risk, person, a, task.goal, o.repetitions);
+      } catch (const std::exception& e) {
+        std::cerr << "\niplan cell-check: task '" << task.name << "': " << e.what() << "\n";
+        return 2;
+      }
+      const bool declared =
+          std::find(task.conflicts_with.begin(), task.conflicts_with.end(), a) != task.conflicts_with.end();
+      std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(a.size(), 8) + 2))
+                << Fixed(r.margin, 2, true) << (declared ? "*" : " ");
+      const std::string detail = "separation " + Fixed(r.separation, 2) + " m (" + r.robot_link + " / " +
+                                 r.human_segment + "), S_p " + Fixed(r.protective, 2) + " m at v_h " +
+                                 Fixed(r.human_speed, 2) + " m/s, " + Fixed(r.time, 1) + " s into the action";
+      if (!declared && r.margin < o.margin) {
+        problems.push_back("'" + task.name + "' is declared harmless during '" + a + "' but the person comes within " +
+                           (r.margin < 0 ? "the protective separation: the monitor would stop the robot there ("
+                                         : "the required margin of it (") +
+                           detail + "). Declare conflicts_with: [" + a + "] or move the goal.");
+      } else if (declared && r.margin >= o.margin) {
+        notes.push_back("'" + task.name + "' is declared to conflict with '" + a + "' but stays clear (" + detail +
+                        "); only the reward's harmony term keeps them apart.");
+      }
+    }
+    const double clearance = planner->CalcClearance(
+        Eigen::Map<const Eigen::VectorXd>(task.goal.data(), static_cast<Eigen::Index>(task.goal.size())));
+    std::cout << std::right << std::setw(11) << Fixed(clearance, 3) << "\n";
+    if (clearance < planner->params().min_clearance) {
+      problems.push_back("'" + task.name + "' has its goal in the static scene (clearance " + Fixed(clearance, 3) +
+                         " m < " + Fixed(planner->params().min_clearance, 3) +
+                         " m): the trajectory optimiser will refuse it every time.");
+    }
+  }
+  std::cout << "\n";
+  for (const auto& n : notes) std::cout << "note: " << n << "\n";
+  for (const auto& p : problems) std::cout << "inconsistent: " << p << "\n";
+  if (problems.empty()) {
+    std::cout << "consistent: every task the graph calls harmless keeps at least " << Fixed(o.margin, 2)
+              << " m beyond S_p\n";
+  }
+  return problems.empty() ? 0 : 1;
+}
+
+const bool kRegistered = RegisterCommand("cell-check", [](CLI::App& app) {
+  auto o = std::make_shared<CheckOptions>();
+  CLI::App* c = app.add_subcommand(
+      "cell-check",
+      "Check that the cell's geometry agrees with its task graph: with the robot at each task's goal and the\n"
+      "synthetic person doing each human action, the ISO/TS 15066 monitor (collision_risk.yaml) must not stop\n"
+      "the robot for tasks the graph calls harmless. Prints the margin table; exit code 0 when consistent,\n"
+      "1 when not, 2 on bad configuration. Goals only: paths between goals are not checked.");
+  c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
+  c->add_option("--margin", o->margin, "m of clearance beyond S_p required for harmless pairs")->capture_default_str()
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--repetitions", o->repetitions, "repetitions of each action (each with its own variation)")
+      ->capture_default_str()->check(CLI::Range(1, 100));
+  c->callback([o] { SetExitCode(RunCellCheck(*o)); });
+});
+
+}  // namespace
+}  // namespace iplan::cli
