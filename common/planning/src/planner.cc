@@ -184,6 +184,18 @@ struct Planner::Impl {
 
   double Threshold() const { return 1.0 - params.delta_cl; }
 
+  // A ball around one link's spheres at the FK in `data`: centre *c (the
+  // spheres' mean) and its radius, which covers every sphere. Distances
+  // are 1-Lipschitz, so the ball's distance bounds all its spheres'.
+  double LinkBall(const RobotData& data, const std::vector<int>& group, Eigen::Vector3d* c) const {
+    c->setZero();
+    for (int sp : group) *c += data.p_WS.col(sp);
+    *c /= static_cast<double>(group.size());
+    double cover = 0.0;
+    for (int sp : group) cover = std::max(cover, (data.p_WS.col(sp) - *c).norm() + radii[sp]);
+    return cover;
+  }
+
   // Minimum signed distance of all checked spheres at the FK in `data`.
   double Clearance(const RobotData& data) const {
     // Per link, a ball around its spheres first (the signed distance is
@@ -191,11 +203,8 @@ struct Planner::Impl {
     // best so far are skipped. The minimum is the same.
     double best = std::numeric_limits<double>::infinity();
     for (const std::vector<int>& grp : link_groups) {
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (int sp : grp) c += data.p_WS.col(sp);
-      c /= static_cast<double>(grp.size());
-      double cover = 0.0;
-      for (int sp : grp) cover = std::max(cover, (data.p_WS.col(sp) - c).norm() + radii[sp]);
+      Eigen::Vector3d c;
+      const double cover = LinkBall(data, grp, &c);
       for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
         if (!checked[grp[0]][o]) continue;  // allowed pairs are per link
         const auto& ob = objects[o];
@@ -308,12 +317,8 @@ struct Planner::Impl {
     for (int i = k; i < n; ++i) {
       const RobotData& d = ws->data[i];
       for (int g = 0; g < NG; ++g) {
-        const std::vector<int>& grp = link_groups[g];
-        Eigen::Vector3d c = Eigen::Vector3d::Zero();
-        for (int sp : grp) c += d.p_WS.col(sp);
-        c /= static_cast<double>(grp.size());
-        double cover = 0.0;
-        for (int sp : grp) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+        Eigen::Vector3d c;
+        const double cover = LinkBall(d, link_groups[g], &c);
         for (int o = 0; o < NO; ++o) {
           const auto& ob = objects[o];
           double lower = (c - ob.centre_W).norm() - ob.bounding_radius - cover;
@@ -369,11 +374,8 @@ struct Planner::Impl {
         const RobotData& d = ws->data[i];
         bool may_matter = false;
         for (std::size_t g = 0; g < link_groups.size(); ++g) {
-          Eigen::Vector3d c = Eigen::Vector3d::Zero();
-          for (int sp : link_groups[g]) c += d.p_WS.col(sp);
-          c /= static_cast<double>(link_groups[g].size());
-          double cover = 0.0;
-          for (int sp : link_groups[g]) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+          Eigen::Vector3d c;
+          const double cover = LinkBall(d, link_groups[g], &c);
           for (int l = 0; l < H; ++l) {
             const HumanPrediction::Summary& sm = hp.summary(t, l);
             const double delta =
@@ -475,11 +477,8 @@ struct Planner::Impl {
         const int t = at.steps[i];
         for (std::size_t g = 0; g < link_groups.size(); ++g) {
           // A ball around the link's spheres first, as for the obstacles.
-          Eigen::Vector3d c = Eigen::Vector3d::Zero();
-          for (int sp : link_groups[g]) c += d.p_WS.col(sp);
-          c /= static_cast<double>(link_groups[g].size());
-          double cover = 0.0;
-          for (int sp : link_groups[g]) cover = std::max(cover, (d.p_WS.col(sp) - c).norm() + radii[sp]);
+          Eigen::Vector3d c;
+          const double cover = LinkBall(d, link_groups[g], &c);
           for (int l = 0; l < H; ++l) {
             // The bounding ball of the actions' means bounds every mean.
             const HumanPrediction::Summary& sm = hp.summary(t, l);
