@@ -16,6 +16,7 @@
 #include <iomanip>
 #include <iostream>
 #include <limits>
+#include <optional>
 #include <sstream>
 
 #include "command_registry.h"
@@ -54,15 +55,18 @@ std::string Fixed(double v, int digits, bool sign = false) {
 
 // The monitor's view while the person does `action` (repeated, each
 // repetition with its own variation) and the robot rests at `goal`.
-PairResult Evaluate(const collision_risk::RiskConfig& rc, const perception::SyntheticPersonParams& person_params,
-                    const std::string& action, const std::vector<double>& goal, int repetitions) {
+// `fresh` is a monitor that has seen nothing yet; it is copied, so the models
+// are loaded once for all pairs.
+PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_risk::RiskParams& params,
+                    const perception::SyntheticPersonParams& person_params, const std::string& action,
+                    const std::vector<double>& goal, int repetitions) {
   perception::SyntheticPersonParams p = person_params;
   const auto it = std::find_if(p.actions.begin(), p.actions.end(), [&](const auto& a) { return a.name == action; });
   const double period = it->period;
   p.script = {perception::ScriptStep{action, 2 * period}};
   p.loop = false;
   perception::SyntheticPerson person(p);
-  collision_risk::RiskMonitor monitor = collision_risk::MakeRiskMonitor(rc);
+  collision_risk::RiskMonitor monitor = fresh;
   std::vector<std::string> robot_joints;
   for (int j : monitor.robot().q_joints) robot_joints.push_back(monitor.robot().joints[static_cast<std::size_t>(j)].name);
   if (goal.size() != robot_joints.size()) {
@@ -77,7 +81,7 @@ PairResult Evaluate(const collision_risk::RiskConfig& rc, const perception::Synt
     person.StartScript(start);
     // Skip the first speed window: the monitor uses the ISO default speed
     // until it has seen enough skeletons, which is not the action's speed.
-    const double settle = rc.params.ssm.speed_window;
+    const double settle = params.ssm.speed_window;
     for (double t = start; t < start + length; t += dt) {
       const auto stamp = static_cast<int64_t>(std::llround(t * 1e9));
       monitor.UpdateRobotState(stamp, robot_joints, goal);
@@ -120,6 +124,7 @@ int RunCellCheck(const CheckOptions& o) {
   collision_risk::RiskConfig risk;
   supervisor::TaskGraph graph;
   std::unique_ptr<planning::Planner> planner;
+  std::optional<collision_risk::RiskMonitor> monitor;
   // Tools read part of each service's file: its values are checked, its other
   // keys are the services' business.
   auto check = [](const framework::ConfigSection& c) {
@@ -142,6 +147,7 @@ int RunCellCheck(const CheckOptions& o) {
     risk = collision_risk::ReadRiskConfig(rsec);
     check(rconf);
     if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
+    monitor = collision_risk::MakeRiskMonitor(risk);
     framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
     framework::ConfigSection ssec = sconf.Section("supervisor");
     std::string graph_file = "tasks/table_top.yaml";
@@ -191,7 +197,7 @@ int RunCellCheck(const CheckOptions& o) {
     for (const auto& a : actions) {
       PairResult r;
       try {
-        r = Evaluate(risk, person, a, task.goal, o.repetitions);
+        r = Evaluate(*monitor, risk.params, person, a, task.goal, o.repetitions);
       } catch (const std::exception& e) {
         std::cerr << "\niplan cell-check: task '" << task.name << "': " << e.what() << "\n";
         return 2;
