@@ -103,6 +103,7 @@ class CollisionRiskService : public framework::Service {
     m.protective_separation = r.protective_separation;
     m.human_speed = r.human_speed;
     m.robot_speed = r.robot_speed;
+    m.separation_margin = r.separation_margin;
     m.verdict = static_cast<uint8_t>(r.verdict);
     m.reason = r.reason;
     writer_->Write(m);

@@ -20,12 +20,14 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   config.Read("stale_after", &p.stale_after, framework::Positive<double>());
   framework::ConfigSection iso = config.Section("iso_ts_15066");
   SsmParams& s = p.ssm;
+  iso.Read("directed", &s.directed);
   iso.Read("measure_human_speed", &s.measure_human_speed);
   iso.Read("default_human_speed", &s.default_human_speed, framework::NonNegative<double>());
   iso.Read("speed_window", &s.speed_window, framework::Positive<double>());
   iso.Read("reaction_time", &s.reaction_time, framework::NonNegative<double>());
   iso.Read("stopping_time", &s.stopping_time, framework::NonNegative<double>());
   iso.Read("stopping_distance", &s.stopping_distance, framework::NonNegative<double>());
+  iso.Read("stopping_speed", &s.stopping_speed, framework::Positive<double>());
   iso.Read("intrusion_distance", &s.intrusion_distance, framework::NonNegative<double>());
   iso.Read("sensing_uncertainty", &s.sensing_uncertainty, framework::NonNegative<double>());
   iso.Read("robot_uncertainty", &s.robot_uncertainty, framework::NonNegative<double>());

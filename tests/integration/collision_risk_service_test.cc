@@ -142,7 +142,7 @@ TEST(CollisionRiskService, ApproachingPersonStopsTheRobotBeforeSeparationIsViola
     const auto& r = risks[i];
     if (r.reason == "no robot state yet") continue;
     if (first_stop < 0 && r.verdict == msg::CollisionRisk::PROTECTIVE_STOP) first_stop = static_cast<int>(i);
-    if (first_violation < 0 && r.min_separation < r.protective_separation) first_violation = static_cast<int>(i);
+    if (first_violation < 0 && r.separation_margin < 0) first_violation = static_cast<int>(i);
   }
   ASSERT_GE(first_stop, 0) << "never stopped";
   ASSERT_GE(first_violation, 0) << "the scripted person should end up inside S_p";
@@ -151,7 +151,7 @@ TEST(CollisionRiskService, ApproachingPersonStopsTheRobotBeforeSeparationIsViola
             << stop.protective_separation << " m, bound " << stop.max_bound << " at +" << stop.max_time
             << " s: " << stop.reason << "\n";
   EXPECT_LT(first_stop, first_violation);
-  EXPECT_GT(stop.min_separation, stop.protective_separation);
+  EXPECT_GT(stop.separation_margin, 0.0);
   EXPECT_NE(stop.reason.find("collision bound"), std::string::npos) << stop.reason;
   EXPECT_EQ(stop.max_action, "walk_to_robot");
   // Once the separation is violated, every later verdict is a stop.
@@ -168,7 +168,8 @@ TEST(CollisionRiskService, PersonWhoStaysAwayIsOk) {
     ++evaluated;
     EXPECT_EQ(r.verdict, msg::CollisionRisk::OK) << r.reason;
     EXPECT_LT(r.max_bound, 0.05 * 0.5);
-    EXPECT_GT(r.min_separation, r.protective_separation);
+    EXPECT_GT(r.separation_margin, 0.0);
+    EXPECT_GE(r.min_separation - r.protective_separation, r.separation_margin - 1e-9);
     EXPECT_GE(r.waypoint_bounds.size(), 13u);  // the future steps of a 15-step prediction
     EXPECT_LT(r.max_waypoint, r.waypoint_bounds.size());
   }

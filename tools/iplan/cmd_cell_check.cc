@@ -94,15 +94,15 @@ PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_ri
       if (auto why = monitor.UpdateSkeleton(stamp, names, pos)) throw std::runtime_error(*why);
       if (t < start + settle) continue;
       const collision_risk::RiskReport r = monitor.Evaluate(stamp);
-      const double m = r.min_separation - r.protective_separation;
+      const double m = r.separation_margin;
       if (m < worst.margin) {
         worst.margin = m;
-        worst.separation = r.min_separation;
+        worst.separation = r.binding_separation;
         worst.protective = r.protective_separation;
         worst.human_speed = r.human_speed;
         worst.time = t - start;
-        worst.robot_link = r.separation_robot_link;
-        worst.human_segment = r.separation_human_segment;
+        worst.robot_link = r.binding_robot_link;
+        worst.human_segment = r.binding_human_segment;
       }
     }
   }

@@ -50,6 +50,7 @@ std::string RiskParams::Validate() const {
     if (!(v >= 0)) return "ISO/TS 15066 parameters must be >= 0";
   }
   if (!(s.speed_window > 0)) return "speed_window must be > 0";
+  if (!(s.stopping_speed > 0)) return "stopping_speed must be > 0";
   return "";
 }
 
@@ -129,23 +130,22 @@ Eigen::VectorXd RiskMonitor::RobotConfigurationAt(int64_t t_ns) const {
   return (1 - u) * trajectory_positions_[i - 1] + u * trajectory_positions_[i];
 }
 
-double RiskMonitor::MeasuredHumanSpeed() const {
-  if (!params_.ssm.measure_human_speed || skeletons_.size() < 2) return params_.ssm.default_human_speed;
+bool RiskMonitor::MeasuredJointVelocities(Eigen::Matrix3Xd* v) const {
+  if (!params_.ssm.measure_human_speed || skeletons_.size() < 2) return false;
   const auto& newest = skeletons_.back();
   const int64_t window = static_cast<int64_t>(params_.ssm.speed_window * 1e9);
   // The oldest skeleton still within the window, at least half a window back.
   for (const auto& s : skeletons_) {
     const int64_t dt = newest.first - s.first;
     if (dt <= window && dt >= window / 2) {
-      return ((newest.second - s.second).colwise().norm()).maxCoeff() / (dt * 1e-9);
+      *v = (newest.second - s.second) / (dt * 1e-9);
+      return true;
     }
   }
-  return params_.ssm.default_human_speed;  // not enough history: the ISO default
+  return false;  // not enough history
 }
 
-double RiskMonitor::RobotSpeed(int64_t now_ns) {
-  // Fastest robot sphere: along the executing trajectory when there is one,
-  // else from the last two joint states.
+void RiskMonitor::RobotSphereVelocities(int64_t now_ns, Eigen::Matrix3Xd* v) {
   Eigen::VectorXd q0, q1;
   double dt = 0;
   if (!trajectory_positions_.empty()) {
@@ -157,11 +157,12 @@ double RiskMonitor::RobotSpeed(int64_t now_ns) {
     q0 = previous_state_->second;
     q1 = state_->second;
   } else {
-    return 0;
+    v->setZero(3, static_cast<Eigen::Index>(robot_.spheres.size()));
+    return;
   }
   collision::CalcForwardKinematics(robot_, q0, &data_);
   collision::CalcForwardKinematics(robot_, q1, &data2_);
-  return (data2_.p_WS - data_.p_WS).colwise().norm().maxCoeff() / dt;
+  *v = (data2_.p_WS - data_.p_WS) / dt;
 }
 
 RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
@@ -177,31 +178,66 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
   r.trajectory_stamp_ns = trajectory_positions_.empty() ? 0 : trajectory_start_ns_;
 
-  // ISO/TS 15066 layer: current separation against S_p.
+  // ISO/TS 15066 layer: current separation against S_p, per sphere pair
+  // when directed (see the header), else one S_p from the fastest joint and
+  // the fastest robot sphere.
   const SsmParams& s = params_.ssm;
-  r.human_speed = person ? MeasuredHumanSpeed() : s.default_human_speed;
-  r.robot_speed = RobotSpeed(now_ns);
-  r.protective_separation = r.human_speed * (s.reaction_time + s.stopping_time) + r.robot_speed * s.reaction_time +
-                            s.stopping_distance + s.intrusion_distance + s.sensing_uncertainty + s.robot_uncertainty;
   const auto& robot_spheres = robot_.spheres;
+  Eigen::Matrix3Xd v_robot;
+  RobotSphereVelocities(now_ns, &v_robot);
+  Eigen::Matrix3Xd v_joints;
+  const bool measured = person && MeasuredJointVelocities(&v_joints);
+  const double fixed = s.intrusion_distance + s.sensing_uncertainty + s.robot_uncertainty;
+  auto protective = [&](double v_h, double v_r) {
+    const double s_s = s.directed ? s.stopping_distance * std::min(1.0, v_r / s.stopping_speed) : s.stopping_distance;
+    return v_h * (s.reaction_time + s.stopping_time) + v_r * s.reaction_time + s_s + fixed;
+  };
+  // Undirected speeds (also what is reported when nobody is seen).
+  const double v_h_max = measured ? v_joints.colwise().norm().maxCoeff() : s.default_human_speed;
+  const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
+  r.human_speed = v_h_max;
+  r.robot_speed = v_r_max;
+  r.protective_separation = protective(v_h_max, v_r_max);
   if (person) {
     collision::CalcForwardKinematics(robot_, state_->second, &data_);
     const Eigen::Matrix3Xd& joints = skeletons_.back().second;
-    const std::vector<Eigen::Matrix3d> zero(static_cast<std::size_t>(body_.num_joints()), Eigen::Matrix3d::Zero());
-    double best = kNoPerson;
+    double best = kNoPerson, best_margin = kNoPerson;
     for (int h = 0; h < body_.num_spheres(); ++h) {
       const auto& def = body_.spheres()[static_cast<std::size_t>(h)];
       const Eigen::Vector3d c = (1 - def.u) * joints.col(def.joint_a) + def.u * joints.col(def.joint_b);
+      Eigen::Vector3d v_c = Eigen::Vector3d::Zero();
+      if (measured) v_c = (1 - def.u) * v_joints.col(def.joint_a) + def.u * v_joints.col(def.joint_b);
       for (std::size_t k = 0; k < robot_spheres.size(); ++k) {
-        const double d = (data_.p_WS.col(static_cast<Eigen::Index>(k)) - c).norm() - robot_spheres[k].radius - def.radius;
+        const Eigen::Index ki = static_cast<Eigen::Index>(k);
+        const Eigen::Vector3d delta = data_.p_WS.col(ki) - c;  // human -> robot
+        const double centres = delta.norm();
+        const double d = centres - robot_spheres[k].radius - def.radius;
+        double v_h = v_h_max, v_r = v_r_max, sp = r.protective_separation;
+        if (s.directed) {
+          const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
+          v_h = measured ? std::max(0.0, v_c.dot(u)) : s.default_human_speed;
+          v_r = std::max(0.0, -v_robot.col(ki).dot(u));
+          if (centres <= 1e-9) v_r = v_robot.col(ki).norm();  // coincident centres: any motion approaches
+          sp = protective(v_h, v_r);
+        }
         if (d < best) {
           best = d;
           r.separation_robot_link = robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)];
           r.separation_human_segment = body_.params().segments[static_cast<std::size_t>(def.segment)].name;
         }
+        if (d - sp < best_margin) {
+          best_margin = d - sp;
+          r.binding_separation = d;
+          r.protective_separation = sp;
+          r.human_speed = v_h;
+          r.robot_speed = v_r;
+          r.binding_robot_link = robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)];
+          r.binding_human_segment = body_.params().segments[static_cast<std::size_t>(def.segment)].name;
+        }
       }
     }
     r.min_separation = best;
+    r.separation_margin = best_margin;
   }
 
   // Prediction layer: bound along the executing trajectory.
@@ -253,10 +289,11 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
       break;
     }
   }
-  if (person && r.min_separation < r.protective_separation) {
+  if (person && r.separation_margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
-    r.reason = "separation " + Fmt(r.min_separation) + " m (" + r.separation_robot_link + " / " +
-               r.separation_human_segment + ") below the protective separation " + Fmt(r.protective_separation) + " m";
+    r.reason = "separation " + Fmt(r.binding_separation) + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
+               ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
+               ", v_r " + Fmt(r.robot_speed) + " m/s)";
   } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) +
@@ -267,9 +304,9 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
-  } else if (person && r.min_separation < r.protective_separation + params_.slow_down_margin) {
+  } else if (person && r.separation_margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "separation " + Fmt(r.min_separation) + " m within " + Fmt(params_.slow_down_margin) +
+    r.reason = "separation " + Fmt(r.binding_separation) + " m within " + Fmt(params_.slow_down_margin) +
                " m of the protective separation";
   } else {
     r.verdict = Verdict::kOk;

@@ -9,6 +9,15 @@
 //    prediction: the current minimum robot-human surface distance against the
 //    protective separation distance
 //      S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r.
+// With `directed` (the default, as ISO/TS 15066 defines the speeds) S_p is
+// evaluated per pair of robot and human spheres: v_h is the human sphere's
+// speed towards the robot sphere, v_r the robot sphere's speed towards the
+// human sphere, and S_s scales with that speed, S_s * min(1, v_r / v_s)
+// with v_s the speed at which the stopping distance was measured (linear in
+// the speed, so above the v^2 of a constant deceleration below v_s; a robot
+// at rest or moving away travels nothing towards the person while it stops).
+// So a stopped robot whose plan moves it away from a person standing
+// still may resume, and a hand moving sideways does not inflate S_p.
 // Verdict: PROTECTIVE_STOP when the separation is below S_p, or the bound
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
 // unknown; SLOW_DOWN when within a margin of either; OK otherwise.
@@ -35,12 +44,14 @@ namespace iplan::collision_risk {
 
 /// ISO/TS 15066 speed and separation monitoring parameters.
 struct SsmParams {
+  bool directed = true;             ///< speeds towards each other per sphere pair; false: fastest joint / sphere, S_s always
   bool measure_human_speed = true;  ///< from the skeleton; else v_h = default_human_speed
   double default_human_speed = 1.6; ///< m/s, ISO value when the speed is not measured
   double speed_window = 0.3;        ///< s, displacement window for the measured speed
   double reaction_time = 0.1;       ///< s, T_r
   double stopping_time = 0.3;       ///< s, T_s
-  double stopping_distance = 0.15;  ///< m, S_s
+  double stopping_distance = 0.15;  ///< m, S_s (at stopping_speed when directed)
+  double stopping_speed = 1.0;      ///< m/s, robot speed at which stopping_distance was measured (directed only)
   double intrusion_distance = 0.1;  ///< m, C
   double sensing_uncertainty = 0.05;  ///< m, Z_d
   double robot_uncertainty = 0.02;    ///< m, Z_r
@@ -72,9 +83,12 @@ struct RiskReport {
   std::string max_robot_link, max_human_segment, max_action;
   double min_separation = 1e6;           ///< m; 1e6 when no person is seen
   std::string separation_robot_link, separation_human_segment;
-  double protective_separation = 0;      ///< m, S_p
-  double human_speed = 0;                ///< m/s used for S_p
-  double robot_speed = 0;                ///< m/s used for S_p
+  double protective_separation = 0;      ///< m, S_p of the binding pair (smallest separation - S_p)
+  double human_speed = 0;                ///< m/s used for that S_p (towards the robot when directed)
+  double robot_speed = 0;                ///< m/s used for that S_p (towards the person when directed)
+  double binding_separation = 1e6;       ///< m, separation of the binding pair; 1e6 when no person is seen
+  double separation_margin = 1e6;        ///< m, binding_separation - protective_separation; < 0 stops
+  std::string binding_robot_link, binding_human_segment;
   Verdict verdict = Verdict::kProtectiveStop;
   std::string reason;
 };
@@ -107,8 +121,12 @@ class RiskMonitor {
 
  private:
   Eigen::VectorXd RobotConfigurationAt(int64_t t_ns) const;
-  double MeasuredHumanSpeed() const;
-  double RobotSpeed(int64_t now_ns);
+  /// Per-joint velocity (m/s, 3 x joints) over the speed window; false when
+  /// not measured (measure_human_speed off or too little history).
+  bool MeasuredJointVelocities(Eigen::Matrix3Xd* v) const;
+  /// Velocity (m/s, 3 x spheres) of the robot spheres along the executing
+  /// trajectory, else from the last two joint states, else zero.
+  void RobotSphereVelocities(int64_t now_ns, Eigen::Matrix3Xd* v);
 
   collision::RobotModel robot_;
   collision::HumanBodyModel body_;

@@ -83,8 +83,29 @@ TEST_F(RiskMonitorTest, OkWhenThePersonStaysAway) {
   EXPECT_LT(r.max_bound, 1e-6);
   EXPECT_GT(r.min_separation, 1.0);
   EXPECT_NEAR(r.human_speed, 0.0, 1e-9);
-  // S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r with v_h = v_r = 0.
+  EXPECT_NEAR(r.robot_speed, 0.0, 1e-9);
+  // S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r with v_h = v_r = 0;
+  // a robot at rest travels nothing while it stops, so S_s does not count.
+  EXPECT_NEAR(r.protective_separation, 0.1 + 0.05 + 0.02, 1e-12);
+  EXPECT_NEAR(r.separation_margin, r.binding_separation - r.protective_separation, 1e-12);
+  EXPECT_GE(r.binding_separation, r.min_separation);
+}
+
+TEST(RiskMonitorUndirected, StoppingDistanceAlwaysCounts) {
+  RiskParams p;
+  p.ssm.directed = false;
+  RiskMonitor monitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
+                      collision::HumanBodyParams::DefaultUpperBody(), p);
+  const int64_t t = 100 * kSec;
+  ASSERT_EQ(monitor.UpdateRobotState(t, {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4", "panda_joint5",
+                                         "panda_joint6", "panda_joint7"},
+                                     {0, -0.785, 0, -2.356, 0, 1.571, 0.785}),
+            std::nullopt);
+  ASSERT_EQ(monitor.UpdateSkeleton(t - 2 * kSec / 10, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
+  ASSERT_EQ(monitor.UpdateSkeleton(t, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
+  const RiskReport r = monitor.Evaluate(t);
   EXPECT_NEAR(r.protective_separation, 0.15 + 0.1 + 0.05 + 0.02, 1e-12);
+  EXPECT_NEAR(r.separation_margin, r.min_separation - r.protective_separation, 1e-12);
 }
 
 TEST_F(RiskMonitorTest, MeasuredHumanSpeedEntersTheProtectiveSeparation) {
@@ -94,9 +115,70 @@ TEST_F(RiskMonitorTest, MeasuredHumanSpeedEntersTheProtectiveSeparation) {
   SeePerson(t - 3 * kSec / 10, {2.3, 0, 1.0});
   SeePerson(t, {2.0, 0, 1.0});
   const RiskReport r = monitor_.Evaluate(t);
-  EXPECT_NEAR(r.human_speed, 1.0, 1e-9);
-  EXPECT_NEAR(r.protective_separation, 1.0 * (0.1 + 0.3) + 0.15 + 0.1 + 0.05 + 0.02, 1e-9);
+  // Directed: the torso's speed towards the binding robot sphere, at most
+  // 1 m/s and most of it (the person walks straight at the robot).
+  EXPECT_GT(r.human_speed, 0.7);
+  EXPECT_LE(r.human_speed, 1.0 + 1e-9);
+  EXPECT_NEAR(r.protective_separation, r.human_speed * (0.1 + 0.3) + 0.1 + 0.05 + 0.02, 1e-9);
   EXPECT_EQ(r.reason, "clear (separation only: no current prediction)");
+}
+
+TEST_F(RiskMonitorTest, SidewaysMotionDoesNotInflateTheDirectedProtectiveSeparation) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // The whole person moving at 1 m/s along y, 1 m in front of the robot.
+  SeePerson(t - 3 * kSec / 10, {1.3, -0.3, 0.6});
+  SeePerson(t, {1.3, 0.0, 0.6});
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_LT(r.human_speed, 0.3) << "only the part of the motion towards the robot counts";
+  // The same scene undirected: v_h = 1 m/s and S_s, so S_p is at least 0.55 m larger.
+  RiskParams p;
+  p.ssm.directed = false;
+  RiskMonitor undirected(collision::RobotModel(monitor_.robot()), collision::HumanBodyParams::DefaultUpperBody(), p);
+  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                          "panda_joint5", "panda_joint6", "panda_joint7"};
+  ASSERT_EQ(undirected.UpdateRobotState(t, names, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  ASSERT_EQ(undirected.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person({1.3, -0.3, 0.6})), std::nullopt);
+  ASSERT_EQ(undirected.UpdateSkeleton(t, kJoints, Person({1.3, 0.0, 0.6})), std::nullopt);
+  const RiskReport u = undirected.Evaluate(t);
+  EXPECT_NEAR(u.human_speed, 1.0, 1e-9);
+  EXPECT_NEAR(u.min_separation, r.min_separation, 1e-12);
+  EXPECT_GT(r.separation_margin - u.separation_margin, 0.4 + 0.15 - 0.3 * 0.4);
+}
+
+TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // A person standing still with the right hand about 0.25 m from the robot:
+  // outside S_p of a robot at rest (0.17 m), inside S_p with S_s (0.32 m).
+  const Eigen::Vector3d torso(0.95, 0, 0.5);
+  SeePerson(t - 2 * kSec / 10, torso, 0.3);
+  SeePerson(t, torso, 0.3);
+  const RiskReport still = monitor_.Evaluate(t);
+  ASSERT_GT(still.min_separation, 0.17 + 0.02);
+  ASSERT_LT(still.min_separation, 0.32 - 0.02);
+  EXPECT_NE(still.verdict, Verdict::kProtectiveStop) << still.reason;
+  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                          "panda_joint5", "panda_joint6", "panda_joint7"};
+  // Folding the shoulder back moves every sphere away from the person.
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 1.0},
+                                      {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -1.3, 0, -2.356, 0, 1.571, 0.785}}),
+            std::nullopt);
+  const RiskReport away = monitor_.Evaluate(t);
+  EXPECT_NEAR(away.robot_speed, 0.0, 1e-12) << "no sphere of the binding pair approaches";
+  EXPECT_NEAR(away.separation_margin, still.separation_margin, 1e-12);
+  EXPECT_NE(away.verdict, Verdict::kProtectiveStop) << away.reason;
+  // Leaning the shoulder forward approaches the person: v_r T_r and S_s,
+  // scaled by v_r / 1 m/s, count.
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 0.5},
+                                      {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -0.3, 0, -2.356, 0, 1.571, 0.785}}),
+            std::nullopt);
+  const RiskReport closer = monitor_.Evaluate(t);
+  EXPECT_EQ(closer.verdict, Verdict::kProtectiveStop) << closer.reason;
+  EXPECT_GT(closer.robot_speed, 0.3);
+  EXPECT_NEAR(closer.protective_separation,
+              closer.robot_speed * 0.1 + 0.15 * std::min(1.0, closer.robot_speed / 1.0) + 0.17 + closer.human_speed * 0.4,
+              1e-9);
 }
 
 TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
@@ -107,7 +189,8 @@ TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
   SeePerson(t, {0.75, 0, 0.5}, 0.35);
   const RiskReport r = monitor_.Evaluate(t);
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
-  EXPECT_LT(r.min_separation, r.protective_separation);
+  EXPECT_LT(r.separation_margin, 0);
+  EXPECT_LT(r.binding_separation, r.protective_separation);
   EXPECT_NE(r.reason.find("below the protective separation"), std::string::npos) << r.reason;
 }
 
@@ -120,7 +203,7 @@ TEST_F(RiskMonitorTest, PredictionOfContactSoonStopsBeforeSeparationIsViolated) 
   SeePerson(t, torso);
   ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
   const RiskReport r = monitor_.Evaluate(t);
-  EXPECT_GT(r.min_separation, r.protective_separation) << "the separation layer alone would not stop yet";
+  EXPECT_GT(r.separation_margin, 0) << "the separation layer alone would not stop yet";
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
   EXPECT_GE(r.max_bound, 0.05);
   EXPECT_NE(r.reason.find("collision bound"), std::string::npos) << r.reason;
