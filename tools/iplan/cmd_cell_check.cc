@@ -110,14 +110,10 @@ PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_ri
 }
 
 int RunCellCheck(const CheckOptions& o) {
-  std::string dir = o.config_dir;
+  const std::string dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
   if (dir.empty()) {
-    const std::string f = framework::DefaultConfigFile("supervisor");
-    if (f.empty()) {
-      std::cerr << "iplan cell-check: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
-      return 2;
-    }
-    dir = fs::path(f).parent_path().string();
+    std::cerr << "iplan cell-check: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+    return 2;
   }
   auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
   perception::SyntheticPersonParams person;

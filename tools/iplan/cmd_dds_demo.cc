@@ -223,14 +223,10 @@ int RunDemo(const DemoOptions& o) {
   const dds::Vendor vendor_b = vendor_a == dds::Vendor::kCyclone ? dds::Vendor::kFastDds : dds::Vendor::kCyclone;
   // A domain of its own so that the demo never talks to a running cell.
   const int domain = o.domain >= 0 ? o.domain : 100 + static_cast<int>(getpid() % 100);
-  std::string config_dir = o.config_dir;
+  const std::string config_dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
   if (config_dir.empty()) {
-    const std::string f = framework::DefaultConfigFile("supervisor");
-    if (f.empty()) {
-      std::cerr << "iplan demo: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
-      return 2;
-    }
-    config_dir = fs::path(f).parent_path().string();
+    std::cerr << "iplan demo: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+    return 2;
   }
   std::string state_dir = o.state_dir;
   if (state_dir.empty()) {

@@ -32,6 +32,11 @@ std::string DefaultConfigFile(const std::string& service_name) {
   return "";
 }
 
+std::string DefaultConfigDir() {
+  const std::string f = DefaultConfigFile("supervisor");
+  return f.empty() ? f : f.substr(0, f.rfind('/'));
+}
+
 int RunService(int argc, char** argv, const ServiceInfo& info,
                const std::function<std::unique_ptr<Service>()>& make) {
   CLI::App app{"iplan-" + info.name + ": " + info.description +

@@ -10,6 +10,8 @@ namespace {
 constexpr int64_t kSec = 1000000000;
 const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
                                           "shoulder_r", "elbow_r", "hand_r"};
+const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                               "panda_joint5", "panda_joint6", "panda_joint7"};
 
 // A person standing upright with the torso at `torso`, facing -x, arms
 // forward; the right hand is `reach` m in front of the torso.
@@ -31,9 +33,7 @@ class RiskMonitorTest : public ::testing::Test {
     return p;
   }
   void RobotAtReady(int64_t t) {
-    const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                            "panda_joint5", "panda_joint6", "panda_joint7"};
-    ASSERT_EQ(monitor_.UpdateRobotState(t, names, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+    ASSERT_EQ(monitor_.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
   }
   void SeePerson(int64_t t, const Eigen::Vector3d& torso, double reach = 0.3) {
     ASSERT_EQ(monitor_.UpdateSkeleton(t, kJoints, Person(torso, reach)), std::nullopt);
@@ -97,9 +97,7 @@ TEST(RiskMonitorUndirected, StoppingDistanceAlwaysCounts) {
   RiskMonitor monitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
                       collision::HumanBodyParams::DefaultUpperBody(), p);
   const int64_t t = 100 * kSec;
-  ASSERT_EQ(monitor.UpdateRobotState(t, {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4", "panda_joint5",
-                                         "panda_joint6", "panda_joint7"},
-                                     {0, -0.785, 0, -2.356, 0, 1.571, 0.785}),
+  ASSERT_EQ(monitor.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}),
             std::nullopt);
   ASSERT_EQ(monitor.UpdateSkeleton(t - 2 * kSec / 10, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
   ASSERT_EQ(monitor.UpdateSkeleton(t, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
@@ -135,9 +133,7 @@ TEST_F(RiskMonitorTest, SidewaysMotionDoesNotInflateTheDirectedProtectiveSeparat
   RiskParams p;
   p.ssm.directed = false;
   RiskMonitor undirected(collision::RobotModel(monitor_.robot()), collision::HumanBodyParams::DefaultUpperBody(), p);
-  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                          "panda_joint5", "panda_joint6", "panda_joint7"};
-  ASSERT_EQ(undirected.UpdateRobotState(t, names, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  ASSERT_EQ(undirected.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
   ASSERT_EQ(undirected.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person({1.3, -0.3, 0.6})), std::nullopt);
   ASSERT_EQ(undirected.UpdateSkeleton(t, kJoints, Person({1.3, 0.0, 0.6})), std::nullopt);
   const RiskReport u = undirected.Evaluate(t);
@@ -158,10 +154,8 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
   ASSERT_GT(still.min_separation, 0.17 + 0.02);
   ASSERT_LT(still.min_separation, 0.32 - 0.02);
   EXPECT_NE(still.verdict, Verdict::kProtectiveStop) << still.reason;
-  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                          "panda_joint5", "panda_joint6", "panda_joint7"};
   // Folding the shoulder back moves every sphere away from the person.
-  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 1.0},
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 1.0},
                                       {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -1.3, 0, -2.356, 0, 1.571, 0.785}}),
             std::nullopt);
   const RiskReport away = monitor_.Evaluate(t);
@@ -170,7 +164,7 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
   EXPECT_NE(away.verdict, Verdict::kProtectiveStop) << away.reason;
   // Leaning the shoulder forward approaches the person: v_r T_r and S_s,
   // scaled by v_r / 1 m/s, count.
-  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 0.5},
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5},
                                       {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -0.3, 0, -2.356, 0, 1.571, 0.785}}),
             std::nullopt);
   const RiskReport closer = monitor_.Evaluate(t);
@@ -234,9 +228,7 @@ TEST_F(RiskMonitorTest, ExecutingTrajectoryIsWhatIsChecked) {
   // the robot holds; a trajectory swinging the arm out to x = 0.78 m is not.
   ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, {0, 0, 0}, 15, 1.0 / 15)), std::nullopt);
   EXPECT_LT(monitor_.Evaluate(t).max_bound, 0.05);
-  const std::vector<std::string> names = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                          "panda_joint5", "panda_joint6", "panda_joint7"};
-  ASSERT_EQ(monitor_.UpdateTrajectory(t, names, {0.0, 1.0},
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 1.0},
                                       {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, 0.9, 0, -0.4, 0, 1.571, 0.785}}),
             std::nullopt);
   const RiskReport r = monitor_.Evaluate(t);

@@ -59,4 +59,9 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
 /// else the installed or source config folder. Empty when none exists.
 std::string DefaultConfigFile(const std::string& service_name);
 
+/// The shipped configuration folder, the one DefaultConfigFile("supervisor")
+/// is in (the cell's tools read several services' files from it). Empty when
+/// none exists.
+std::string DefaultConfigDir();
+
 }  // namespace iplan::framework
