@@ -202,6 +202,8 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
     collision::CalcForwardKinematics(robot_, state_->second, &data_);
     const Eigen::Matrix3Xd& joints = skeletons_.back().second;
     double best = kNoPerson, best_margin = kNoPerson;
+    std::size_t closest_k = 0, binding_k = 0;
+    int closest_h = 0, binding_h = 0;
     for (int h = 0; h < body_.num_spheres(); ++h) {
       const auto& def = body_.spheres()[static_cast<std::size_t>(h)];
       const Eigen::Vector3d c = (1 - def.u) * joints.col(def.joint_a) + def.u * joints.col(def.joint_b);
@@ -214,30 +216,38 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
         const double d = centres - robot_spheres[k].radius - def.radius;
         double v_h = v_h_max, v_r = v_r_max, sp = r.protective_separation;
         if (s.directed) {
+          // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
           const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
           v_h = measured ? std::max(0.0, v_c.dot(u)) : s.default_human_speed;
           v_r = std::max(0.0, -v_robot.col(ki).dot(u));
-          if (centres <= 1e-9) v_r = v_robot.col(ki).norm();  // coincident centres: any motion approaches
           sp = protective(v_h, v_r);
         }
         if (d < best) {
           best = d;
-          r.separation_robot_link = robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)];
-          r.separation_human_segment = body_.params().segments[static_cast<std::size_t>(def.segment)].name;
+          closest_k = k;
+          closest_h = h;
         }
         if (d - sp < best_margin) {
           best_margin = d - sp;
+          binding_k = k;
+          binding_h = h;
           r.binding_separation = d;
           r.protective_separation = sp;
           r.human_speed = v_h;
           r.robot_speed = v_r;
-          r.binding_robot_link = robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)];
-          r.binding_human_segment = body_.params().segments[static_cast<std::size_t>(def.segment)].name;
         }
       }
     }
+    auto link = [&](std::size_t k) { return robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)]; };
+    auto segment = [&](int h) {
+      return body_.params().segments[static_cast<std::size_t>(body_.spheres()[static_cast<std::size_t>(h)].segment)].name;
+    };
     r.min_separation = best;
+    r.separation_robot_link = link(closest_k);
+    r.separation_human_segment = segment(closest_h);
     r.separation_margin = best_margin;
+    r.binding_robot_link = link(binding_k);
+    r.binding_human_segment = segment(binding_h);
   }
 
   // Prediction layer: bound along the executing trajectory.
