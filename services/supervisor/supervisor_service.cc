@@ -159,6 +159,7 @@ class SupervisorService : public framework::Service {
     c.command = msg::TaskCommand::START;
     c.goal_type = msg::TaskCommand::GOAL_JOINTS;
     c.goal_positions = t.goal;
+    c.retreat_positions = t.retreat;
     c.episode = static_cast<uint32_t>(episodes_ + 1);
     command_writer_->Write(c);
     node.log().info("task {} '{}' (episode {}, state {:#x})", task_id_, t.name, episodes_ + 1, planner_->state());

@@ -90,15 +90,26 @@ class TrajoptService : public framework::Service {
     t.id = m.task_id;
     t.name = m.task_name;
     t.time_limit = m.time_limit;
+    auto refuse = [&](const std::string& reason) {
+      TaskOutcome o;
+      o.id = m.task_id;
+      o.name = m.task_name;
+      o.status = TaskStatus::kFailed;
+      o.reason = reason;
+      Publish(node, o);
+    };
+    const int nq = planner_->robot().nq;
+    if (!m.retreat_positions.empty() && static_cast<int>(m.retreat_positions.size()) != nq) {
+      refuse("retreat has " + std::to_string(m.retreat_positions.size()) + " joint positions, the robot " +
+             std::to_string(nq));
+      return;
+    }
+    t.retreat = Eigen::Map<const Eigen::VectorXd>(m.retreat_positions.data(),
+                                                  static_cast<Eigen::Index>(m.retreat_positions.size()));
     if (m.goal_type == msg::TaskCommand::GOAL_JOINTS) {
-      if (static_cast<int>(m.goal_positions.size()) != planner_->robot().nq) {
-        TaskOutcome o;
-        o.id = m.task_id;
-        o.name = m.task_name;
-        o.status = TaskStatus::kFailed;
-        o.reason = "goal has " + std::to_string(m.goal_positions.size()) + " joint positions, the robot " +
-                   std::to_string(planner_->robot().nq);
-        Publish(node, o);
+      if (static_cast<int>(m.goal_positions.size()) != nq) {
+        refuse("goal has " + std::to_string(m.goal_positions.size()) + " joint positions, the robot " +
+               std::to_string(nq));
         return;
       }
       t.goal = planning::Goal::Joint(Eigen::Map<const Eigen::VectorXd>(m.goal_positions.data(),

@@ -1,9 +1,9 @@
 // `iplan cell-check` on real configuration folders (copies of config/, some
 // edited as an integrator would): the shipped cell, whose task graph agrees
 // with its person and ISO/TS 15066 monitor, passes; a task declared harmless
-// that the monitor would stop, and a goal inside a scene object, are found and
-// named; the same cell under undirected speeds is not consistent; a broken
-// configuration is refused.
+// that the monitor would stop, a retreat inside the person's space and a goal
+// inside a scene object are found and named; the same cell under undirected
+// speeds is not consistent; a broken configuration is refused.
 #include <filesystem>
 #include <fstream>
 #include <regex>
@@ -70,6 +70,21 @@ TEST_F(CellCheck, ShippedCellPassesWithItsMarginTable) {
   const std::regex row(R"(fetch_left\s+(-0\.\d\d)\*\s+\+0\.\d\d\s+\+0\.\d\d\s+0\.\d{3})");
   EXPECT_TRUE(std::regex_search(out, row)) << out;
   EXPECT_TRUE(std::regex_search(out, std::regex(R"(hand_over\s+\+0\.\d\d\s+-0\.\d\d\*)"))) << out;
+  // Where the hand-over withdraws to is clear of every action.
+  EXPECT_TRUE(std::regex_search(out, std::regex(R"(hand_over \(retreat\)\s+\+0\.\d\d\s+\+0\.\d\d\s+\+0\.\d\d\s+0\.\d{3})")))
+      << out;
+}
+
+TEST_F(CellCheck, RetreatInsideThePersonsSpaceIsNamed) {
+  // The hand-over "withdraws" to where it handed over: in the assembly.
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(retreat: \[[^\]]*\])", "retreat: [-0.274, 0.417, 0.0, -1.68, 0.0, 2.097, 0.8]");
+  std::string out;
+  EXPECT_EQ(Run(&out), 1) << out;
+  EXPECT_NE(out.find("inconsistent: 'hand_over (retreat)': during 'assemble' the person comes within the protective "
+                     "separation"),
+            std::string::npos)
+      << out;
+  EXPECT_NE(out.find("A retreat must be clear of every action"), std::string::npos) << out;
 }
 
 TEST_F(CellCheck, UndirectedSpeedsMakeTheSameCellInconsistent) {
@@ -96,7 +111,7 @@ TEST_F(CellCheck, GoalInsideASceneObjectIsNamed) {
        "goal: [0.686, 0.745, 0.0, -1.521, 0.0, 2.266, 0.8]");
   std::string out;
   EXPECT_EQ(Run(&out), 1) << out;
-  EXPECT_NE(out.find("'fetch_left' has its goal in the static scene"), std::string::npos) << out;
+  EXPECT_NE(out.find("'fetch_left' rests in the static scene"), std::string::npos) << out;
 }
 
 TEST_F(CellCheck, UnknownHumanActionAndBrokenConfigAreRefused) {

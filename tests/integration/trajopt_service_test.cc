@@ -2,7 +2,8 @@
 // DDS); this process sends a task and scripts the person. The service
 // publishes a trajectory every cycle and an outcome at the end; with a person
 // standing on the goal the outcome reports waits and delay, and the simulated
-// robot never touches the person's true body.
+// robot never touches the person's true body; a task with a retreat ends
+// there, and a retreat of the wrong size is refused.
 #include <signal.h>
 
 #include <cmath>
@@ -34,13 +35,16 @@ std::vector<Eigen::Vector3d> PersonWithHandAt(const Eigen::Vector3d& hand) {
 
 struct Result {
   std::optional<msg::TaskOutcome> outcome;
+  std::vector<double> last_waypoint;  // of the last trajectory before the outcome
   int trajectories = 0;
   double seconds = 0;
   std::string contacts;
 };
 
-Result RunTask(double block_for_s) {
-  const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10));
+// Sends one task to the goal kGoal (with `retreat`, if any) while a person
+// stands on the goal for `block_for_s`.
+Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
+  const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10) + static_cast<int>(retreat.size()));
   Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain)});
   Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain)});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
@@ -53,7 +57,10 @@ Result RunTask(double block_for_s) {
   node.Subscribe(framework::topics::RobotTrajectory(),
                  std::function<void(const msg::JointTrajectory&, const dds::SampleInfo&)>(
                      [&](const msg::JointTrajectory& t, const dds::SampleInfo&) {
-                       if (started && !r.outcome) ++r.trajectories;
+                       if (started && !r.outcome) {
+                         ++r.trajectories;
+                         if (!t.points.empty()) r.last_waypoint = t.points.back().positions;
+                       }
                        EXPECT_EQ(t.joint_names.size(), 7u);
                      }));
   node.Subscribe(framework::topics::TaskOutcome(),
@@ -90,6 +97,7 @@ Result RunTask(double block_for_s) {
   c.command = msg::TaskCommand::START;
   c.goal_type = msg::TaskCommand::GOAL_JOINTS;
   c.goal_positions = kGoal;
+  c.retreat_positions = retreat;
   c.time_limit = 30;
   const auto start = Clock::now();
   auto next = start;
@@ -172,6 +180,21 @@ TEST(TrajoptService, PersonOnTheGoalIsReportedAsWaitAndDelayNotContact) {
   EXPECT_GT(r.outcome->duration, 3.0);
   EXPECT_LT(r.outcome->max_collision_bound, 0.05);
   EXPECT_EQ(r.contacts, "0");
+}
+
+TEST(TrajoptService, TaskWithARetreatEndsThereAndAWrongRetreatIsRefused) {
+  const std::vector<double> ready = {0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785};
+  Result r = RunTask(0.0, ready);
+  ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
+  EXPECT_EQ(r.outcome->status, msg::TaskOutcome::SUCCEEDED) << r.outcome->reason;
+  ASSERT_EQ(r.last_waypoint.size(), ready.size());
+  for (std::size_t j = 0; j < ready.size(); ++j) EXPECT_NEAR(r.last_waypoint[j], ready[j], 0.01) << "joint " << j;
+  EXPECT_EQ(r.contacts, "0");
+
+  r = RunTask(0.0, {0.0, -0.785, 0.0});
+  ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
+  EXPECT_EQ(r.outcome->status, msg::TaskOutcome::FAILED);
+  EXPECT_EQ(r.outcome->reason, "retreat has 3 joint positions, the robot 7");
 }
 
 }  // namespace

@@ -2,7 +2,8 @@
 //
 // The task graph declares which robot tasks conflict with which human
 // actions; the supervisor's reward and the learned task order rest on those
-// declarations. This command puts the robot at every task's goal, lets the
+// declarations. This command puts the robot at every task's goal (and
+// retreat, which must be harmless during every action), lets the
 // configured synthetic person do every action (several repetitions, with the
 // configured variation and sensor noise), and runs the collision-risk
 // service's own ISO/TS 15066 monitor on it. A task the graph calls harmless
@@ -178,22 +179,36 @@ int RunCellCheck(const CheckOptions& o) {
   }
 
   std::cout << "ISO/TS 15066 margin (separation - protective separation, m) with the robot at each task's goal\n"
-            << "and the person doing each action (worst of " << o.repetitions
-            << " repetitions, sensor noise included; * = declared conflict), and the goal's clearance from\n"
-            << "the static scene (m; the trajectory optimiser needs at least " << Fixed(planner->params().min_clearance, 3)
+            << "and retreat and the person doing each action (worst of " << o.repetitions
+            << " repetitions, sensor noise included;\n* = declared conflict), and the pose's clearance from "
+            << "the static scene (m; the trajectory optimiser\nneeds at least " << Fixed(planner->params().min_clearance, 3)
             << "):\n\n";
+  // One row per place the robot rests at: every task's goal and, for tasks
+  // with one, the retreat it withdraws to (where it waits for the next task,
+  // so it must be harmless during every action).
+  struct Row {
+    std::string name;
+    const std::vector<double>* pose;
+    std::vector<std::string> conflicts_with;
+    bool retreat;
+  };
+  std::vector<Row> rows;
+  for (const auto& t : graph.tasks) {
+    rows.push_back({t.name, &t.goal, t.conflicts_with, false});
+    if (!t.retreat.empty()) rows.push_back({t.name + " (retreat)", &t.retreat, {}, true});
+  }
   std::size_t w = 6;
-  for (const auto& t : graph.tasks) w = std::max(w, t.name.size() + 2);
+  for (const auto& r : rows) w = std::max(w, r.name.size() + 2);
   std::cout << std::left << std::setw(static_cast<int>(w)) << "task";
   for (const auto& a : actions) std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(a.size(), 8) + 3)) << a;
   std::cout << std::right << std::setw(12) << "clearance" << "\n";
   std::vector<std::string> notes;
-  for (const auto& task : graph.tasks) {
+  for (const Row& task : rows) {
     std::cout << std::left << std::setw(static_cast<int>(w)) << task.name;
     for (const auto& a : actions) {
       PairResult r;
       try {
-        r = Evaluate(*monitor, risk.params, person, a, task.goal, o.repetitions);
+        r = Evaluate(*monitor, risk.params, person, a, *task.pose, o.repetitions);
       } catch (const std::exception& e) {
         std::cerr << "\niplan cell-check: task '" << task.name << "': " << e.what() << "\n";
         return 2;
@@ -206,20 +221,26 @@ int RunCellCheck(const CheckOptions& o) {
                                  r.human_segment + "), S_p " + Fixed(r.protective, 2) + " m at v_h " +
                                  Fixed(r.human_speed, 2) + " m/s, " + Fixed(r.time, 1) + " s into the action";
       if (!declared && r.margin < o.margin) {
-        problems.push_back("'" + task.name + "' is declared harmless during '" + a + "' but the person comes within " +
-                           (r.margin < 0 ? "the protective separation: the monitor would stop the robot there ("
-                                         : "the required margin of it (") +
-                           detail + "). Declare conflicts_with: [" + a + "] or move the goal.");
+        const std::string within =
+            " the person comes within " +
+            std::string(r.margin < 0 ? "the protective separation: the monitor would stop the robot there ("
+                                     : "the required margin of it (") +
+            detail;
+        problems.push_back(task.retreat ? "'" + task.name + "': during '" + a + "'" + within +
+                                              "). A retreat must be clear of every action: move it out of the "
+                                              "person's space."
+                                        : "'" + task.name + "' is declared harmless during '" + a + "' but" + within +
+                                              "). Declare conflicts_with: [" + a + "] or move the goal.");
       } else if (declared && r.margin >= o.margin) {
         notes.push_back("'" + task.name + "' is declared to conflict with '" + a + "' but stays clear (" + detail +
                         "); only the reward's harmony term keeps them apart.");
       }
     }
     const double clearance = planner->CalcClearance(
-        Eigen::Map<const Eigen::VectorXd>(task.goal.data(), static_cast<Eigen::Index>(task.goal.size())));
+        Eigen::Map<const Eigen::VectorXd>(task.pose->data(), static_cast<Eigen::Index>(task.pose->size())));
     std::cout << std::right << std::setw(11) << Fixed(clearance, 3) << "\n";
     if (clearance < planner->params().min_clearance) {
-      problems.push_back("'" + task.name + "' has its goal in the static scene (clearance " + Fixed(clearance, 3) +
+      problems.push_back("'" + task.name + "' rests in the static scene (clearance " + Fixed(clearance, 3) +
                          " m < " + Fixed(planner->params().min_clearance, 3) +
                          " m): the trajectory optimiser will refuse it every time.");
     }
@@ -238,10 +259,11 @@ const bool kRegistered = RegisterCommand("cell-check", [](CLI::App& app) {
   auto o = std::make_shared<CheckOptions>();
   CLI::App* c = app.add_subcommand(
       "cell-check",
-      "Check that the cell's geometry agrees with its task graph: with the robot at each task's goal and the\n"
-      "synthetic person doing each human action, the ISO/TS 15066 monitor (collision_risk.yaml) must not stop\n"
-      "the robot for tasks the graph calls harmless. Prints the margin table; exit code 0 when consistent,\n"
-      "1 when not, 2 on bad configuration. Goals only: paths between goals are not checked.");
+      "Check that the cell's geometry agrees with its task graph: with the robot at each task's goal and\n"
+      "retreat and the synthetic person doing each human action, the ISO/TS 15066 monitor (collision_risk.yaml)\n"
+      "must not stop the robot for tasks the graph calls harmless, nor at any retreat. Prints the margin table;\n"
+      "exit code 0 when consistent, 1 when not, 2 on bad configuration. Resting poses only: paths between them\n"
+      "are not checked.");
   c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
   c->add_option("--margin", o->margin, "m of clearance beyond S_p required for harmless pairs")->capture_default_str()
       ->check(CLI::NonNegativeNumber);

@@ -48,6 +48,16 @@ std::string TaskGraph::Validate() const {
       if (tasks[i].name == tasks[j].name) return "task '" + tasks[i].name + "' defined twice";
     }
     if (tasks[i].goal.empty()) return "task '" + tasks[i].name + "' has no goal";
+    if (!tasks[i].retreat.empty() && tasks[i].retreat.size() != tasks[i].goal.size()) {
+      return "task '" + tasks[i].name + "' has a retreat of " + std::to_string(tasks[i].retreat.size()) +
+             " joint positions and a goal of " + std::to_string(tasks[i].goal.size());
+    }
+    for (double v : tasks[i].goal) {
+      if (!std::isfinite(v)) return "task '" + tasks[i].name + "' has a non-finite goal";
+    }
+    for (double v : tasks[i].retreat) {
+      if (!std::isfinite(v)) return "task '" + tasks[i].name + "' has a non-finite retreat";
+    }
     for (const auto& a : tasks[i].after) {
       if (std::none_of(tasks.begin(), tasks.end(), [&](const RobotTask& t) { return t.name == a; })) {
         return "task '" + tasks[i].name + "' comes after unknown task '" + a + "'";
@@ -102,13 +112,16 @@ TaskGraph LoadTaskGraph(const std::string& path) {
       const std::string where = "robot_tasks[" + std::to_string(i) + "]";
       for (auto it = n.begin(); it != n.end(); ++it) {
         const std::string k = it->first.as<std::string>();
-        if (k != "name" && k != "goal" && k != "after" && k != "conflicts_with") fail(where + "." + k, "unknown key");
+        if (k != "name" && k != "goal" && k != "retreat" && k != "after" && k != "conflicts_with") {
+          fail(where + "." + k, "unknown key");
+        }
       }
       RobotTask t;
       if (!n["name"]) fail(where + ".name", "is required");
       t.name = n["name"].as<std::string>();
       if (!n["goal"]) fail(where + ".goal", "is required");
       t.goal = n["goal"].as<std::vector<double>>();
+      if (n["retreat"]) t.retreat = n["retreat"].as<std::vector<double>>();
       if (n["after"]) t.after = n["after"].as<std::vector<std::string>>();
       if (n["conflicts_with"]) t.conflicts_with = n["conflicts_with"].as<std::vector<std::string>>();
       g.tasks.push_back(std::move(t));

@@ -23,6 +23,10 @@ struct RobotTask {
   std::vector<double> goal;               ///< joint goal (rad), robot joint order
   std::vector<std::string> after;         ///< tasks that must be finished first
   std::vector<std::string> conflicts_with; ///< human actions this task conflicts with
+  /// Joint positions (rad) to withdraw to after the goal before the task
+  /// counts as done (e.g. out of the person's space after a hand-over), so
+  /// that the delay of leaving is charged to this task. Empty: none.
+  std::vector<double> retreat = {};
 };
 
 struct TaskGraph {

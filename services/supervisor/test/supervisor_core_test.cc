@@ -2,6 +2,7 @@
 // monitor of the supervisor, without DDS.
 #include <unistd.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -37,6 +38,39 @@ TEST(TaskGraph, ValidationNamesTheProblem) {
   g = Graph();
   g.tasks[1].conflicts_with = {"dance"};
   EXPECT_EQ(g.Validate(), "task 'pick_right' conflicts with unknown human action 'dance'");
+  g = Graph();
+  g.tasks[2].retreat = {0.0, 0.1};
+  EXPECT_EQ(g.Validate(), "task 'place' has a retreat of 2 joint positions and a goal of 1");
+  g.tasks[2].retreat = {std::nan("")};
+  EXPECT_EQ(g.Validate(), "task 'place' has a non-finite retreat");
+}
+
+TEST(TaskGraph, LoadsRetreatsAndNamesTheFileOnErrors) {
+  const std::string path = TempPath("graph.yaml");
+  std::ofstream(path) << "human_actions: [assemble]\n"
+                         "robot_tasks:\n"
+                         "  - name: fetch\n"
+                         "    goal: [0.1, 0.2]\n"
+                         "  - name: hand_over\n"
+                         "    goal: [0.3, 0.4]\n"
+                         "    retreat: [0.0, -0.5]\n"
+                         "    after: [fetch]\n"
+                         "    conflicts_with: [assemble]\n";
+  const TaskGraph g = LoadTaskGraph(path);
+  ASSERT_EQ(g.tasks.size(), 2u);
+  EXPECT_TRUE(g.tasks[0].retreat.empty());
+  EXPECT_EQ(g.tasks[1].retreat, (std::vector<double>{0.0, -0.5}));
+  std::ofstream(path) << "robot_tasks:\n"
+                         "  - name: hand_over\n"
+                         "    goal: [0.3, 0.4]\n"
+                         "    retreat: [0.0]\n";
+  try {
+    LoadTaskGraph(path);
+    ADD_FAILURE() << "a retreat of the wrong size was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": task 'hand_over' has a retreat of 1 joint positions and a goal of 2");
+  }
+  std::filesystem::remove(path);
 }
 
 TEST(TaskPlanner, PrecedenceAndHarmony) {

@@ -86,6 +86,10 @@ TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int6
 std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t now_ns) {
   std::optional<TaskOutcome> replaced;
   if (task_ && task_->spec.id == task.id) return replaced;  // a repeat of the running task
+  if (task.retreat.size() != 0 && task.retreat.size() != planner_.robot().nq) {
+    throw std::invalid_argument("retreat has " + std::to_string(task.retreat.size()) + " joint positions, the robot " +
+                                std::to_string(planner_.robot().nq));
+  }
   if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
   task_ = Active{};
   task_->spec = task;
@@ -126,12 +130,18 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   t.stopped = robot_stopped_;
   t.last_cycle_ns = now_ns;
 
-  // Arrived?
+  // Arrived? At the goal of a task with a retreat, the task goes on to it.
   if (t.goal_q && (q_->second - *t.goal_q).cwiseAbs().maxCoeff() < params_.goal_tolerance &&
       qd_.cwiseAbs().maxCoeff() < params_.settle_speed) {
-    CycleResult done = Hold(now_ns, q_->second, "goal reached");
-    done.outcome = Finish(TaskStatus::kSucceeded, "", now_ns);
-    return done;
+    if (t.spec.retreat.size() > 0 && !t.retreating) {
+      t.retreating = true;
+      t.goal_q = t.spec.retreat;
+      r.status = "goal reached, retreating: ";
+    } else {
+      CycleResult done = Hold(now_ns, q_->second, t.retreating ? "retreat reached" : "goal reached");
+      done.outcome = Finish(TaskStatus::kSucceeded, "", now_ns);
+      return done;
+    }
   }
   if (t.spec.time_limit > 0 && (now_ns - t.start_ns) * 1e-9 > t.spec.time_limit) {
     CycleResult late = Hold(now_ns, q_->second, "time limit");
@@ -149,7 +159,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     const Eigen::VectorXd expected = (1 - (s - i)) * P.col(i) + (s - i) * P.col(j);
     if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
       previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
-      r.status = "robot off the plan: replanning from its state; ";
+      r.status += "robot off the plan: replanning from its state; ";
     }
   }
   if (previous_) {

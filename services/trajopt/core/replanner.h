@@ -45,6 +45,11 @@ struct TaskSpec {
   std::string name;
   planning::Goal goal;
   double time_limit = 0;  ///< s; 0: none
+  /// Joint positions (rad, model order) the robot withdraws to after
+  /// reaching `goal`, e.g. out of the person's space after a hand-over; the
+  /// task ends there, so the delay of withdrawing is the task's own. Empty:
+  /// the task ends at the goal.
+  Eigen::VectorXd retreat = Eigen::VectorXd();
 };
 
 struct TaskOutcome {
@@ -52,7 +57,7 @@ struct TaskOutcome {
   std::string name;
   TaskStatus status = TaskStatus::kFailed;
   std::string reason;
-  double duration = 0;       ///< s, command to arrival (or to the end)
+  double duration = 0;       ///< s, command to arrival at the goal, or at the retreat when there is one (or to the end)
   double delay = 0;          ///< s from each cycle whose plan waited or was held off by the person's
                              ///< keep-out, or during which the robot was in protective stop, to the
                              ///< next cycle (wall time)
@@ -82,7 +87,8 @@ class Replanner {
 
   /// A new task replaces the current one, whose outcome (CANCELLED) is
   /// returned. A repeat of the running task's id is ignored (commands may be
-  /// re-sent after a fault).
+  /// re-sent after a fault). Throws std::invalid_argument when a retreat
+  /// does not have one position per robot joint.
   std::optional<TaskOutcome> StartTask(const TaskSpec& task, int64_t now_ns);
   /// Cancels the current task if it has this id.
   std::optional<TaskOutcome> CancelTask(uint32_t id, int64_t now_ns);
@@ -118,7 +124,8 @@ class Replanner {
   struct Active {
     TaskSpec spec;
     int64_t start_ns = 0;
-    std::optional<Eigen::VectorXd> goal_q;
+    std::optional<Eigen::VectorXd> goal_q;  // where the robot is going now (the retreat once the goal is reached)
+    bool retreating = false;                // the goal is reached; withdrawing to spec.retreat
     double delay = 0;
     uint32_t waits = 0;
     double max_bound = 0;

@@ -4,6 +4,8 @@
 // and cancellations end the task with the right outcome.
 #include "core/replanner.h"
 
+#include <algorithm>
+
 #include <gtest/gtest.h>
 
 #include "iplan/planning/planner_params.h"
@@ -77,6 +79,7 @@ class ReplannerTest : public ::testing::Test {
     for (int k = 0; k < max_cycles; ++k) {
       if (each) each(*t);
       CycleResult c = replanner_.Cycle(*t);
+      statuses_.push_back(c.status);
       if (c.outcome) return c.outcome;
       if (c.publish) {
         if (last && last->positions.cols() > 1) {
@@ -89,6 +92,7 @@ class ReplannerTest : public ::testing::Test {
       const Eigen::VectorXd q = last ? At(*last, next) : Ready();
       const Eigen::VectorXd q2 = last ? At(*last, next + kSec / 100) : Ready();
       SetState(next, q, (q2 - q) / 0.01);
+      visited_.push_back(q);
       *t = next;
     }
     return std::nullopt;
@@ -97,6 +101,8 @@ class ReplannerTest : public ::testing::Test {
   planning::Planner planner_;
   collision::HumanBodyModel body_;
   Replanner replanner_;
+  std::vector<std::string> statuses_;       // of every cycle Run() made
+  std::vector<Eigen::VectorXd> visited_;    // the ideal robot's states in Run()
 };
 
 TEST_F(ReplannerTest, IdleHoldsTheCurrentPose) {
@@ -121,6 +127,42 @@ TEST_F(ReplannerTest, ReachesAJointGoalWithoutDelay) {
   EXPECT_EQ(o->num_waits, 0u);
   EXPECT_GT(o->duration, 0.5);
   EXPECT_GT(o->planning_time_p50, 0.0);
+  EXPECT_FALSE(replanner_.busy());
+}
+
+TEST_F(ReplannerTest, TaskWithARetreatEndsOnlyWhenTheRobotHasWithdrawn) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  const auto plain = [&] {
+    EXPECT_EQ(replanner_.StartTask({7, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+    return Run(&t, 80);
+  }();
+  ASSERT_TRUE(plain.has_value());
+  ASSERT_EQ(plain->status, TaskStatus::kSucceeded) << plain->reason;
+  EXPECT_EQ(statuses_.back(), "goal reached");
+
+  // From the goal, reach it again (no motion) and withdraw to Ready.
+  statuses_.clear();
+  visited_.clear();
+  TaskSpec hand_over{8, "hand_over", planning::Goal::Joint(Goal()), 0, Ready()};
+  EXPECT_EQ(replanner_.StartTask(hand_over, t), std::nullopt);
+  const auto o = Run(&t, 80);
+  ASSERT_TRUE(o.has_value()) << "no outcome in 8 s";
+  EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
+  EXPECT_EQ(o->id, 8u);
+  EXPECT_EQ(o->delay, 0.0);
+  EXPECT_EQ(statuses_.back(), "retreat reached");
+  EXPECT_EQ(std::count_if(statuses_.begin(), statuses_.end(),
+                          [](const std::string& s) { return s.rfind("goal reached, retreating", 0) == 0; }),
+            1);
+  ASSERT_FALSE(visited_.empty());
+  EXPECT_LT((visited_.back() - Ready()).cwiseAbs().maxCoeff(), ReplannerParams{}.goal_tolerance);
+  // The withdrawal is part of the task: it took about as long as the way there.
+  EXPECT_GT(o->duration, 0.5 * plain->duration);
+
+  // A retreat of the wrong size is refused before anything moves.
+  TaskSpec wrong{9, "bad", planning::Goal::Joint(Goal()), 0, Eigen::VectorXd::Zero(6)};
+  EXPECT_THROW(replanner_.StartTask(wrong, t), std::invalid_argument);
   EXPECT_FALSE(replanner_.busy());
 }
 
