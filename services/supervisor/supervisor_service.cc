@@ -30,6 +30,8 @@ class SupervisorService : public framework::Service {
     config.Read("alpha", &q.alpha, framework::InRange(1e-6, 1.0));
     config.Read("gamma", &q.gamma, framework::InRange(0.0, 0.999));
     config.Read("epsilon", &q.epsilon, framework::InRange(0.0, 1.0));
+    config.Read("epsilon_decay", &q.epsilon_decay, framework::InRange(1e-6, 1.0));
+    config.Read("epsilon_min", &q.epsilon_min, framework::InRange(0.0, 1.0));
     config.Read("delay_weight", &q.delay_weight, framework::NonNegative<double>());
     int seed = 1;
     config.Read("seed", &seed, framework::NonNegative<int>());
@@ -162,7 +164,8 @@ class SupervisorService : public framework::Service {
     c.retreat_positions = t.retreat;
     c.episode = static_cast<uint32_t>(episodes_ + 1);
     command_writer_->Write(c);
-    node.log().info("task {} '{}' (episode {}, state {:#x})", task_id_, t.name, episodes_ + 1, planner_->state());
+    node.log().info("task {} '{}' (episode {}, state {:#x}, epsilon {:.3f})", task_id_, t.name, episodes_ + 1,
+                    planner_->state(), planner_->Epsilon());
   }
 
   void OnOutcome(Node& node, const msg::TaskOutcome& o) {

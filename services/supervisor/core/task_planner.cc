@@ -14,7 +14,10 @@
 namespace iplan::supervisor {
 namespace {
 
-constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
+// Version 2 adds the number of learning episodes after the row count;
+// version 1 tables (without it) still load, as 0 episodes.
+constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
+constexpr char kMagicV1[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
 
 uint64_t Fnv(const void* data, std::size_t n, uint64_t h = 1469598103934665603ULL) {
   const auto* p = static_cast<const unsigned char*>(data);
@@ -137,6 +140,8 @@ std::string QLearningParams::Validate() const {
   if (!(alpha > 0 && alpha <= 1)) return "alpha must be in (0, 1]";
   if (!(gamma >= 0 && gamma < 1)) return "gamma must be in [0, 1)";
   if (!(epsilon >= 0 && epsilon <= 1)) return "epsilon must be in [0, 1]";
+  if (!(epsilon_decay > 0 && epsilon_decay <= 1)) return "epsilon_decay must be in (0, 1]";
+  if (!(epsilon_min >= 0 && epsilon_min <= 1)) return "epsilon_min must be in [0, 1]";
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
   return "";
 }
@@ -187,10 +192,16 @@ double TaskPlanner::Q(State s, int task) const {
   return it == q_.end() ? 0.0 : it->second[static_cast<std::size_t>(task)];
 }
 
+double TaskPlanner::Epsilon() const {
+  if (!params_.learning) return 0.0;
+  const double decayed = params_.epsilon * std::pow(params_.epsilon_decay, static_cast<double>(episodes_learned_));
+  return std::min(params_.epsilon, std::max(params_.epsilon_min, decayed));
+}
+
 int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
   const std::vector<int> avail = Available();
   if (avail.empty()) return -1;
-  if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < params_.epsilon) {
+  if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < Epsilon()) {
     return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
   }
   int best = avail.front();
@@ -220,6 +231,7 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
     q += params_.alpha * (reward + params_.gamma * best_next - q);
   }
   state_ = next;
+  if (params_.learning && succeeded && episode_done()) ++episodes_learned_;
   return reward;
 }
 
@@ -237,6 +249,7 @@ void TaskPlanner::Save(const std::string& path) const {
   Put(&body, GraphHash());
   Put(&body, static_cast<uint64_t>(graph_.tasks.size()));
   Put(&body, static_cast<uint64_t>(q_.size()));
+  Put(&body, episodes_learned_);
   for (const auto& [s, row] : q_) {
     Put(&body, s);
     for (double v : row) Put(&body, v);
@@ -257,14 +270,18 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   } catch (const std::exception& e) {
     return std::string(e.what());
   }
-  if (data.size() < sizeof(kMagic) + 8 || std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) {
-    return path + " is not an iplan Q-table";
-  }
+  if (data.size() < sizeof(kMagic) + 8) return path + " is not an iplan Q-table";
+  const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
+  if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
   std::size_t pos = sizeof(kMagic);
   uint64_t checksum = 0, hash = 0, ntasks = 0, nrows = 0;
   Get(data, &pos, &checksum);
   if (Fnv(data.data() + pos, data.size() - pos) != checksum) return path + " is corrupt (checksum mismatch)";
-  if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows)) return path + " is truncated";
+  uint64_t episodes = 0;
+  if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows) ||
+      (!v1 && !Get(data, &pos, &episodes))) {
+    return path + " is truncated";
+  }
   if (hash != GraphHash() || ntasks != graph_.tasks.size()) return path + " belongs to another task graph";
   std::map<State, std::vector<double>> q;
   for (uint64_t r = 0; r < nrows; ++r) {
@@ -278,6 +295,7 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   }
   if (pos != data.size()) return path + " has trailing bytes";
   q_ = std::move(q);
+  episodes_learned_ = episodes;
   return std::nullopt;
 }
 
@@ -289,7 +307,10 @@ bool TaskPlanner::Load(const std::string& path, std::string* note) {
   }
   const auto main_error = main_exists ? TryLoad(path) : std::optional<std::string>(path + " is missing");
   if (!main_error) {
-    if (note) *note = "loaded " + path + " (" + std::to_string(q_.size()) + " states)";
+    if (note) {
+      *note = "loaded " + path + " (" + std::to_string(q_.size()) + " states, " + std::to_string(episodes_learned_) +
+              " episodes learned)";
+    }
     return true;
   }
   const auto backup_error = backup_exists ? TryLoad(path + ".bak") : std::optional<std::string>("no backup");

@@ -43,7 +43,11 @@ TaskGraph LoadTaskGraph(const std::string& path);
 struct QLearningParams {
   double alpha = 0.2;         ///< learning rate
   double gamma = 0.6;         ///< discount
-  double epsilon = 0.3;       ///< exploration in learning mode
+  double epsilon = 0.3;       ///< exploration in learning mode (before the first finished episode)
+  /// Factor on epsilon per finished learning episode (our extension; 1 keeps
+  /// it constant as in METHOD 6): exploration fades as the table learns.
+  double epsilon_decay = 1.0;
+  double epsilon_min = 0.0;   ///< floor of the decayed epsilon
   double delay_weight = 1.0;  ///< w_d, per second of delay
   bool learning = true;       ///< false: deployment, greedy, no updates
   uint64_t seed = 1;
@@ -65,12 +69,19 @@ class TaskPlanner {
   /// h(s, a | belief): 1 - sum_c p(c) conflict(a, c); belief over
   /// graph().human_actions (missing actions count as 0).
   double Harmony(int task, const std::map<std::string, double>& belief) const;
+  /// Episodes finished in learning mode by this table (saved with it).
+  uint64_t episodes_learned() const { return episodes_learned_; }
+  /// Exploration of the next choice: max(epsilon_min, epsilon *
+  /// epsilon_decay^episodes_learned()) while learning (never above epsilon),
+  /// 0 in deployment.
+  double Epsilon() const;
   /// Chooses the next task: epsilon-greedy on Q in learning mode, greedy in
   /// deployment; ties broken by the harmony with the current belief, then by
   /// index. -1 when the episode is done.
   int Choose(const std::map<std::string, double>& belief);
   /// Q-learning update after `task` ended with `delay` (s); advances the
-  /// state when `succeeded`. Returns the reward.
+  /// state when `succeeded` (counting the episode when that finishes it, in
+  /// learning mode). Returns the reward.
   double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief);
   /// Starts a new episode (state 0).
   void ResetEpisode() { state_ = 0; }
@@ -95,6 +106,7 @@ class TaskPlanner {
   QLearningParams params_;
   std::map<State, std::vector<double>> q_;
   State state_ = 0;
+  uint64_t episodes_learned_ = 0;
   std::vector<uint64_t> prerequisites_;  // bitmask per task
   std::mt19937_64 rng_;
 };

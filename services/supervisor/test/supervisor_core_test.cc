@@ -5,6 +5,7 @@
 #include <cmath>
 #include <filesystem>
 #include <fstream>
+#include <iterator>
 
 #include <gtest/gtest.h>
 
@@ -113,6 +114,97 @@ TEST(TaskPlanner, LearnsToAvoidTheTaskThatCausesDelay) {
   EXPECT_EQ(d.Q(0, 0), p.Q(0, 0));
   std::filesystem::remove(path);
   std::filesystem::remove(path + ".bak");
+}
+
+// Plays one episode in index order; every task succeeds without delay.
+void PlayEpisode(TaskPlanner* p) {
+  p->ResetEpisode();
+  while (!p->episode_done()) p->Complete(p->Available().front(), true, 0.0, {});
+}
+
+TEST(TaskPlanner, ExplorationDecaysPerLearnedEpisodeAndTheCountIsSaved) {
+  QLearningParams params;
+  params.epsilon = 0.3;
+  params.epsilon_decay = 0.5;
+  params.epsilon_min = 0.05;
+  TaskPlanner p(Graph(), params);
+  EXPECT_DOUBLE_EQ(p.Epsilon(), 0.3);
+  PlayEpisode(&p);
+  EXPECT_EQ(p.episodes_learned(), 1u);
+  EXPECT_DOUBLE_EQ(p.Epsilon(), 0.15);
+  // A failed task does not finish an episode; an unfinished one is not counted.
+  p.ResetEpisode();
+  p.Complete(0, true, 0.0, {});
+  p.Complete(1, false, 0.0, {});
+  EXPECT_EQ(p.episodes_learned(), 1u);
+  PlayEpisode(&p);
+  PlayEpisode(&p);
+  EXPECT_EQ(p.episodes_learned(), 3u);
+  EXPECT_DOUBLE_EQ(p.Epsilon(), 0.05);  // 0.0375 decayed, held at the floor
+
+  // The count survives a restart, so exploration does not start over.
+  const std::string path = TempPath("episodes.bin");
+  p.Save(path);
+  TaskPlanner q(Graph(), params);
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("3 episodes learned"), std::string::npos) << note;
+  EXPECT_EQ(q.episodes_learned(), 3u);
+  EXPECT_DOUBLE_EQ(q.Epsilon(), 0.05);
+
+  // Deployment neither explores nor counts.
+  QLearningParams deploy = params;
+  deploy.learning = false;
+  TaskPlanner d(Graph(), deploy);
+  ASSERT_TRUE(d.Load(path, &note));
+  EXPECT_EQ(d.Epsilon(), 0.0);
+  PlayEpisode(&d);
+  EXPECT_EQ(d.episodes_learned(), 3u);
+
+  // The default is METHOD 6's constant epsilon.
+  TaskPlanner c(Graph(), QLearningParams{});
+  PlayEpisode(&c);
+  PlayEpisode(&c);
+  EXPECT_DOUBLE_EQ(c.Epsilon(), 0.3);
+  params.epsilon_decay = 0;
+  EXPECT_EQ(params.Validate(), "epsilon_decay must be in (0, 1]");
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, TableOfTheFirstFormatStillLoads) {
+  // Version 1 had no episode count: magic "IPLQTBL1", FNV-1a 64 checksum of
+  // the body, then graph hash, task count, row count and the rows. Made from
+  // a version 2 file by dropping the count and re-summing.
+  const std::string path = TempPath("v1.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  PlayEpisode(&p);
+  p.Save(path);
+  std::string v2;
+  {
+    std::ifstream in(path, std::ios::binary);
+    v2.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+  }
+  ASSERT_EQ(v2.substr(0, 8), "IPLQTBL2");
+  std::string body = v2.substr(16, 24) + v2.substr(48);  // without the episode count at 40..47
+  uint64_t sum = 1469598103934665603ULL;
+  for (unsigned char c : body) {
+    sum ^= c;
+    sum *= 1099511628211ULL;
+  }
+  std::string v1 = "IPLQTBL1";
+  v1.append(reinterpret_cast<const char*>(&sum), 8);
+  v1 += body;
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << v1;
+  std::filesystem::remove(path + ".bak");
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note)) << note;
+  EXPECT_NE(note.find("0 episodes learned"), std::string::npos) << note;
+  EXPECT_EQ(q.Q(0, 1), p.Q(0, 1));
+  EXPECT_NE(q.Q(0, 1), 0.0);
+  std::filesystem::remove(path);
 }
 
 TEST(TaskPlanner, CorruptTableIsRefusedAndThePreviousGoodOneKept) {
