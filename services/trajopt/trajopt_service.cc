@@ -5,9 +5,8 @@
 #include <filesystem>
 
 #include "common/adapters.h"
-#include "core/replanner.h"
 #include "iplan/framework/service.h"
-#include "iplan/planning/planner_params.h"
+#include "trajopt_config.h"
 
 namespace iplan::trajopt {
 namespace {
@@ -19,25 +18,12 @@ using framework::Result;
 class TrajoptService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml",
-                scene_file = "scenes/cell.yaml", planner_file = "planner.yaml";
-    config.Read("robot", &robot_file);
-    config.Read("human_body", &body_file);
-    config.Read("scene", &scene_file);
-    config.Read("planner", &planner_file);
-    config.Read("planning_step", &params_.planning_step, framework::InRange(0.01, 2.0));
-    config.Read("frozen_waypoints", &params_.frozen_waypoints, framework::InRange(2, 50));
-    config.Read("goal_tolerance", &params_.goal_tolerance, framework::Positive<double>());
-    config.Read("settle_speed", &params_.settle_speed, framework::Positive<double>());
-    config.Read("stale_after", &params_.stale_after, framework::Positive<double>());
-    config.Read("max_tracking_error", &params_.max_tracking_error, framework::Positive<double>());
-    auto path = [&](const std::string& f) { return config.ResolvePath(f); };
+    const TrajoptConfig c = ReadTrajoptConfig(config);
+    planning_step_ = c.replanner.planning_step;
     try {
-      planner_ = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(path(robot_file)),
-                                                     collision::LoadSceneParams(path(scene_file)),
-                                                     planning::LoadPlannerParams(path(planner_file)));
-      body_ = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(path(body_file)));
-      replanner_ = std::make_unique<Replanner>(*planner_, *body_, params_);
+      planner_ = MakePlanner(c);
+      body_ = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(c.human_body_file));
+      replanner_ = std::make_unique<Replanner>(*planner_, *body_, c.replanner);
     } catch (const std::exception& e) {
       return Result::Fail(e.what());
     }
@@ -69,7 +55,7 @@ class TrajoptService : public framework::Service {
   }
 
   Result OnActivate(Node& node) override {
-    timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(params_.planning_step * 1e9)),
+    timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(planning_step_ * 1e9)),
                            [this, &node] { Step(node); });
     return Result::Ok();
   }
@@ -179,7 +165,7 @@ class TrajoptService : public framework::Service {
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
 
-  ReplannerParams params_;
+  double planning_step_ = 0.1;  // s
   std::unique_ptr<planning::Planner> planner_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   std::unique_ptr<Replanner> replanner_;

@@ -28,6 +28,7 @@
 #include "iplan/planning/planner.h"
 #include "risk_config.h"
 #include "synthetic_config.h"
+#include "trajopt_config.h"
 
 namespace iplan::cli {
 namespace {
@@ -154,14 +155,9 @@ int RunCellCheck(const CheckOptions& o) {
     // The static scene, as the trajectory optimiser sees it.
     framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
     framework::ConfigSection tsec = tconf.Section("trajopt");
-    std::string robot_file = "robots/panda.yaml", scene_file = "scenes/cell.yaml", planner_file = "planner.yaml";
-    tsec.Read("robot", &robot_file);
-    tsec.Read("scene", &scene_file);
-    tsec.Read("planner", &planner_file);
+    const trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
     check(tconf);
-    planner = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(tconf.ResolvePath(robot_file)),
-                                                  collision::LoadSceneParams(tconf.ResolvePath(scene_file)),
-                                                  planning::LoadPlannerParams(tconf.ResolvePath(planner_file)));
+    planner = trajopt::MakePlanner(topt);
   } catch (const std::exception& e) {
     std::cerr << "iplan cell-check: " << e.what() << "\n";
     return 2;
