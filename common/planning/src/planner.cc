@@ -23,6 +23,10 @@ using collision::HumanPrediction;
 // keep-out (PlannerParams::human_separation); each other action's mean
 // weighs in with its probability.
 constexpr double kSeparationMinProbability = 0.3;
+// Peak over mean joint speed of the rest-to-rest motions the optimiser finds
+// within the velocity limits: a motion whose largest joint distance over its
+// velocity limit is t_min gets at least this times t_min.
+constexpr double kRestToRestPeakFactor = 1.5;
 using collision::RobotData;
 using collision::RobotModel;
 using Clock = std::chrono::steady_clock;
@@ -968,11 +972,28 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
   Impl::Attempt at;
   at.nq = nq;
   at.dt = P.dt;
-  at.n = std::max(2, static_cast<int>(std::lround(P.horizon / P.dt)));
+  const int horizon_n = std::max(2, static_cast<int>(std::lround(P.horizon / P.dt)));
+  at.n = horizon_n;
   // A warm start longer than the horizon (it contains earlier waits) keeps
   // its length, up to twice the horizon, so its remaining motion is not cut.
   if (req.warm_start.cols() - 1 > at.n)
     at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
+  // A motion longer than the horizon allows within the velocity limits gets
+  // the time it needs after the frozen prefix, up to twice the horizon, and a
+  // straight line to the goal as its start; otherwise every attempt would
+  // break a velocity limit and the robot would never leave (measured on the
+  // Panda: 2.1 rad of joint 1 plans in a 1.5 s horizon, 2.8 rad does not).
+  const bool warm_prefix = req.warm_start.cols() > 1;
+  const int keep = warm_prefix ? req.num_frozen : 1;
+  const Eigen::VectorXd from = warm_prefix ? Eigen::VectorXd(req.warm_start.col(keep - 1)) : req.start_q;
+  double t_min = 0.0;
+  for (int j = 0; j < nq; ++j) t_min = std::max(t_min, std::abs(q_goal[j] - from[j]) / I.vmax[j]);
+  const int need = (keep - 1) + static_cast<int>(std::ceil(kRestToRestPeakFactor * t_min / P.dt));
+  bool stretched = false;
+  if (need > at.n) {
+    at.n = std::min(need, 2 * horizon_n);
+    stretched = true;
+  }
   at.k = req.num_frozen;
   if (at.k >= at.n) bad("num_frozen = " + std::to_string(at.k) + " leaves no free waypoint in a horizon of " +
                         std::to_string(at.n) + " intervals");
@@ -983,7 +1004,15 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
   at.prediction_start = req.prediction_start;
   at.base.resize(nq, at.n + 1);
   const bool warm = req.warm_start.cols() > 1;
-  if (warm) {
+  if (warm && stretched) {
+    // The frozen prefix, then straight to the goal over the stretched time.
+    const int steps = at.n - (keep - 1);
+    for (int i = 0; i < keep; ++i) at.base.col(i) = req.warm_start.col(i);
+    for (int i = 1; i <= steps; ++i) {
+      const double s = static_cast<double>(i) / steps;
+      at.base.col(keep - 1 + i) = (1.0 - s) * from + s * q_goal;
+    }
+  } else if (warm) {
     for (int i = 0; i <= at.n; ++i)
       at.base.col(i) = req.warm_start.col(std::min<Eigen::Index>(i, req.warm_start.cols() - 1));
   } else {

@@ -295,6 +295,43 @@ TEST_F(PlannerTest, WarmStartKeepsTheFrozenPrefixAndStartVelocity) {
   EXPECT_GE(FclClearance(r.positions), -1e-9);
 }
 
+TEST_F(PlannerTest, MotionLongerThanTheHorizonAllowsGetsTheTimeItNeeds) {
+  // 2.8 rad of joint 1 (limit 2.175 rad/s) in a 1.5 s horizon: at least
+  // 1.5 x 2.8 / 2.175 = 1.93 s are needed, so the plan is stretched (up to
+  // twice the horizon) instead of breaking the velocity limit.
+  PlannerParams params;
+  params.horizon = 1.5;
+  const Planner short_horizon(robot_, scene_params_, params);
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.start_q[0] = -1.4;
+  Eigen::VectorXd goal = req.start_q;
+  goal[0] = 1.4;
+  req.goal = Goal::Joint(goal);
+  const PlanningResult r = short_horizon.Plan(req);
+  ExpectValid(r, req.start_q);
+  EXPECT_EQ(r.positions.cols() - 1, static_cast<int>(std::ceil(1.5 * 2.8 / 2.175 / r.dt)));
+  // A short motion keeps the horizon.
+  req.goal = Goal::Joint(Ready());
+  req.start_q = Ready();
+  req.start_q[0] = 0.3;
+  const PlanningResult s = short_horizon.Plan(req);
+  ASSERT_TRUE(s.success) << s.reason;
+  EXPECT_EQ(s.positions.cols(), 16);
+
+  // Replanning from a warm start that is too short for the rest of the
+  // motion: the frozen prefix is kept and the rest stretched.
+  PlanningRequest next;
+  next.start_q = Ready();
+  next.start_q[0] = -1.4;
+  next.warm_start = next.start_q.replicate(1, 4);
+  next.num_frozen = 3;
+  next.goal = Goal::Joint(goal);
+  const PlanningResult w = short_horizon.Plan(next);
+  ExpectValid(w, next.start_q);
+  EXPECT_GT(w.positions.cols(), 16);
+}
+
 TEST_F(PlannerTest, UnreachablePoseIsReportedAsIkFailure) {
   PlanningRequest req;
   req.start_q = Ready();

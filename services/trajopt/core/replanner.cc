@@ -8,12 +8,6 @@
 #include "iplan/core/stats.h"
 
 namespace iplan::trajopt {
-namespace {
-// Peak over mean joint speed of the rest-to-rest motions the optimiser finds
-// within the velocity limits (measured on the Panda: 2.1 rad of joint 1 in
-// a 1.5 s horizon plans, 2.8 rad does not).
-constexpr double kRestToRestPeakFactor = 1.5;
-}  // namespace
 
 std::string ReplannerParams::Validate() const {
   if (!(planning_step > 0)) return "planning_step must be > 0";
@@ -177,32 +171,6 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     req.num_frozen = 1;
   }
   req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
-  if (req.goal.kind == planning::Goal::Kind::kJoint) {
-    // A motion longer than the horizon allows within the velocity limits
-    // (from rest at a task's start, or after a hold) gets a straight warm
-    // start of the length it needs after the frozen prefix: the planner keeps
-    // a longer warm start's length, up to twice the horizon.
-    const collision::RobotModel& robot = planner_.robot();
-    const int keep = req.warm_start.cols() > 0 ? req.num_frozen : 1;
-    const Eigen::VectorXd from = req.warm_start.cols() > 0 ? Eigen::VectorXd(req.warm_start.col(keep - 1)) : req.start_q;
-    double t_min = 0;
-    for (int j = 0; j < robot.nq; ++j) {
-      const double v = robot.joints[static_cast<std::size_t>(robot.q_joints[j])].limits.velocity;
-      t_min = std::max(t_min, std::abs(req.goal.q[j] - from[j]) / v);
-    }
-    const int n = static_cast<int>(std::ceil(kRestToRestPeakFactor * t_min / dt));
-    const int have = static_cast<int>(req.warm_start.cols()) - keep;  // intervals after the prefix
-    if (n > static_cast<int>(std::lround(planner_.params().horizon / dt)) && have < n) {
-      Eigen::MatrixXd w(robot.nq, keep + n);
-      if (req.warm_start.cols() > 0) w.leftCols(keep) = req.warm_start.leftCols(keep);
-      else w.col(0) = req.start_q;
-      for (int i = 1; i <= n; ++i) {
-        const double s = static_cast<double>(i) / n;
-        w.col(keep - 1 + i) = (1 - s) * from + s * req.goal.q;
-      }
-      req.warm_start = w;
-    }
-  }
   const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
   if (predicted) {
     req.prediction = &*prediction_;
