@@ -6,6 +6,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -44,6 +45,9 @@ TEST(TaskGraph, ValidationNamesTheProblem) {
   EXPECT_EQ(g.Validate(), "task 'place' has a retreat of 2 joint positions and a goal of 1");
   g.tasks[2].retreat = {std::nan("")};
   EXPECT_EQ(g.Validate(), "task 'place' has a non-finite retreat");
+  g = Graph();
+  g.tasks[0].goal = {std::numeric_limits<double>::infinity()};
+  EXPECT_EQ(g.Validate(), "task 'pick_left' has a non-finite goal");
 }
 
 TEST(TaskGraph, LoadsRetreatsAndNamesTheFileOnErrors) {
