@@ -179,6 +179,8 @@ class SupervisorService : public framework::Service {
     next_task_at_ = std::chrono::steady_clock::now() + std::chrono::milliseconds(static_cast<int64_t>(pause_ * 1000));
     node.SetDiagnosticValue("tasks_completed", std::to_string(completed_));
     node.SetDiagnosticValue("last_reward", std::to_string(reward));
+    node.SetDiagnosticValue("episodes_learned", std::to_string(planner_->episodes_learned()));
+    node.SetDiagnosticValue("epsilon", std::to_string(planner_->Epsilon()));
     if (!q_table_.empty()) {
       try {
         planner_->Save(q_table_);
