@@ -3,6 +3,8 @@
 // common/planning), publishes it, and reports each task's outcome.
 #include <chrono>
 #include <filesystem>
+#include <optional>
+#include <stdexcept>
 
 #include "common/adapters.h"
 #include "iplan/framework/service.h"
@@ -85,11 +87,6 @@ class TrajoptService : public framework::Service {
       Publish(node, o);
     };
     const int nq = planner_->robot().nq;
-    if (!m.retreat_positions.empty() && static_cast<int>(m.retreat_positions.size()) != nq) {
-      refuse("retreat has " + std::to_string(m.retreat_positions.size()) + " joint positions, the robot " +
-             std::to_string(nq));
-      return;
-    }
     t.retreat = Eigen::Map<const Eigen::VectorXd>(m.retreat_positions.data(),
                                                   static_cast<Eigen::Index>(m.retreat_positions.size()));
     if (m.goal_type == msg::TaskCommand::GOAL_JOINTS) {
@@ -107,8 +104,15 @@ class TrajoptService : public framework::Service {
                                         .normalized());
     }
     if (replanner_->current_task_id() == t.id) return;  // a re-sent command of the running task
+    std::optional<TaskOutcome> replaced;
+    try {
+      replaced = replanner_->StartTask(t, now);  // refuses a retreat of the wrong size
+    } catch (const std::invalid_argument& e) {
+      refuse(e.what());
+      return;
+    }
     node.log().info("task {} '{}' started", t.id, t.name);
-    if (auto replaced = replanner_->StartTask(t, now)) Publish(node, *replaced);
+    if (replaced) Publish(node, *replaced);
   }
 
   void Publish(Node& node, const TaskOutcome& o) {
