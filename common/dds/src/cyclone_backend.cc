@@ -2,6 +2,7 @@
 // per participant.
 #include <cstring>
 #include <mutex>
+#include <string>
 #include <stdexcept>
 #include <unordered_map>
 
@@ -93,6 +94,29 @@ class CycloneWriter final : public BackendWriter {
 class CycloneReader final : public BackendReader {
  public:
   CycloneReader(const cyclone_gen::CycloneTypeOps& ops, dds_entity_t r) : ops_(ops), reader_(r) {}
+  // The writer's announced participant name, looked up once per matched
+  // writer (a miss is not cached: discovery data may still be on its way).
+  const std::string& WriterName(dds_instance_handle_t h) {
+    auto it = names_.find(h);
+    if (it != names_.end()) return it->second;
+    dds_builtintopic_endpoint_t* e = dds_get_matched_publication_data(reader_, h);
+    std::string name;
+    if (e) {
+      void* ud = nullptr;
+      size_t sz = 0;
+      if (e->qos && dds_qget_userdata(e->qos, &ud, &sz)) {
+        name = NameFromUserData(static_cast<const unsigned char*>(ud), sz);
+        dds_free(ud);
+      }
+      dds_builtintopic_free_endpoint(e);
+    }
+    if (name.empty()) {
+      static const std::string kNone;
+      return kNone;
+    }
+    if (names_.size() > 4096) names_.clear();  // bounded: writers come and go
+    return names_.emplace(h, std::move(name)).first->second;
+  }
   ~CycloneReader() override { dds_delete(reader_); }
   bool Take(void* plain, SampleInfo* info) override {
     // Clear DATA_AVAILABLE before taking: a sample that arrives after this
@@ -111,6 +135,7 @@ class CycloneReader final : public BackendReader {
         info->reception_ns = NowNs();
         info->writer_id = HashBytes(reinterpret_cast<const unsigned char*>(&si.publication_handle),
                                     sizeof(si.publication_handle));
+        info->writer_name = WriterName(si.publication_handle);
       }
       dds_return_loan(reader_, samples, n);
       if (valid) return true;
@@ -169,11 +194,13 @@ class CycloneReader final : public BackendReader {
  private:
   const cyclone_gen::CycloneTypeOps& ops_;
   dds_entity_t reader_;
+  std::unordered_map<dds_instance_handle_t, std::string> names_;
 };
 
 class CycloneParticipant final : public BackendParticipant {
  public:
-  CycloneParticipant(const ParticipantOptions& options, const std::string& config_file) {
+  CycloneParticipant(const ParticipantOptions& options, const std::string& config_file)
+      : user_data_(WriterUserData(options.name)) {
     if (!config_file.empty()) {
       const std::string uri = "file://" + config_file;
       const dds_entity_t dom = dds_create_domain(static_cast<dds_domainid_t>(options.domain_id), uri.c_str());
@@ -229,6 +256,7 @@ class CycloneParticipant final : public BackendParticipant {
                                               const QosProfile& q) override {
     const dds_entity_t t = GetTopic(topic, dds_type);
     dds_qos_t* qos = MakeQos(q, true);
+    dds_qset_userdata(qos, user_data_.data(), user_data_.size());
     const dds_entity_t w = dds_create_writer(participant_, t, qos, nullptr);
     dds_delete_qos(qos);
     if (w < 0) throw std::runtime_error(Err("cannot create a writer on " + topic, w));
@@ -285,6 +313,7 @@ class CycloneParticipant final : public BackendParticipant {
   }
 
  private:
+  std::string user_data_;
   dds_entity_t domain_ = 0;
   dds_entity_t participant_ = 0;
   dds_entity_t waitset_ = 0;

@@ -71,6 +71,39 @@ std::string GuidText(const eprosima::fastrtps::rtps::GUID_t& g) {
 
 class FastParticipant;
 
+// Participant names that remote writers announced in their USER_DATA, by
+// writer GUID (kept by the participant's discovery listener).
+class WriterNames {
+ public:
+  void Set(const eprosima::fastrtps::rtps::GUID_t& g, std::string name) {
+    std::lock_guard<std::mutex> lock(mu_);
+    if (name.empty()) {
+      names_.erase(Key(g));
+    } else {
+      names_[Key(g)] = std::move(name);
+    }
+  }
+  void Erase(const eprosima::fastrtps::rtps::GUID_t& g) {
+    std::lock_guard<std::mutex> lock(mu_);
+    names_.erase(Key(g));
+  }
+  std::string Get(const unsigned char* handle16) const {
+    std::lock_guard<std::mutex> lock(mu_);
+    auto it = names_.find(std::string(reinterpret_cast<const char*>(handle16), 16));
+    return it == names_.end() ? std::string() : it->second;
+  }
+
+ private:
+  static std::string Key(const eprosima::fastrtps::rtps::GUID_t& g) {
+    std::string k(16, '\0');
+    std::copy(g.guidPrefix.value, g.guidPrefix.value + 12, k.begin());
+    std::copy(g.entityId.value, g.entityId.value + 4, k.begin() + 12);
+    return k;
+  }
+  mutable std::mutex mu_;
+  std::unordered_map<std::string, std::string> names_;
+};
+
 class FastWriter final : public BackendWriter {
  public:
   FastWriter(const fastdds_gen::FastTypeOps& ops, fdds::Publisher* pub, fdds::DataWriter* w)
@@ -108,8 +141,8 @@ class FastWriter final : public BackendWriter {
 class FastReader final : public BackendReader {
  public:
   FastReader(FastParticipant* owner, const fastdds_gen::FastTypeOps& ops, fdds::Subscriber* sub,
-             fdds::DataReader* r)
-      : owner_(owner), ops_(ops), subscriber_(sub), reader_(r), sample_(ops.new_vendor()) {}
+             fdds::DataReader* r, const WriterNames& names)
+      : owner_(owner), ops_(ops), subscriber_(sub), reader_(r), sample_(ops.new_vendor()), names_(names) {}
   ~FastReader() override;
   bool Take(void* plain, SampleInfo* info) override {
     fdds::SampleInfo si;
@@ -119,6 +152,16 @@ class FastReader final : public BackendReader {
       info->source_timestamp_ns = si.source_timestamp.to_ns();
       info->reception_ns = NowNs();
       info->writer_id = HashBytes(si.publication_handle.value, 16);
+      // Cache per writer; a miss is not cached (discovery may still be on its way).
+      auto it = cache_.find(info->writer_id);
+      if (it == cache_.end()) {
+        std::string name = names_.Get(si.publication_handle.value);
+        if (!name.empty()) {
+          if (cache_.size() > 4096) cache_.clear();
+          it = cache_.emplace(info->writer_id, std::move(name)).first;
+        }
+      }
+      info->writer_name = it == cache_.end() ? std::string() : it->second;
       return true;
     }
     return false;
@@ -178,20 +221,32 @@ class FastReader final : public BackendReader {
   fdds::Subscriber* subscriber_;
   fdds::DataReader* reader_;
   void* sample_;
+  const WriterNames& names_;
+  std::unordered_map<uint64_t, std::string> cache_;
 };
 
-// Keeps the table of discovered endpoints for `iplan topic list`.
+// Keeps the names remote writers announce (always) and the table of
+// discovered endpoints for `iplan topic list` (when tracking).
 class DiscoveryListener : public fdds::DomainParticipantListener {
  public:
+  explicit DiscoveryListener(bool track) : track_(track) {}
   void on_publisher_discovery(fdds::DomainParticipant*,
                               eprosima::fastrtps::rtps::WriterDiscoveryInfo&& info) override {
     using S = eprosima::fastrtps::rtps::WriterDiscoveryInfo::DISCOVERY_STATUS;
+    if (info.status == S::REMOVED_WRITER) {
+      names_.Erase(info.info.guid());
+    } else {
+      const auto& ud = info.info.m_qos.m_userData.data_vec();
+      names_.Set(info.info.guid(), NameFromUserData(ud.data(), ud.size()));
+    }
+    if (!track_) return;
     Update(GuidText(info.info.guid()), info.info.topicName().to_string(),
            info.info.typeName().to_string(), true,
            info.status == S::REMOVED_WRITER);
   }
   void on_subscriber_discovery(fdds::DomainParticipant*,
                                eprosima::fastrtps::rtps::ReaderDiscoveryInfo&& info) override {
+    if (!track_) return;
     using S = eprosima::fastrtps::rtps::ReaderDiscoveryInfo::DISCOVERY_STATUS;
     Update(GuidText(info.info.guid()), info.info.topicName().to_string(),
            info.info.typeName().to_string(), false,
@@ -203,6 +258,7 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
     for (const auto& [guid, e] : endpoints_) out.push_back(e);
     return out;
   }
+  const WriterNames& names() const { return names_; }
 
  private:
   void Update(const std::string& guid, const std::string& topic, const std::string& type,
@@ -214,15 +270,18 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
       endpoints_[guid] = EndpointInfo{topic, type, writer, guid};
     }
   }
+  bool track_;
+  WriterNames names_;
   mutable std::mutex mu_;
   std::map<std::string, EndpointInfo> endpoints_;
 };
 
 class FastParticipant final : public BackendParticipant {
  public:
-  FastParticipant(const ParticipantOptions& options, const std::string& config_file) {
+  FastParticipant(const ParticipantOptions& options, const std::string& config_file)
+      : user_data_(WriterUserData(options.name)) {
     auto* factory = fdds::DomainParticipantFactory::get_instance();
-    if (options.track_endpoints) listener_ = std::make_unique<DiscoveryListener>();
+    listener_ = std::make_unique<DiscoveryListener>(options.track_endpoints);
     if (!config_file.empty()) {
       if (factory->load_XML_profiles_file(config_file) != RC::RETCODE_OK) {
         throw std::runtime_error("Fast DDS: cannot load XML profiles from " + config_file);
@@ -293,6 +352,7 @@ class FastParticipant final : public BackendParticipant {
     qos.data_sharing().off();
     qos.endpoint().history_memory_policy =
         eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(user_data_.begin(), user_data_.end()));
     fdds::DataWriter* w = publisher_->create_datawriter(t, qos, nullptr, fdds::StatusMask::none());
     if (!w) throw std::runtime_error("Fast DDS: cannot create a writer on " + topic);
     return std::make_unique<FastWriter>(FindOps(dds_type), publisher_, w);
@@ -311,7 +371,7 @@ class FastParticipant final : public BackendParticipant {
         eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
     fdds::DataReader* r = subscriber_->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
     if (!r) throw std::runtime_error("Fast DDS: cannot create a reader on " + topic);
-    auto reader = std::make_unique<FastReader>(this, FindOps(dds_type), subscriber_, r);
+    auto reader = std::make_unique<FastReader>(this, FindOps(dds_type), subscriber_, r, listener_->names());
     fdds::StatusCondition& cond = r->get_statuscondition();
     fdds::StatusMask mask = fdds::StatusMask::data_available();
     mask << fdds::StatusMask::requested_deadline_missed() << fdds::StatusMask::liveliness_changed()
@@ -352,12 +412,13 @@ class FastParticipant final : public BackendParticipant {
   void Wake() override { guard_.set_trigger_value(true); }
 
   std::vector<EndpointInfo> Endpoints() const override {
-    return listener_ ? listener_->Endpoints() : std::vector<EndpointInfo>{};
+    return listener_->Endpoints();
   }
 
   fdds::Subscriber* subscriber() { return subscriber_; }
 
  private:
+  std::string user_data_;
   std::unique_ptr<DiscoveryListener> listener_;
   fdds::DomainParticipant* participant_ = nullptr;
   fdds::Publisher* publisher_ = nullptr;

@@ -41,6 +41,22 @@ uint64_t HashBytes(const unsigned char* bytes, int n) {
 }  // namespace internal
 
 namespace {
+constexpr char kUserDataPrefix[] = "iplan.name=";
+}  // namespace
+
+std::string WriterUserData(const std::string& participant_name) { return kUserDataPrefix + participant_name; }
+
+std::string NameFromUserData(const unsigned char* bytes, std::size_t size) {
+  const std::size_t n = sizeof(kUserDataPrefix) - 1;
+  if (bytes == nullptr || size <= n || std::char_traits<char>::compare(reinterpret_cast<const char*>(bytes), kUserDataPrefix, n) != 0) {
+    return "";
+  }
+  // Names are short; a longer claim is not one of ours.
+  if (size - n > 128) return "";
+  return std::string(reinterpret_cast<const char*>(bytes) + n, size - n);
+}
+
+namespace {
 
 std::string Lower(std::string s) {
   std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return std::tolower(c); });

@@ -52,6 +52,8 @@ struct ParticipantOptions {
   std::string config_file;
   /// Keep track of every endpoint on the domain (for `iplan topic list`).
   bool track_endpoints = false;
+  // `name` is also announced in every writer's USER_DATA (WriterUserData), so
+  // readers can tell which participant wrote a sample (SampleInfo::writer_name).
 };
 
 /// Metadata of a received sample.
@@ -59,7 +61,18 @@ struct SampleInfo {
   int64_t source_timestamp_ns = 0;  ///< writer's clock, ns since the epoch
   int64_t reception_ns = 0;         ///< our system clock at Take(), ns since the epoch
   uint64_t writer_id = 0;           ///< stable per remote writer (hash of its GUID)
+  /// Name of the participant that owns the writer, as the writer announced it
+  /// at discovery (USER_DATA "iplan.name=<ParticipantOptions::name>"); empty
+  /// when it announced none (e.g. a ROS 2 node). Without DDS Security anyone
+  /// can claim any name: it tells iplan's own services apart and keeps
+  /// strangers that do not pretend out; it is no authentication.
+  std::string writer_name;
 };
+
+/// The USER_DATA every iplan writer announces: "iplan.name=" + participant name.
+std::string WriterUserData(const std::string& participant_name);
+/// The participant name in a writer's USER_DATA, or "" when it is not ours.
+std::string NameFromUserData(const unsigned char* bytes, std::size_t size);
 
 /// Status changes a reader reports (counts are cumulative per reader).
 enum class EventKind {
