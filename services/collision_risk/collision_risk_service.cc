@@ -1,6 +1,9 @@
 // iplan-collision-risk: the independent watchdog on the executing trajectory.
 // Evaluates the collision bound against every human prediction and ISO/TS
-// 15066 separation monitoring, and publishes /iplan/collision_risk.
+// 15066 separation monitoring, publishes /iplan/collision_risk, and with
+// every evaluation its own permit to move (/iplan/safety/permit): the robot
+// obeys it independently of the supervisor, so the robot stops when this
+// service stops evaluating, whatever happens to the supervisor.
 #include <chrono>
 #include <filesystem>
 
@@ -22,6 +25,10 @@ class CollisionRiskService : public framework::Service {
     const RiskConfig rc = ReadRiskConfig(config);
     params_ = rc.params;
     rate_hz_ = rc.rate_hz;
+    permit_validity_ = rc.permit_validity;
+    if (permit_validity_ < 2.0 / rate_hz_) {
+      config.AddError("permit_validity", "must be at least two evaluation periods (2 / rate_hz)");
+    }
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(config.file() + ": " + why);
     try {
       monitor_ = std::make_unique<RiskMonitor>(MakeRiskMonitor(rc));
@@ -31,6 +38,7 @@ class CollisionRiskService : public framework::Service {
       return Result::Fail(e.what());
     }
     writer_ = &node.Advertise(framework::topics::CollisionRisk());
+    permit_writer_ = &node.Advertise(framework::topics::SafetyPermit());
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
                    std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
@@ -107,6 +115,14 @@ class CollisionRiskService : public framework::Service {
     m.verdict = static_cast<uint8_t>(r.verdict);
     m.reason = r.reason;
     writer_->Write(m);
+    msg::SafetyPermit p;
+    p.header.stamp = msg::Now();
+    p.seq = ++permit_seq_;
+    p.state = r.verdict == Verdict::kProtectiveStop ? msg::SafetyPermit::STOP : msg::SafetyPermit::PERMIT;
+    p.validity = permit_validity_;
+    p.source = "collision_risk";
+    p.reason = r.reason;
+    permit_writer_->Write(p);
     last_publish_ns_ = now_ns;
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (r.verdict != last_verdict_) {
@@ -120,6 +136,9 @@ class CollisionRiskService : public framework::Service {
   double rate_hz_ = 15;
   std::unique_ptr<RiskMonitor> monitor_;
   dds::Writer<msg::CollisionRisk>* writer_ = nullptr;
+  dds::Writer<msg::SafetyPermit>* permit_writer_ = nullptr;
+  double permit_validity_ = 0.2;  // s
+  uint32_t permit_seq_ = 0;
   int timer_ = 0;
   int64_t last_publish_ns_ = 0;
   Verdict last_verdict_ = Verdict::kOk;

@@ -18,11 +18,14 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   config.Read("slow_down_fraction", &p.slow_down_fraction, framework::InRange(0.01, 1.0));
   config.Read("slow_down_margin", &p.slow_down_margin, framework::NonNegative<double>());
   config.Read("stale_after", &p.stale_after, framework::Positive<double>());
+  config.Read("person_required", &p.person_required);
+  config.Read("permit_validity", &c.permit_validity, framework::InRange(0.01, 10.0));
   framework::ConfigSection iso = config.Section("iso_ts_15066");
   SsmParams& s = p.ssm;
   iso.Read("directed", &s.directed);
   iso.Read("measure_human_speed", &s.measure_human_speed);
   iso.Read("default_human_speed", &s.default_human_speed, framework::NonNegative<double>());
+  iso.Read("degrade_without_prediction", &s.degrade_without_prediction);
   iso.Read("speed_window", &s.speed_window, framework::Positive<double>());
   iso.Read("reaction_time", &s.reaction_time, framework::NonNegative<double>());
   iso.Read("stopping_time", &s.stopping_time, framework::NonNegative<double>());

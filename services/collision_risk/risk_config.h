@@ -13,6 +13,7 @@ namespace iplan::collision_risk {
 struct RiskConfig {
   RiskParams params;
   double rate_hz = 15;        ///< evaluations per second between predictions
+  double permit_validity = 0.2;  ///< s, validity of the permit published with every evaluation
   std::string robot_file;     ///< resolved against the configuration file
   std::string human_body_file;
 };

@@ -6,7 +6,7 @@ namespace iplan::services {
 
 collision::JointMixture ToJointMixture(const msg::HumanPrediction& m) {
   collision::JointMixture in;
-  in.t0_ns = msg::ToNanoseconds(m.header.stamp);
+  in.t0_ns = msg::ToNanoseconds(m.observation_stamp);
   in.time_step = m.time_step;
   in.num_steps = static_cast<int>(m.num_steps);
   in.joint_names = m.joint_names;

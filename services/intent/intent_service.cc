@@ -114,10 +114,17 @@ class IntentService : public framework::Service {
   }
 
   void Publish(Node& node, const msg::HumanSkeleton& s) {
-    belief_.header = s.header;
+    // Our own stamp on our outputs (a consumer orders them by it); the
+    // skeleton's stamp, t0 of the prediction steps, travels beside it.
+    const msg::Time now = msg::Now();
+    belief_.header.stamp = now;
+    belief_.header.frame_id = s.header.frame_id;
+    belief_.observation_stamp = s.header.stamp;
     belief_.body_id = s.body_id;
     belief_.probabilities.resize(mixture_.actions.size());
-    prediction_.header = s.header;
+    prediction_.header.stamp = now;
+    prediction_.header.frame_id = s.header.frame_id;
+    prediction_.observation_stamp = s.header.stamp;
     prediction_.body_id = s.body_id;
     for (std::size_t c = 0; c < mixture_.actions.size(); ++c) {
       const intent::ActionHypothesis& h = mixture_.actions[c];

@@ -1,13 +1,15 @@
 // iplan-robot-sim: a simulated robot for the demo cell and the tests.
-// Follows /iplan/robot/trajectory, publishes /joint_states, obeys
-// /iplan/safety/command, and counts true contacts with the simulated
-// person's true body (/iplan/sim/human_truth).
+// Follows /iplan/robot/trajectory, publishes /joint_states, moves only while
+// it holds a fresh permit from every configured monitor
+// (/iplan/safety/permit, iplan/safety/permit_gate.h), and counts true
+// contacts with the simulated person's true body (/iplan/sim/human_truth).
 #include <chrono>
 #include <filesystem>
 
 #include "common/adapters.h"
 #include "core/robot_simulator.h"
 #include "iplan/framework/service.h"
+#include "iplan/safety/permit_gate.h"
 
 namespace iplan::robot_sim {
 namespace {
@@ -29,6 +31,14 @@ class RobotSimService : public framework::Service {
     config.Read("publish_rate_hz", &publish_rate_hz_, framework::InRange(1.0, 1000.0));
     config.Read("stopping_time", &params.stopping_time, framework::Positive<double>());
     config.Read("contact_margin", &params.contact_margin, framework::NonNegative<double>());
+    safety::PermitGateParams permits;
+    permits.monitors = {"iplan-supervisor", "iplan-collision_risk"};
+    ConfigSection pc = config.Section("permits");
+    pc.Read("monitors", &permits.monitors);
+    pc.Read("max_validity", &permits.max_validity, framework::InRange(1e-3, 10.0));
+    pc.Read("clock_tolerance", &permits.clock_tolerance, framework::InRange(0.0, 1.0));
+    if (const std::string why = permits.Validate(); !why.empty()) return Result::Fail(config.file() + ": " + why);
+    gate_ = std::make_unique<safety::PermitGate>(permits);
     try {
       auto robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));
       sim_ = std::make_unique<RobotSimulator>(std::move(robot), Eigen::Map<const Eigen::VectorXd>(q0.data(), static_cast<Eigen::Index>(q0.size())), params);
@@ -47,17 +57,18 @@ class RobotSimService : public framework::Service {
                      node.CountRejection("trajectory",
                                          sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
                    }));
-    node.Subscribe(framework::topics::SafetyCommand(),
-                   std::function<void(const msg::SafetyCommand&, SI)>([this, &node](const msg::SafetyCommand& m, SI) {
-                     if (m.command == msg::SafetyCommand::PROTECTIVE_STOP && !sim_->stopped()) {
-                       sim_->Stop();
-                       ++stops_;
-                       node.log().warn("protective stop from {}: {}", m.source, m.reason);
-                     } else if (m.command == msg::SafetyCommand::RESUME && sim_->stopped()) {
-                       sim_->Resume();
-                       node.log().info("resume from {}: {}", m.source, m.reason);
-                     }
+    // Permits count only from the configured monitors' writers.
+    auto permit_topic = framework::topics::SafetyPermit();
+    permit_topic.writers = permits.monitors;
+    node.Subscribe(permit_topic,
+                   std::function<void(const msg::SafetyPermit&, SI)>([this, &node](const msg::SafetyPermit& m, SI info) {
+                     node.CountRejection("permit", gate_->OnPermit(info.writer_name, m.state == msg::SafetyPermit::PERMIT,
+                                                                   m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
+                                                                   msg::ToNanoseconds(msg::Now())));
                    }));
+    node.OnReaderEvent([this, permit_topic](const std::string& topic, const dds::ReaderEvent& e) {
+      if (topic == permit_topic.name && e.kind == dds::EventKind::kLivelinessLost) gate_->OnWriterLost();
+    });
     node.Subscribe(framework::topics::HumanTruth(),
                    std::function<void(const msg::HumanSkeleton&, SI)>([this, &node](const msg::HumanSkeleton& m, SI) {
                      Eigen::Matrix3Xd joints(3, body_->num_joints());
@@ -81,6 +92,7 @@ class RobotSimService : public framework::Service {
     timer_ = node.AddTimer(period, [this, &node, publish_every] {
       const auto t0 = std::chrono::steady_clock::now();
       const int64_t now = msg::ToNanoseconds(msg::Now());
+      ApplyPermits(node, now);
       sim_->Step(now, (now - last_) * 1e-9);
       last_ = now;
       if (++steps_ % publish_every == 0) {
@@ -94,6 +106,7 @@ class RobotSimService : public framework::Service {
         node.SetDiagnosticValue("min_true_separation_m", std::to_string(sim_->min_separation_seen()));
         node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
         node.SetDiagnosticValue("stopped", sim_->stopped() ? "true" : "false");
+        node.SetDiagnosticValue("permit", permit_reason_);
         node.SetDiagnosticValue("last_stopping_distance_m", std::to_string(sim_->last_stopping_distance()));
       }
       node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -109,7 +122,26 @@ class RobotSimService : public framework::Service {
   }
 
  private:
+  // Stop at once when any permit is missing, lapsed or a stop; resume when
+  // every monitor permits again (their own hysteresis decides when).
+  void ApplyPermits(Node& node, int64_t now_ns) {
+    const safety::PermitDecision d = gate_->Evaluate(now_ns);
+    permit_reason_ = d.reason;
+    if (!d.permitted && !sim_->stopped()) {
+      sim_->Stop();
+      if (ever_permitted_) ++stops_;  // holding still before the first permit is no protective stop
+      node.log().warn("PROTECTIVE STOP: {}", d.reason);
+    } else if (d.permitted && sim_->stopped()) {
+      ever_permitted_ = true;
+      sim_->Resume();
+      node.log().info("resume: {}", d.reason);
+    }
+  }
+
   double control_rate_hz_ = 100, publish_rate_hz_ = 50;
+  std::unique_ptr<safety::PermitGate> gate_;
+  std::string permit_reason_;
+  bool ever_permitted_ = false;
   std::unique_ptr<RobotSimulator> sim_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   dds::Writer<msg::JointState>* joint_writer_ = nullptr;

@@ -1,8 +1,12 @@
 // iplan-supervisor: the task planner (MDP + Q-learning, METHOD 6) and the
 // cell's deadline / liveliness monitor. It issues task commands to the
 // trajectory optimiser, learns from their outcomes and the predicted human
-// action, and commands a protective stop whenever an input is late or gone
-// or the collision-risk verdict says so, resuming when all is healthy.
+// action, and withholds its permit to move (/iplan/safety/permit, asserted
+// every permit period, not only on change) whenever an input is late, gone
+// or unusable or the collision-risk verdict says stop, granting it again
+// when all is healthy. While a task runs its command is re-sent every
+// command_resend_period, so an outcome lost to a frozen or restarted
+// supervisor (or optimiser) is recovered and the cell never idles for good.
 #include <chrono>
 #include <filesystem>
 
@@ -40,6 +44,19 @@ class SupervisorService : public framework::Service {
     double resume_delay = 0.5;
     config.Read("resume_delay", &resume_delay, framework::InRange(0.0, 10.0));
     config.Read("max_episodes", &max_episodes_, framework::NonNegative<int>());
+    config.Read("permit_period", &permit_period_, framework::InRange(0.005, 1.0));
+    config.Read("permit_validity", &permit_validity_, framework::InRange(0.01, 10.0));
+    config.Read("command_resend_period", &resend_period_, framework::InRange(0.1, 60.0));
+    if (permit_validity_ < 2 * permit_period_) {
+      config.AddError("permit_validity", "must be at least twice permit_period (one late permit must not stop the cell)");
+    }
+    if (watched.empty()) {
+      if (mode == "deployment") {
+        config.AddError("watch", "must name at least one topic in deployment (an empty list switches the deadline monitor off)");
+      } else {
+        node.log().warn("supervisor.watch is empty: the deadline / liveliness monitor watches nothing");
+      }
+    }
     q.learning = mode == "learning";
     q.seed = static_cast<uint64_t>(seed);
     q_table_ = config.ResolvePath(q_table_);
@@ -53,8 +70,11 @@ class SupervisorService : public framework::Service {
     } catch (const std::exception& e) {
       return Result::Fail(e.what());
     }
+    // Task ids continue from the clock (ms), so a restarted supervisor never
+    // reuses the id of a task the optimiser already finished.
+    task_id_ = static_cast<uint32_t>((msg::ToNanoseconds(msg::Now()) / 1000000) % 2000000000);
     command_writer_ = &node.Advertise(framework::topics::TaskCommand());
-    safety_writer_ = &node.Advertise(framework::topics::SafetyCommand());
+    permit_writer_ = &node.Advertise(framework::topics::SafetyPermit());
     using SI = const dds::SampleInfo&;
     // Watched topics: any sample is a sign of life; deadline and liveliness
     // events come through OnReaderEvent.
@@ -71,6 +91,7 @@ class SupervisorService : public framework::Service {
     }
     monitor_ = std::make_unique<SafetyMonitor>(names);
     monitor_->SetResumeDelay(resume_delay);
+    for (const auto& [name, deadline] : deadlines_) monitor_->SetDeadline(name, deadline);
     node.OnReaderEvent([this](const std::string& topic, const dds::ReaderEvent& e) {
       if (e.kind == dds::EventKind::kDeadlineMissed) monitor_->OnDeadlineMissed(topic);
       if (e.kind == dds::EventKind::kLivelinessLost) monitor_->OnLivelinessLost(topic, e.current);
@@ -101,9 +122,12 @@ class SupervisorService : public framework::Service {
   template <class T>
   void Watch(Node& node, const framework::Topic<T>& topic, std::vector<std::string>* names) {
     names->push_back(topic.name);
+    deadlines_.emplace_back(topic.name, std::chrono::duration<double>(topic.qos.deadline).count());
     const std::string name = topic.name;
+    // Only samples that passed every check arrive here: they alone count as
+    // signs of life (rejected samples still meet the DDS deadline).
     node.Subscribe(topic, std::function<void(const T&, const dds::SampleInfo&)>([this, name](const T& m, const dds::SampleInfo&) {
-                     monitor_->OnData(name);
+                     monitor_->OnData(name, msg::ToNanoseconds(msg::Now()));
                      if constexpr (std::is_same_v<T, msg::CollisionRisk>) monitor_->OnRiskVerdict(m.verdict, m.reason);
                      if constexpr (std::is_same_v<T, msg::ActionBelief>) Belief(m);
                    }));
@@ -114,17 +138,25 @@ class SupervisorService : public framework::Service {
     for (std::size_t i = 0; i < b.actions.size(); ++i) belief_[b.actions[i]] = b.probabilities[i];
   }
 
+  void PublishPermit(const SafetyDecision& d) {
+    msg::SafetyPermit p;
+    p.header.stamp = msg::Now();
+    p.seq = ++permit_seq_;
+    p.state = d.stop ? msg::SafetyPermit::STOP : msg::SafetyPermit::PERMIT;
+    p.validity = permit_validity_;
+    p.source = "supervisor";
+    p.reason = d.reason;
+    permit_writer_->Write(p);
+    last_permit_at_ = std::chrono::steady_clock::now();
+  }
+
   void Tick(Node& node) {
     bool changed = false;
     const SafetyDecision d = monitor_->Evaluate(&changed, msg::ToNanoseconds(msg::Now()));
+    // Asserted every period whatever the state, at once on a change.
+    const auto now_steady = std::chrono::steady_clock::now();
+    if (changed || now_steady - last_permit_at_ >= std::chrono::duration<double>(permit_period_)) PublishPermit(d);
     if (changed) {
-      msg::SafetyCommand c;
-      c.header.stamp = msg::Now();
-      c.seq = ++safety_seq_;
-      c.command = d.stop ? msg::SafetyCommand::PROTECTIVE_STOP : msg::SafetyCommand::RESUME;
-      c.source = "supervisor";
-      c.reason = d.reason;
-      safety_writer_->Write(c);
       if (d.stop) {
         ++stops_;
         node.log().warn("PROTECTIVE STOP: {}", d.reason);
@@ -132,13 +164,16 @@ class SupervisorService : public framework::Service {
         node.log().info("RESUME: {}", d.reason);
         // A restarted trajectory optimiser never saw the running task's
         // (volatile) command: send it again; the optimiser ignores a repeat.
-        if (current_task_ >= 0) {
-          command_.header.stamp = msg::Now();
-          command_writer_->Write(command_);
-        }
+        if (current_task_ >= 0) ResendCommand();
       }
       node.SetDiagnosticValue("safety", d.stop ? "stopped: " + d.reason : "running");
       node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
+    }
+    // A running task's command again every resend period: the optimiser
+    // ignores a repeat of its running task and answers a repeat of a
+    // finished one with its outcome again (one lost to a freeze).
+    if (current_task_ >= 0 && now_steady - last_command_at_ >= std::chrono::duration<double>(resend_period_)) {
+      ResendCommand();
     }
     // Issue the next task when idle (tasks are not started while stopped).
     if (d.stop || current_task_ >= 0) return;
@@ -164,8 +199,15 @@ class SupervisorService : public framework::Service {
     c.retreat_positions = t.retreat;
     c.episode = static_cast<uint32_t>(episodes_ + 1);
     command_writer_->Write(c);
+    last_command_at_ = std::chrono::steady_clock::now();
     node.log().info("task {} '{}' (episode {}, state {:#x}, epsilon {:.3f})", task_id_, t.name, episodes_ + 1,
                     planner_->state(), planner_->Epsilon());
+  }
+
+  void ResendCommand() {
+    command_.header.stamp = msg::Now();
+    command_writer_->Write(command_);
+    last_command_at_ = std::chrono::steady_clock::now();
   }
 
   void OnOutcome(Node& node, const msg::TaskOutcome& o) {
@@ -185,8 +227,11 @@ class SupervisorService : public framework::Service {
       try {
         planner_->Save(q_table_);
       } catch (const std::exception& e) {
+        ++save_failures_;
         node.log().error("Q-table not saved: {}", e.what());
+        node.SetDiagnosticValue("q_table_last_save_error", e.what());
       }
+      node.SetDiagnosticValue("q_table_save_failures", std::to_string(save_failures_));
     }
   }
 
@@ -196,11 +241,15 @@ class SupervisorService : public framework::Service {
   double pause_ = 0.5;
   int max_episodes_ = 0;
   dds::Writer<msg::TaskCommand>* command_writer_ = nullptr;
-  dds::Writer<msg::SafetyCommand>* safety_writer_ = nullptr;
+  dds::Writer<msg::SafetyPermit>* permit_writer_ = nullptr;
+  double permit_period_ = 0.05, permit_validity_ = 0.2, resend_period_ = 1.0;  // s
+  std::vector<std::pair<std::string, double>> deadlines_;  // watched topic, s
+  std::chrono::steady_clock::time_point last_permit_at_{}, last_command_at_{};
+  uint64_t save_failures_ = 0;
   std::map<std::string, double> belief_;
   msg::TaskCommand command_;  // the running task's command (re-sent on resume)
   int current_task_ = -1;
-  uint32_t task_id_ = 0, safety_seq_ = 0;
+  uint32_t task_id_ = 0, permit_seq_ = 0;
   int episodes_ = 0;
   uint64_t completed_ = 0, stops_ = 0;
   std::chrono::steady_clock::time_point next_task_at_{};

@@ -2,6 +2,7 @@
 // replans the robot's trajectory against the newest prediction (ITOMP,
 // common/planning), publishes it, and reports each task's outcome.
 #include <chrono>
+#include <deque>
 #include <filesystem>
 #include <optional>
 #include <stdexcept>
@@ -42,12 +43,13 @@ class TrajoptService : public framework::Service {
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      node.CountRejection("prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
                    }));
-    node.Subscribe(framework::topics::SafetyCommand(),
-                   std::function<void(const msg::SafetyCommand&, SI)>([this](const msg::SafetyCommand& m, SI) {
-                     // Only the supervisor's commands are latched decisions for the cell.
-                     if (m.source == "supervisor") replanner_->SetRobotStopped(m.command == msg::SafetyCommand::PROTECTIVE_STOP);
-                   }),
-                   framework::SubscribeOptions{false});
+    // The supervisor's permit tells whether the cell is stopped (its stop
+    // covers the collision-risk verdict too): stop time counts as delay.
+    auto permits = framework::topics::SafetyPermit();
+    permits.writers = {"iplan-supervisor"};
+    node.Subscribe(permits, std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
+                     replanner_->SetRobotStopped(m.state == msg::SafetyPermit::STOP);
+                   }));
     node.Subscribe(framework::topics::TaskCommand(),
                    std::function<void(const msg::TaskCommand& m, SI)>([this, &node](const msg::TaskCommand& m, SI) {
                      OnCommand(node, m);
@@ -86,15 +88,18 @@ class TrajoptService : public framework::Service {
       o.reason = reason;
       Publish(node, o);
     };
-    const int nq = planner_->robot().nq;
+    // A repeat of a finished task (the supervisor re-sends while it waits):
+    // its outcome again, in case the first one was lost.
+    for (const TaskOutcome& done : finished_) {
+      if (done.id == m.task_id && done.name == m.task_name) {
+        node.log().info("task {} '{}' repeated after it ended: outcome sent again", done.id, done.name);
+        Publish(node, done, /*remember=*/false);
+        return;
+      }
+    }
     t.retreat = Eigen::Map<const Eigen::VectorXd>(m.retreat_positions.data(),
                                                   static_cast<Eigen::Index>(m.retreat_positions.size()));
     if (m.goal_type == msg::TaskCommand::GOAL_JOINTS) {
-      if (static_cast<int>(m.goal_positions.size()) != nq) {
-        refuse("goal has " + std::to_string(m.goal_positions.size()) + " joint positions, the robot " +
-               std::to_string(nq));
-        return;
-      }
       t.goal = planning::Goal::Joint(Eigen::Map<const Eigen::VectorXd>(m.goal_positions.data(),
                                                                        static_cast<Eigen::Index>(m.goal_positions.size())));
     } else {
@@ -106,7 +111,7 @@ class TrajoptService : public framework::Service {
     if (replanner_->current_task_id() == t.id) return;  // a re-sent command of the running task
     std::optional<TaskOutcome> replaced;
     try {
-      replaced = replanner_->StartTask(t, now);  // refuses a retreat of the wrong size
+      replaced = replanner_->StartTask(t, now);  // validates everything before replacing the running task
     } catch (const std::invalid_argument& e) {
       refuse(e.what());
       return;
@@ -115,7 +120,11 @@ class TrajoptService : public framework::Service {
     if (replaced) Publish(node, *replaced);
   }
 
-  void Publish(Node& node, const TaskOutcome& o) {
+  void Publish(Node& node, const TaskOutcome& o, bool remember = true) {
+    if (remember) {
+      finished_.push_back(o);
+      if (finished_.size() > 32) finished_.pop_front();
+    }
     msg::TaskOutcome m;
     m.header.stamp = msg::Now();
     m.task_id = o.id;
@@ -177,6 +186,7 @@ class TrajoptService : public framework::Service {
   dds::Writer<msg::TaskOutcome>* outcome_writer_ = nullptr;
   dds::Writer<msg::PlanStatus>* status_writer_ = nullptr;
   std::string last_status_;
+  std::deque<TaskOutcome> finished_;  // the last outcomes, answered again on a repeated command
   int timer_ = 0;
 };
 

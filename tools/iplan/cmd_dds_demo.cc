@@ -47,7 +47,7 @@ struct DemoOptions {
   int episodes = 6;
   double timeout = 170;
   std::string summary_file, config_dir, state_dir;
-  bool keep_learning = false, retrain = false;
+  bool keep_learning = false, retrain = false, prepare_only = false;
 };
 
 // The services in start order (executable suffix, config name).
@@ -94,13 +94,17 @@ class CellMonitor {
                      separation_ = m.min_separation;
                      min_observed_separation_ = std::min(min_observed_separation_, m.min_separation);
                    }));
-    node.Subscribe(topics::SafetyCommand(),
-                   std::function<void(const msg::SafetyCommand&, SI)>([this](const msg::SafetyCommand& m, SI) {
-                     if (m.command == msg::SafetyCommand::PROTECTIVE_STOP && !stopped_) {
+    // The robot is stopped while any monitor withholds its permit; a stop
+    // is counted when the first one does.
+    node.Subscribe(topics::SafetyPermit(),
+                   std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
+                     const bool was_stopped = stopped_;
+                     permit_stops_[m.source] = m.state == msg::SafetyPermit::STOP;
+                     stopped_ = std::any_of(permit_stops_.begin(), permit_stops_.end(), [](const auto& p) { return p.second; });
+                     if (stopped_ && !was_stopped) {
                        ++stops_;
                        stop_reasons_.push_back(m.source + ": " + m.reason);
                      }
-                     stopped_ = m.command == msg::SafetyCommand::PROTECTIVE_STOP;
                    }),
                    any_order);
     node.Subscribe(topics::Diagnostics(),
@@ -205,6 +209,7 @@ class CellMonitor {
   int current_episode_ = 0;
   std::string current_task_;
   bool waiting_ = false, stopped_ = false;
+  std::map<std::string, bool> permit_stops_;  // per monitor: its last permit is a STOP
   std::map<std::string, std::map<std::string, std::string>> diag_;
   std::vector<std::string> events_;
 };
@@ -256,6 +261,10 @@ int RunDemo(const DemoOptions& o) {
     std::cout << "  intent model: checking ..." << std::flush;
     model = EnsureCellModel(cfg("perception"), cfg("intent"), state_dir, o.retrain);
     std::cout << "\r  " << model.summary << "\n";
+    if (o.prepare_only) {
+      std::cout << "  model path: " << model.path << "\n";
+      return 0;
+    }
     framework::ConfigSection sup = framework::ConfigSection::Load(cfg("supervisor"));
     std::string graph_file = "tasks/table_top.yaml";
     sup.Section("supervisor").Read("task_graph", &graph_file);
@@ -447,6 +456,8 @@ void Register(CLI::App& app) {
   d->add_flag("--keep-learning", o.keep_learning,
               "use the Q-table of supervisor.yaml (learning carries over between runs) instead of a fresh one");
   d->add_flag("--retrain", o.retrain, "train the intent model again even if a cached one fits");
+  d->add_flag("--prepare-only", o.prepare_only,
+              "train (or check) the cell's intent model, print its path ('model path: FILE') and exit without running the cell");
   d->callback([] { SetExitCode(RunDemo(o)); });
 }
 

@@ -3,7 +3,9 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
+#include <limits>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -21,6 +23,12 @@ std::string Fmt(double v) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), "%.6g", v);
   return buf;
+}
+
+std::string Join(const std::vector<std::string>& v) {
+  std::string out;
+  for (const auto& x : v) out += (out.empty() ? "" : ", ") + x;
+  return out;
 }
 
 }  // namespace
@@ -138,15 +146,66 @@ void Node::Reject(SubscriptionBase& sub, const std::string& why) {
   }
 }
 
+bool Node::AcceptWriter(SubscriptionBase& sub, const dds::SampleInfo& info) {
+  if (sub.entitled.empty()) return true;
+  if (std::find(sub.entitled.begin(), sub.entitled.end(), info.writer_name) != sub.entitled.end()) return true;
+  const std::string who = info.writer_name.empty() ? "(unnamed)" : info.writer_name;
+  ++sub.stats.ignored_writers;
+  sub.stats.last_ignored_writer = who;
+  if (sub.ignored_names.size() < 64 && sub.ignored_names.insert(who).second) {
+    log_->warn("{}: ignoring samples from '{}', not entitled to write it (entitled: {})", sub.reader->topic(), who,
+               Join(sub.entitled));
+  }
+  return false;
+}
+
+bool Node::AcceptFrame(SubscriptionBase& sub, const std::string& frame_id) {
+  if (!sub.check_frame || frame_id == options_.frame_id) return true;
+  Reject(sub, "frame_id '" + frame_id + "' is not the cell frame '" + options_.frame_id + "'");
+  return false;
+}
+
 bool Node::AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns) {
-  auto [it, inserted] = sub.last_stamp_ns.emplace(writer, stamp_ns);
-  if (inserted) return true;
-  if (stamp_ns < it->second) {
-    Reject(sub, "stamp went backwards by " + Fmt((it->second - stamp_ns) * 1e-9) + " s");
+  const int64_t now_ns = msg::ToNanoseconds(msg::Now());
+  const int64_t ahead_ns = stamp_ns - now_ns;
+  if (ahead_ns > static_cast<int64_t>(options_.max_stamp_ahead * 1e9)) {
+    Reject(sub, "stamp " + Fmt(ahead_ns * 1e-9) + " s ahead of this host's clock (tolerance " +
+                    Fmt(options_.max_stamp_ahead) + " s)");
     return false;
   }
-  it->second = stamp_ns;
+  auto [it, inserted] = sub.clocks.emplace(writer, SubscriptionBase::WriterClock{stamp_ns, 0});
+  if (inserted) return true;
+  SubscriptionBase::WriterClock& c = it->second;
+  if (stamp_ns < c.last_ns) {
+    if (++c.backwards < kResyncAfter) {
+      Reject(sub, "stamp went backwards by " + Fmt((c.last_ns - stamp_ns) * 1e-9) + " s");
+      return false;
+    }
+    log_->warn("{}: a writer's stamps went backwards {} times in a row (by {} s): its clock stepped back; "
+               "ordering restarts from the new stamp",
+               sub.reader->topic(), c.backwards, Fmt((c.last_ns - stamp_ns) * 1e-9));
+  }
+  c.last_ns = stamp_ns;
+  c.backwards = 0;
   return true;
+}
+
+std::vector<std::string> Node::EntitledWriters(const std::string& topic, const std::vector<std::string>& catalogue) const {
+  // Configuration keys may use the wire name ("rt/iplan/...") or the ROS name ("/iplan/...").
+  const std::string ros = topic.rfind("rt/", 0) == 0 ? topic.substr(2) : topic;
+  for (const std::string& key : {topic, ros}) {
+    if (auto it = options_.entitled_writers.find(key); it != options_.entitled_writers.end()) return it->second;
+  }
+  return catalogue;
+}
+
+double Node::SecondsSinceAccepted(const std::string& topic) const {
+  for (const auto& s : subscriptions_) {
+    if (s->reader->topic() == topic && s->stats.last_accepted) {
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - *s->stats.last_accepted).count();
+    }
+  }
+  return std::numeric_limits<double>::infinity();
 }
 
 bool Node::CountRejection(const std::string& input, const std::optional<std::string>& rejection) {
@@ -186,8 +245,9 @@ msg::DiagnosticArray Node::MakeDiagnostics() const {
   s.level = level_;
   auto add = [&s](const std::string& k, const std::string& v) { s.values.push_back({k, v}); };
   add("state", state_);
-  uint64_t rejected = 0, misses = 0, lost = 0, errors = 0;
+  uint64_t rejected = 0, misses = 0, lost = 0, errors = 0, ignored = 0;
   for (const auto& sub : subscriptions_) {
+    ignored += sub->stats.ignored_writers;
     rejected += sub->stats.rejected;
     misses += sub->stats.deadline_misses;
     lost += sub->stats.liveliness_lost;
@@ -205,6 +265,7 @@ msg::DiagnosticArray Node::MakeDiagnostics() const {
   add("liveliness_lost", std::to_string(lost));
   add("rejected_messages", std::to_string(rejected));
   add("callback_errors", std::to_string(errors));
+  add("ignored_writers", std::to_string(ignored));
   for (const auto& sub : subscriptions_) {
     const std::string& t = sub->reader->topic();
     add("received/" + t, std::to_string(sub->stats.received));
@@ -212,9 +273,13 @@ msg::DiagnosticArray Node::MakeDiagnostics() const {
     add("deadline_misses/" + t, std::to_string(sub->stats.deadline_misses));
     add("liveliness_lost/" + t, std::to_string(sub->stats.liveliness_lost));
     if (!sub->stats.last_rejection.empty()) add("last_rejection/" + t, sub->stats.last_rejection);
+    if (sub->stats.ignored_writers > 0) {
+      add("ignored_writers/" + t, std::to_string(sub->stats.ignored_writers));
+      add("last_ignored_writer/" + t, sub->stats.last_ignored_writer);
+    }
   }
   for (const auto& [k, v] : extra_values_) add(k, v);
-  if (s.level == msg::DiagnosticStatus::OK && (rejected > 0 || misses > 0 || lost > 0 || errors > 0)) {
+  if (s.level == msg::DiagnosticStatus::OK && (rejected > 0 || misses > 0 || lost > 0 || errors > 0 || ignored > 0)) {
     s.level = msg::DiagnosticStatus::WARN;
   }
   a.status.push_back(std::move(s));

@@ -96,6 +96,17 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     ConfigSection node_section = config->Section("node");
     node_section.Read("diagnostics_period", &nopts.diagnostics_period, NonNegative<double>());
     node_section.Read("hardware_id", &nopts.hardware_id);
+    node_section.Read("max_stamp_ahead", &nopts.max_stamp_ahead, InRange(0.0, 60.0));
+    node_section.Read("frame_id", &nopts.frame_id, Check<std::string>([](const std::string& f) {
+      return f.empty() ? std::string("must not be empty") : std::string();
+    }));
+    // entitled_writers: {"/iplan/robot/trajectory": [iplan-trajopt], ...}
+    ConfigSection entitled = node_section.Section("entitled_writers");
+    for (const std::string& topic : entitled.Keys()) {
+      std::vector<std::string> names;
+      entitled.Read(topic, &names);
+      nopts.entitled_writers[topic] = names;
+    }
   } catch (const ConfigError& e) {
     std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
     return kExitConfigError;

@@ -7,40 +7,44 @@ using Q = dds::QosProfile;
 }  // namespace
 
 Topic<msg::HumanSkeleton> HumanSkeleton() {
-  return {"rt/iplan/human/skeleton", Q::SensorStream(milliseconds(150), milliseconds(300))};
+  // Any provider may publish skeletons (perception is swappable).
+  return {"rt/iplan/human/skeleton", Q::SensorStream(milliseconds(150), milliseconds(300)), {}, true};
 }
 Topic<msg::HumanSkeleton> HumanTruth() {
-  return {"rt/iplan/sim/human_truth", Q::SensorStream(milliseconds(150), milliseconds(300))};
+  return {"rt/iplan/sim/human_truth", Q::SensorStream(milliseconds(150), milliseconds(300)), {}, true};
 }
 Topic<msg::PointCloud2> Obstacles() {
   return {"rt/iplan/obstacles", Q::SensorStream(milliseconds(1000), milliseconds(1000))};
 }
 Topic<msg::ActionBelief> ActionBelief() {
-  return {"rt/iplan/human/action_belief", Q::SensorStream(milliseconds(200), milliseconds(300))};
+  return {"rt/iplan/human/action_belief", Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-intent"}};
 }
 Topic<msg::HumanPrediction> HumanPrediction() {
-  return {"rt/iplan/human/prediction", Q::SensorStream(milliseconds(200), milliseconds(300))};
+  return {"rt/iplan/human/prediction", Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-intent"}, true};
 }
 Topic<msg::JointState> JointStates() {
   return {"rt/joint_states", Q::SensorStream(milliseconds(100), milliseconds(300))};
 }
 Topic<msg::JointTrajectory> RobotTrajectory() {
-  return {"rt/iplan/robot/trajectory", Q::LatchedState(milliseconds(300), milliseconds(300))};
+  return {"rt/iplan/robot/trajectory", Q::LatchedState(milliseconds(300), milliseconds(300)), {"iplan-trajopt"}};
 }
 Topic<msg::TaskCommand> TaskCommand() {
-  return {"rt/iplan/task/command", Q::Command(milliseconds(1000))};
+  return {"rt/iplan/task/command", Q::Command(milliseconds(1000)), {"iplan-supervisor"}};
 }
 Topic<msg::TaskOutcome> TaskOutcome() {
-  return {"rt/iplan/task/outcome", Q::Command(milliseconds(1000))};
+  return {"rt/iplan/task/outcome", Q::Command(milliseconds(1000)), {"iplan-trajopt"}};
 }
 Topic<msg::PlanStatus> PlanStatus() {
-  return {"rt/iplan/robot/plan_status", Q::SensorStream(milliseconds(300), milliseconds(300))};
+  return {"rt/iplan/robot/plan_status", Q::SensorStream(milliseconds(300), milliseconds(300)), {"iplan-trajopt"}};
 }
 Topic<msg::CollisionRisk> CollisionRisk() {
-  return {"rt/iplan/collision_risk", Q::SensorStream(milliseconds(200), milliseconds(300))};
+  return {"rt/iplan/collision_risk", Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-collision_risk"}};
 }
-Topic<msg::SafetyCommand> SafetyCommand() {
-  return {"rt/iplan/safety/command", Q::LatchedState(milliseconds(0), milliseconds(1000))};
+Topic<msg::SafetyPermit> SafetyPermit() {
+  // Deadline and lease well above the permit period (50 ms); the robot side
+  // judges freshness itself, from each permit's validity.
+  return {"rt/iplan/safety/permit", Q::SensorStream(milliseconds(200), milliseconds(300)),
+          {"iplan-supervisor", "iplan-collision_risk"}};
 }
 Topic<msg::DiagnosticArray> Diagnostics() {
   Q q = Q::Command(milliseconds(3000));
@@ -68,7 +72,7 @@ std::vector<TopicDescription> All() {
       Describe(TaskOutcome(), "robot task outcomes (trajectory optimisation)"),
       Describe(PlanStatus(), "one status per replanning cycle, with end-to-end latency (trajectory optimisation)"),
       Describe(CollisionRisk(), "collision bound and separation monitoring (collision risk)"),
-      Describe(SafetyCommand(), "protective stop / resume (supervisor, collision risk)"),
+      Describe(SafetyPermit(), "permission to move, re-published every period (supervisor, collision risk)"),
       Describe(Diagnostics(), "per-service diagnostics (every service)"),
   };
 }

@@ -77,6 +77,7 @@ std::optional<std::string> CheckSemantics(const HumanSkeleton& m) {
 
 std::optional<std::string> CheckSemantics(const ActionBelief& m) {
   if (auto e = CheckSemantics(m.header)) return e;
+  if (m.observation_stamp.nanosec >= 1000000000u) return std::string("observation_stamp.nanosec >= 1e9");
   if (m.actions.size() != m.probabilities.size()) {
     return "probabilities has " + std::to_string(m.probabilities.size()) + " entries for " +
            std::to_string(m.actions.size()) + " actions";
@@ -92,6 +93,7 @@ std::optional<std::string> CheckSemantics(const ActionBelief& m) {
 
 std::optional<std::string> CheckSemantics(const HumanPrediction& m) {
   if (auto e = CheckSemantics(m.header)) return e;
+  if (m.observation_stamp.nanosec >= 1000000000u) return std::string("observation_stamp.nanosec >= 1e9");
   if (!(m.time_step > 0)) return "time_step " + Num(m.time_step) + " is not positive";
   const std::size_t expected = static_cast<std::size_t>(m.num_steps) * m.joint_names.size();
   double sum = 0;
@@ -201,9 +203,10 @@ std::optional<std::string> CheckSemantics(const CollisionRisk& m) {
   return std::nullopt;
 }
 
-std::optional<std::string> CheckSemantics(const SafetyCommand& m) {
+std::optional<std::string> CheckSemantics(const SafetyPermit& m) {
   if (auto e = CheckSemantics(m.header)) return e;
-  if (m.command > SafetyCommand::RESUME) return "command " + std::to_string(m.command) + " unknown";
+  if (m.state > SafetyPermit::PERMIT) return "state " + std::to_string(m.state) + " unknown";
+  if (!(m.validity > 0) || m.validity > 10) return "validity " + Num(m.validity) + " s outside (0, 10]";
   return std::nullopt;
 }
 

@@ -186,7 +186,8 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   Eigen::Matrix3Xd v_robot;
   RobotSphereVelocities(now_ns, &v_robot);
   Eigen::Matrix3Xd v_joints;
-  const bool measured = person && MeasuredJointVelocities(&v_joints);
+  const bool degraded = person && !predicted && s.degrade_without_prediction;
+  const bool measured = person && !degraded && MeasuredJointVelocities(&v_joints);
   const double fixed = s.intrusion_distance + s.sensing_uncertainty + s.robot_uncertainty;
   auto protective = [&](double v_h, double v_r) {
     const double s_s = s.directed ? s.stopping_distance * std::min(1.0, v_r / s.stopping_speed) : s.stopping_distance;
@@ -299,7 +300,12 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
       break;
     }
   }
-  if (person && r.separation_margin < 0) {
+  if (!person && params_.person_required) {
+    r.verdict = Verdict::kProtectiveStop;
+    r.reason = skeletons_.empty() ? "no person tracked yet (no skeleton): the person could be anywhere"
+                                  : "person no longer tracked (no skeleton for " +
+                                        Fmt((now_ns - skeletons_.back().first) * 1e-9) + " s): the person could be anywhere";
+  } else if (person && r.separation_margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + Fmt(r.binding_separation) + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
                ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
@@ -320,7 +326,10 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
                " m of the protective separation";
   } else {
     r.verdict = Verdict::kOk;
-    r.reason = !person ? "no person seen" : (predicted ? "clear" : "clear (separation only: no current prediction)");
+    r.reason = !person    ? "no person seen"
+               : predicted ? "clear"
+               : degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
+                           : "clear (separation only: no current prediction)";
   }
   return r;
 }

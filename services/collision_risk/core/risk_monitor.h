@@ -20,7 +20,9 @@
 // still may resume, and a hand moving sideways does not inflate S_p.
 // Verdict: PROTECTIVE_STOP when the separation is below S_p, or the bound
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
-// unknown; SLOW_DOWN when within a margin of either; OK otherwise.
+// unknown, or (person_required) no person is tracked; SLOW_DOWN when within
+// a margin of either; OK otherwise. Without a usable prediction the monitor
+// runs degraded: separation only, at the ISO default human speed.
 //
 // Frames and units: positions in the world frame (= robot base frame), m;
 // times are ns since the epoch on input and s relative to the evaluation in
@@ -47,6 +49,10 @@ struct SsmParams {
   bool directed = true;             ///< speeds towards each other per sphere pair; false: fastest joint / sphere, S_s always
   bool measure_human_speed = true;  ///< from the skeleton; else v_h = default_human_speed
   double default_human_speed = 1.6; ///< m/s, ISO value when the speed is not measured
+  /// Degraded mode: without a usable prediction the person's intent is
+  /// unknown, so v_h is default_human_speed even when the skeleton gives a
+  /// measured speed (the robot keeps working, more cautiously).
+  bool degrade_without_prediction = true;
   double speed_window = 0.3;        ///< s, displacement window for the measured speed
   double reaction_time = 0.1;       ///< s, T_r
   double stopping_time = 0.3;       ///< s, T_s
@@ -63,6 +69,10 @@ struct RiskParams {
   double slow_down_fraction = 0.5; ///< slow down above this fraction of 1 - delta_cl
   double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
   double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
+  /// No fresh skeleton means protective stop: a person no sensor sees could
+  /// be anywhere. false: "no person seen" is clear (a cell whose perception
+  /// publishes nothing when nobody is there).
+  bool person_required = true;
   SsmParams ssm;
   /// Empty when valid, else the reason.
   std::string Validate() const;

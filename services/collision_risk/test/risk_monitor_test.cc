@@ -30,6 +30,10 @@ class RiskMonitorTest : public ::testing::Test {
   static RiskParams Params() {
     RiskParams p;
     p.ssm.measure_human_speed = true;
+    // These cases test the layers one at a time: separation with a measured
+    // speed and no prediction; the degraded mode has tests of its own.
+    p.ssm.degrade_without_prediction = false;
+    p.person_required = false;
     return p;
   }
   void RobotAtReady(int64_t t) {
@@ -94,6 +98,7 @@ TEST_F(RiskMonitorTest, OkWhenThePersonStaysAway) {
 TEST(RiskMonitorUndirected, StoppingDistanceAlwaysCounts) {
   RiskParams p;
   p.ssm.directed = false;
+  p.ssm.degrade_without_prediction = false;
   RiskMonitor monitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
                       collision::HumanBodyParams::DefaultUpperBody(), p);
   const int64_t t = 100 * kSec;
@@ -132,6 +137,7 @@ TEST_F(RiskMonitorTest, SidewaysMotionDoesNotInflateTheDirectedProtectiveSeparat
   // The same scene undirected: v_h = 1 m/s and S_s, so S_p is at least 0.55 m larger.
   RiskParams p;
   p.ssm.directed = false;
+  p.ssm.degrade_without_prediction = false;
   RiskMonitor undirected(collision::RobotModel(monitor_.robot()), collision::HumanBodyParams::DefaultUpperBody(), p);
   ASSERT_EQ(undirected.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
   ASSERT_EQ(undirected.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person({1.3, -0.3, 0.6})), std::nullopt);
@@ -246,6 +252,40 @@ TEST_F(RiskMonitorTest, RejectsInputsItCannotMap) {
   p = Predict(0, {2, 0, 1}, {0, 0, 0}, 3, 0.1);
   p.means[0].pop_back();
   EXPECT_EQ(*monitor_.UpdatePrediction(p), "prediction action 0 has the wrong number of Gaussians");
+}
+
+TEST(RiskMonitorFailSafe, NoTrackedPersonStopsTheRobot) {
+  RiskMonitor monitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
+                      collision::HumanBodyParams::DefaultUpperBody(), RiskParams{});
+  const int64_t t = 100 * kSec;
+  ASSERT_EQ(monitor.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  RiskReport r = monitor.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
+  EXPECT_NE(r.reason.find("no person tracked yet"), std::string::npos) << r.reason;
+  ASSERT_EQ(monitor.UpdateSkeleton(t, kJoints, Person({2.5, 0, 1.0})), std::nullopt);
+  EXPECT_EQ(monitor.Evaluate(t).verdict, Verdict::kOk);
+  // The skeleton stream stops: after stale_after the person could be anywhere.
+  ASSERT_EQ(monitor.UpdateRobotState(t + kSec, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  r = monitor.Evaluate(t + kSec);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
+  EXPECT_NE(r.reason.find("person no longer tracked"), std::string::npos) << r.reason;
+}
+
+TEST(RiskMonitorFailSafe, WithoutAUsablePredictionSeparationUsesTheDefaultHumanSpeed) {
+  RiskParams p;
+  p.ssm.measure_human_speed = true;
+  RiskMonitor monitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
+                      collision::HumanBodyParams::DefaultUpperBody(), p);
+  const int64_t t = 100 * kSec;
+  ASSERT_EQ(monitor.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  // A person standing still: measured speed 0, but no prediction says what
+  // they intend, so S_p takes the ISO default speed.
+  ASSERT_EQ(monitor.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
+  ASSERT_EQ(monitor.UpdateSkeleton(t, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
+  const RiskReport r = monitor.Evaluate(t);
+  EXPECT_DOUBLE_EQ(r.human_speed, p.ssm.default_human_speed);
+  EXPECT_NEAR(r.protective_separation, 1.6 * (0.1 + 0.3) + 0.1 + 0.05 + 0.02, 1e-9);
+  EXPECT_NE(r.reason.find("degraded"), std::string::npos) << r.reason;
 }
 
 }  // namespace

@@ -8,8 +8,14 @@ SafetyMonitor::SafetyMonitor(std::vector<std::string> watched_topics) : topics_(
   for (const auto& t : topics_) causes_[t] = "never seen";
 }
 
-void SafetyMonitor::OnData(const std::string& topic) {
-  if (causes_.count(topic)) causes_[topic].clear();
+void SafetyMonitor::OnData(const std::string& topic, int64_t now_ns) {
+  if (!causes_.count(topic)) return;
+  causes_[topic].clear();
+  last_data_ns_[topic] = now_ns;
+}
+
+void SafetyMonitor::SetDeadline(const std::string& topic, double seconds) {
+  deadline_ns_[topic] = static_cast<int64_t>(seconds * 1e9);
 }
 
 void SafetyMonitor::OnDeadlineMissed(const std::string& topic) {
@@ -28,7 +34,14 @@ SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {
   SafetyDecision d;
   std::string reason;
   for (const auto& t : topics_) {
-    const std::string& c = causes_[t];
+    std::string& c = causes_[t];
+    const auto dl = deadline_ns_.find(t);
+    const auto last = last_data_ns_.find(t);
+    if (c.empty() && dl != deadline_ns_.end() && dl->second > 0 && last != last_data_ns_.end() &&
+        now_ns - last->second > dl->second) {
+      c = "no usable sample for " + std::to_string((now_ns - last->second) / 1000000) + " ms (deadline " +
+          std::to_string(dl->second / 1000000) + " ms)";
+    }
     if (!c.empty()) reason += (reason.empty() ? "" : "; ") + t + ": " + c;
   }
   if (!risk_cause_.empty()) reason += (reason.empty() ? "" : "; ") + risk_cause_;

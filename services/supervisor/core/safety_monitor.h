@@ -3,8 +3,11 @@
 // PROTECTIVE_STOP verdict of the collision-risk service, means the robot
 // must stop, naming the culprit; when every cause has cleared (data flows
 // again, the verdict is no longer a stop) the cell resumes by itself.
-// Topics never seen since start count as late (safe start). No DDS types;
-// times in ns since the epoch. Not thread-safe.
+// Topics never seen since start count as late (safe start). A topic with a
+// deadline (SetDeadline) also counts as late when no *usable* sample came for
+// longer than it: the caller reports only samples that passed every check,
+// so a stream of rejected samples, which meets the DDS deadline, still stops
+// the robot. No DDS types; times in ns since the epoch. Not thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -24,7 +27,11 @@ class SafetyMonitor {
  public:
   explicit SafetyMonitor(std::vector<std::string> watched_topics);
 
-  void OnData(const std::string& topic);
+  /// A usable sample of `topic` arrived at `now_ns`.
+  void OnData(const std::string& topic, int64_t now_ns = 0);
+  /// Seconds without a usable sample after which `topic` counts as late
+  /// (0: only the DDS deadline events count).
+  void SetDeadline(const std::string& topic, double seconds);
   void OnDeadlineMissed(const std::string& topic);
   void OnLivelinessLost(const std::string& topic, int alive_writers);
   /// verdict: 0 OK, 1 SLOW_DOWN, 2 PROTECTIVE_STOP (CollisionRisk constants).
@@ -42,6 +49,7 @@ class SafetyMonitor {
  private:
   std::vector<std::string> topics_;
   std::map<std::string, std::string> causes_;
+  std::map<std::string, int64_t> deadline_ns_, last_data_ns_;
   std::string risk_cause_;
   std::optional<SafetyDecision> last_;
   int64_t resume_delay_ns_ = 0;

@@ -84,6 +84,29 @@ std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t no
     throw std::invalid_argument("retreat has " + std::to_string(task.retreat.size()) + " joint positions, the robot " +
                                 std::to_string(planner_.robot().nq));
   }
+  // Everything is checked before the running task is replaced: a command
+  // that cannot be carried out must not cancel one that can.
+  const Eigen::VectorXd lo = planner_.robot().LowerLimits(), hi = planner_.robot().UpperLimits();
+  auto check_limits = [&](const Eigen::VectorXd& q, const char* what) {
+    for (Eigen::Index i = 0; i < q.size(); ++i) {
+      if (!(q[i] >= lo[i] && q[i] <= hi[i])) {
+        throw std::invalid_argument(std::string(what) + " joint " + std::to_string(i) + " at " + std::to_string(q[i]) +
+                                    " rad is outside its limits [" + std::to_string(lo[i]) + ", " +
+                                    std::to_string(hi[i]) + "]");
+      }
+    }
+  };
+  if (task.goal.kind == planning::Goal::Kind::kJoint) {
+    if (task.goal.q.size() != planner_.robot().nq) {
+      throw std::invalid_argument("goal has " + std::to_string(task.goal.q.size()) + " joint positions, the robot " +
+                                  std::to_string(planner_.robot().nq));
+    }
+    check_limits(task.goal.q, "goal");
+  } else if (!task.goal.p_WE.allFinite() || !task.goal.R_WE.coeffs().allFinite() ||
+             std::abs(task.goal.R_WE.norm() - 1) > 1e-6) {
+    throw std::invalid_argument("goal pose is not finite or its orientation is not a unit quaternion");
+  }
+  if (task.retreat.size() != 0) check_limits(task.retreat, "retreat");
   if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
   task_ = Active{};
   task_->spec = task;

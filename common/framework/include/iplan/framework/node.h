@@ -3,10 +3,23 @@
 // diagnostics every service publishes.
 //
 // Every received message passes a boundary check before the callback sees
-// it: non-finite numbers, inconsistent sizes (msg::Check) and stamps that go
-// backwards for the same writer are rejected, counted per topic, logged once
-// (then every 100th), and reported in diagnostics. A callback that throws is
-// logged and counted; it never takes the service down.
+// it, in this order:
+//  1. the writer: on a topic with entitled writers (the catalogue's, or the
+//     `node.entitled_writers` configuration), samples from any other writer
+//     are ignored, counted per topic as `ignored_writers`, logged once per
+//     writer name, and reported in diagnostics;
+//  2. the content: non-finite numbers, sizes beyond the limits, inconsistent
+//     sizes (msg::Check), a header.frame_id other than the cell's frame on
+//     topics in the cell frame;
+//  3. time: a header stamp more than `max_stamp_ahead` ahead of this host's
+//     clock (a forged or broken clock must not blind the cell), or older than
+//     the previous accepted one from the same writer. One sample cannot
+//     ratchet a writer's ordering: after kResyncAfter consecutive backwards
+//     samples the writer's clock is taken to have stepped back and the
+//     ordering restarts from the new stamp (logged).
+// A failing message is rejected, counted per topic, logged once (then every
+// 100th), and reported in diagnostics. A callback that throws is logged and
+// counted; it never takes the service down.
 //
 // Threading: all callbacks and timers run on the thread that calls
 // SpinOnce()/SpinUntil(); the core of a service therefore needs no locks.
@@ -18,6 +31,8 @@
 #include <functional>
 #include <map>
 #include <memory>
+#include <optional>
+#include <set>
 #include <string>
 #include <vector>
 
@@ -33,6 +48,15 @@ namespace iplan::framework {
 struct NodeOptions {
   double diagnostics_period = 1.0;  ///< s between diagnostics messages; 0: none
   std::string hardware_id;          ///< default: the host name
+  /// s; header stamps further ahead of this host's clock are rejected
+  /// (hosts are expected to be synchronised to well within this).
+  double max_stamp_ahead = 0.5;
+  /// The cell frame: header.frame_id of messages on topics in the cell frame.
+  std::string frame_id = "world";
+  /// Per topic (wire name "rt/..." or ROS name "/..."), the participant names
+  /// whose samples are accepted; replaces the catalogue's list for that topic.
+  /// An empty list accepts every writer.
+  std::map<std::string, std::vector<std::string>> entitled_writers;
 };
 
 /// Counters of one subscribed topic.
@@ -43,15 +67,23 @@ struct TopicStats {
   uint64_t deadline_misses = 0;
   uint64_t liveliness_lost = 0;
   uint64_t incompatible_qos = 0;
+  uint64_t ignored_writers = 0;  ///< samples from writers not entitled to the topic
   int alive_writers = 0;
   std::string last_rejection;
+  std::string last_ignored_writer;  ///< name of the last writer ignored ("(unnamed)" when none)
+  /// When a sample was last accepted (steady clock); nullopt: never.
+  std::optional<std::chrono::steady_clock::time_point> last_accepted;
 };
 
 struct SubscribeOptions {
   /// Reject a message whose header stamp is older than the previous accepted
-  /// one from the same writer.
+  /// one from the same writer, or too far ahead of this host's clock.
   bool check_stamps = true;
 };
+
+/// Consecutive backwards samples from one writer after which its ordering
+/// restarts from the newest stamp (a clock stepped back, not a reordering).
+constexpr int kResyncAfter = 3;
 
 class Node {
  public:
@@ -107,6 +139,12 @@ class Node {
 
   /// Counters of a subscribed topic (zeros when not subscribed).
   TopicStats stats(const std::string& topic) const;
+  /// Seconds since a sample of `topic` was last accepted (passed every
+  /// check); +infinity when none ever was or the topic is not subscribed.
+  double SecondsSinceAccepted(const std::string& topic) const;
+  /// Entitled writers of `topic` after the configuration (empty: anyone).
+  std::vector<std::string> EntitledWriters(const std::string& topic,
+                                           const std::vector<std::string>& catalogue) const;
   spdlog::logger& log() { return *log_; }
   const std::string& name() const { return name_; }
   dds::Participant& participant() { return participant_; }
@@ -118,7 +156,14 @@ class Node {
     std::unique_ptr<dds::AnyReader> reader;
     TopicStats stats;
     SubscribeOptions options;
-    std::map<uint64_t, int64_t> last_stamp_ns;  // per writer
+    std::vector<std::string> entitled;  // empty: anyone
+    bool check_frame = false;
+    struct WriterClock {
+      int64_t last_ns = 0;
+      int backwards = 0;  // consecutive backwards samples
+    };
+    std::map<uint64_t, WriterClock> clocks;  // per writer
+    std::set<std::string> ignored_names;     // logged once each
   };
   template <class T>
   struct Subscription;
@@ -130,8 +175,16 @@ class Node {
 
   void HandleEvents(SubscriptionBase& sub);
   void Reject(SubscriptionBase& sub, const std::string& why);
+  /// True when the writer may write this topic (else counts and logs it).
+  bool AcceptWriter(SubscriptionBase& sub, const dds::SampleInfo& info);
+  /// True when the frame is the cell's (or the topic is not in it).
+  bool AcceptFrame(SubscriptionBase& sub, const std::string& frame_id);
   /// True when the stamp is acceptable for this writer (and records it).
   bool AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns);
+  void Accepted(SubscriptionBase& sub) {
+    ++sub.stats.received;
+    sub.stats.last_accepted = std::chrono::steady_clock::now();
+  }
   template <class F>
   void RunGuarded(SubscriptionBase* sub, const char* what, F&& f);
   void RunTimers();
@@ -183,17 +236,19 @@ struct Node::Subscription : Node::SubscriptionBase {
         continue;
       }
       if (!took) break;
+      if (!node.AcceptWriter(*this, info)) continue;
       if (auto why = msg::Check(msg)) {
         node.Reject(*this, *why);
         continue;
       }
       if constexpr (msg::HasHeader<T>::value) {
+        if (!node.AcceptFrame(*this, msg.header.frame_id)) continue;
         if (options.check_stamps &&
             !node.AcceptStamp(*this, info.writer_id, msg::ToNanoseconds(msg.header.stamp))) {
           continue;
         }
       }
-      ++stats.received;
+      node.Accepted(*this);
       node.RunGuarded(this, "callback", [&] { on_message(msg, info); });
     }
   }
@@ -205,6 +260,8 @@ void Node::Subscribe(const Topic<T>& topic, std::function<void(const T&, const d
   auto sub = std::make_unique<Subscription<T>>();
   sub->on_message = std::move(on_message);
   sub->options = options;
+  sub->entitled = EntitledWriters(topic.name, topic.writers);
+  sub->check_frame = topic.in_cell_frame;
   sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos);
   by_reader_[sub->reader.get()] = sub.get();
   subscriptions_.push_back(std::move(sub));

@@ -18,6 +18,12 @@ template <class T>
 struct Topic {
   std::string name;  ///< DDS topic name, e.g. "rt/iplan/human/skeleton"
   dds::QosProfile qos;
+  /// Participant names entitled to write it (readers ignore everyone else;
+  /// `node.entitled_writers` overrides); empty: any writer (sensor data
+  /// from any provider, diagnostics).
+  std::vector<std::string> writers = {};
+  /// Positions in the cell frame: header.frame_id must name it.
+  bool in_cell_frame = false;
 };
 
 /// Untyped description for tools and docs.
@@ -52,8 +58,10 @@ Topic<msg::TaskOutcome> TaskOutcome();
 Topic<msg::PlanStatus> PlanStatus();
 /// Collision risk of the executing trajectory.
 Topic<msg::CollisionRisk> CollisionRisk();
-/// Protective stop / resume (latched).
-Topic<msg::SafetyCommand> SafetyCommand();
+/// Permission to move from each safety monitor, re-published every period
+/// (supervisor, collision risk). Volatile: a late joiner must wait for a
+/// fresh permit, never replay an old one.
+Topic<msg::SafetyPermit> SafetyPermit();
 /// Per-service diagnostics (ROS 2 /diagnostics).
 Topic<msg::DiagnosticArray> Diagnostics();
 

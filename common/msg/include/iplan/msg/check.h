@@ -24,7 +24,7 @@ std::optional<std::string> CheckSemantics(const TaskCommand& m);
 std::optional<std::string> CheckSemantics(const TaskOutcome& m);
 std::optional<std::string> CheckSemantics(const PlanStatus& m);
 std::optional<std::string> CheckSemantics(const CollisionRisk& m);
-std::optional<std::string> CheckSemantics(const SafetyCommand& m);
+std::optional<std::string> CheckSemantics(const SafetyPermit& m);
 std::optional<std::string> CheckSemantics(const DiagnosticArray& m);
 std::optional<std::string> CheckSemantics(const Header& m);
 template <class T>

@@ -1,0 +1,228 @@
+// The whole cell for multi-process fault and attack tests: the six services
+// as separate processes with the shipped configuration (config/), the
+// synthetic person of the demo cell, one DDS vendor, a domain and a state
+// folder of their own, and an observer participant in the test process that
+// records joint states, permits, task outcomes and diagnostics.
+//
+// Unlike `iplan demo`, every process is the test's own, so a test can kill,
+// freeze (SIGSTOP) and restart any of them.
+#pragma once
+
+#include <signal.h>
+#include <unistd.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <functional>
+#include <map>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "iplan/framework/node.h"
+#include "test_node.h"
+#include "test_paths.h"
+
+namespace iplan::testing {
+
+class CellHarness {
+ public:
+  using Clock = std::chrono::steady_clock;
+  static const std::vector<std::string>& Services() {
+    static const std::vector<std::string> kServices = {"perception", "intent",  "collision_risk",
+                                                       "trajopt",    "robot_sim", "supervisor"};
+    return kServices;
+  }
+
+  struct JointSample {
+    Clock::time_point at;
+    double max_speed = 0;  ///< rad/s, largest |qd| over the joints
+  };
+  struct PermitSample {
+    Clock::time_point at;
+    msg::SafetyPermit permit;
+    std::string writer;
+  };
+
+  CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset)
+      : vendor_(vendor), domain_(UniqueDomain(domain_offset)) {
+    dir_ = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
+    std::filesystem::remove_all(dir_);
+    std::filesystem::create_directories(dir_);
+    config_dir_ = std::string(IPLAN_SOURCE_DIR) + "/config";
+    // The cell's intent model, trained from the synthetic person on first
+    // use and cached (as `iplan demo` does).
+    Process prep({BinPath("iplan"), "demo", "--prepare-only", "--config-dir", config_dir_, "--state-dir", dir_.string()});
+    const auto rc = prep.Wait(std::chrono::seconds(300));
+    const std::string out = prep.Stdout();
+    const auto at = out.find("model path: ");
+    if (!rc || *rc != 0 || at == std::string::npos) {
+      ADD_FAILURE() << "cannot prepare the cell's intent model:\n" << out << prep.Stderr();
+      return;
+    }
+    model_ = out.substr(at + 12, out.find('\n', at) - at - 12);
+    observer_ = std::make_unique<TestNode>("observer", vendor, domain_);
+    framework::Node& node = *observer_->node;
+    using SI = const dds::SampleInfo&;
+    framework::SubscribeOptions any_order{false};
+    node.Subscribe(framework::topics::JointStates(),
+                   std::function<void(const msg::JointState&, SI)>([this](const msg::JointState& m, SI) {
+                     double v = 0;
+                     for (double x : m.velocity) v = std::max(v, std::abs(x));
+                     joints_.push_back({Clock::now(), v});
+                     positions_ = m.position;
+                   }),
+                   any_order);
+    node.Subscribe(framework::topics::SafetyPermit(),
+                   std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI info) {
+                     permits_.push_back({Clock::now(), m, info.writer_name});
+                   }),
+                   any_order);
+    node.Subscribe(framework::topics::TaskOutcome(),
+                   std::function<void(const msg::TaskOutcome&, SI)>([this](const msg::TaskOutcome& m, SI) {
+                     outcomes_.push_back(m);
+                   }),
+                   any_order);
+    node.Subscribe(framework::topics::Diagnostics(),
+                   std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
+                     for (const auto& st : a.status) {
+                       for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
+                     }
+                   }),
+                   any_order);
+  }
+
+  ~CellHarness() {
+    for (auto& [name, p] : procs_) {
+      if (!p) continue;
+      p->Signal(SIGCONT);
+      p->Signal(SIGTERM);
+    }
+    for (auto& [name, p] : procs_) {
+      if (p) p->Wait(std::chrono::seconds(10));
+    }
+    procs_.clear();
+    observer_.reset();
+    std::filesystem::remove_all(dir_);
+  }
+
+  bool ready() const { return observer_ != nullptr; }
+  framework::Node& node() { return *observer_->node; }
+  int domain() const { return domain_; }
+  const std::filesystem::path& dir() const { return dir_; }
+  std::string q_table() const { return (dir_ / "q_table.bin").string(); }
+
+  /// Starts (or restarts) `svc` with the shipped configuration.
+  void Start(const std::string& svc, const std::vector<std::string>& extra = {}) {
+    const std::string exe = svc == "robot_sim" ? "robot-sim" : svc == "collision_risk" ? "collision-risk" : svc;
+    std::vector<std::string> argv = {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml",
+                                     "--dds", dds::ToString(vendor_), "--domain", std::to_string(domain_)};
+    if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
+    if (svc == "perception") {
+      argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true"});
+    }
+    if (svc == "supervisor") {
+      argv.insert(argv.end(), {"--set", "supervisor.q_table=" + q_table(), "--set", "supervisor.pause_between_tasks=0.2"});
+    }
+    argv.insert(argv.end(), extra.begin(), extra.end());
+    procs_[svc] = std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false,
+                                            (dir_ / (svc + "-" + std::to_string(++starts_))).string());
+  }
+  void StartAll() {
+    for (const auto& s : Services()) Start(s);
+  }
+  Process& operator[](const std::string& svc) { return *procs_.at(svc); }
+  std::string Logs(const std::string& svc) const {
+    auto it = procs_.find(svc);
+    return it == procs_.end() || !it->second ? "" : it->second->Stderr();
+  }
+
+  /// Spins the observer until `done()` or `timeout`; returns done().
+  bool SpinUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
+    const auto end = Clock::now() + timeout;
+    while (!done() && Clock::now() < end) node().SpinOnce(std::chrono::milliseconds(5));
+    return done();
+  }
+  void SpinFor(std::chrono::milliseconds d) {
+    SpinUntil([] { return false; }, d);
+  }
+
+  /// The arm moves faster than `speed` rad/s (newest joint state).
+  bool Moving(double speed = 0.2) const { return !joints_.empty() && joints_.back().max_speed > speed; }
+  /// Newest joint state is recent and at rest.
+  bool AtRest(double speed = 1e-3) const {
+    return !joints_.empty() && Clock::now() - joints_.back().at < std::chrono::milliseconds(200) &&
+           joints_.back().max_speed < speed;
+  }
+  /// First joint state after `since` from which the arm stays at rest to the
+  /// newest one (nullopt when it is not at rest now).
+  std::optional<Clock::time_point> RestSince(Clock::time_point since, double speed = 1e-3) const {
+    std::optional<Clock::time_point> rest;
+    for (const auto& j : joints_) {
+      if (j.at < since) continue;
+      if (j.max_speed < speed) {
+        if (!rest) rest = j.at;
+      } else {
+        rest.reset();
+      }
+    }
+    return rest;
+  }
+  /// Largest joint speed seen after `since`.
+  double MaxSpeedSince(Clock::time_point since) const {
+    double v = 0;
+    for (const auto& j : joints_) {
+      if (j.at >= since) v = std::max(v, j.max_speed);
+    }
+    return v;
+  }
+  std::size_t num_joint_states() const { return joints_.size(); }
+  const std::vector<double>& positions() const { return positions_; }
+  const std::vector<PermitSample>& permits() const { return permits_; }
+  const std::vector<msg::TaskOutcome>& outcomes() const { return outcomes_; }
+  /// The newest permit of `source` ("supervisor", "collision_risk") is PERMIT.
+  bool Permits(const std::string& source) const {
+    for (auto it = permits_.rbegin(); it != permits_.rend(); ++it) {
+      if (it->permit.source == source) return it->permit.state == msg::SafetyPermit::PERMIT;
+    }
+    return false;
+  }
+  std::string LastReason(const std::string& source) const {
+    for (auto it = permits_.rbegin(); it != permits_.rend(); ++it) {
+      if (it->permit.source == source) return it->permit.reason;
+    }
+    return "(no permit from " + source + ")";
+  }
+  /// A diagnostics value of a service ("" when not seen).
+  std::string Diag(const std::string& service, const std::string& key) const {
+    auto s = diag_.find(service);
+    if (s == diag_.end()) return "";
+    auto k = s->second.find(key);
+    return k == s->second.end() ? "" : k->second;
+  }
+  double DiagNumber(const std::string& service, const std::string& key, double otherwise = 0) const {
+    const std::string v = Diag(service, key);
+    return v.empty() ? otherwise : std::stod(v);
+  }
+  void ForgetDiagnostics() { diag_.clear(); }
+
+ private:
+  dds::Vendor vendor_;
+  int domain_;
+  std::filesystem::path dir_;
+  std::string config_dir_, model_;
+  std::unique_ptr<TestNode> observer_;
+  std::map<std::string, std::unique_ptr<Process>> procs_;
+  int starts_ = 0;
+  std::vector<JointSample> joints_;
+  std::vector<double> positions_;
+  std::vector<PermitSample> permits_;
+  std::vector<msg::TaskOutcome> outcomes_;
+  std::map<std::string, std::map<std::string, std::string>> diag_;
+};
+
+}  // namespace iplan::testing
