@@ -63,6 +63,9 @@ struct RiskParams {
   double slow_down_fraction = 0.5; ///< slow down above this fraction of 1 - delta_cl
   double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
   double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
+  /// rad (m for prismatic joints); a robot state further outside the joint
+  /// limits is refused as corrupt (encoder noise and a stop's overshoot stay within)
+  double joint_limit_tolerance = 0.05;
   SsmParams ssm;
   /// Empty when valid, else the reason.
   std::string Validate() const;
@@ -102,7 +105,8 @@ class RiskMonitor {
   RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params);
 
   /// Each Update returns nullopt when accepted, else why it was rejected
-  /// (unknown joint names, wrong sizes); rejected input leaves state alone.
+  /// (unknown joint names, wrong sizes, a robot state outside the joint
+  /// limits); rejected input leaves state alone.
   std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                               const std::vector<double>& positions);
   /// `times` in s from `start_ns`, increasing; positions one vector per point.
