@@ -18,6 +18,7 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   config.Read("slow_down_fraction", &p.slow_down_fraction, framework::InRange(0.01, 1.0));
   config.Read("slow_down_margin", &p.slow_down_margin, framework::NonNegative<double>());
   config.Read("stale_after", &p.stale_after, framework::Positive<double>());
+  config.Read("joint_limit_tolerance", &p.joint_limit_tolerance, framework::NonNegative<double>());
   framework::ConfigSection iso = config.Section("iso_ts_15066");
   SsmParams& s = p.ssm;
   iso.Read("directed", &s.directed);
