@@ -20,6 +20,7 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   config.Read("stale_after", &p.stale_after, framework::Positive<double>());
   config.Read("person_required", &p.person_required);
   config.Read("permit_validity", &c.permit_validity, framework::InRange(0.01, 10.0));
+  config.Read("joint_limit_tolerance", &p.joint_limit_tolerance, framework::NonNegative<double>());
   framework::ConfigSection iso = config.Section("iso_ts_15066");
   SsmParams& s = p.ssm;
   iso.Read("directed", &s.directed);

@@ -19,6 +19,8 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   config.Read("settle_speed", &p.settle_speed, framework::Positive<double>());
   config.Read("stale_after", &p.stale_after, framework::Positive<double>());
   config.Read("max_tracking_error", &p.max_tracking_error, framework::Positive<double>());
+  config.Read("joint_limit_tolerance", &p.joint_limit_tolerance, framework::NonNegative<double>());
+  config.Read("joint_velocity_factor", &p.joint_velocity_factor, framework::InRange(1.0, 10.0));
   c.robot_file = config.ResolvePath(robot_file);
   c.human_body_file = config.ResolvePath(body_file);
   c.scene_file = config.ResolvePath(scene_file);

@@ -1,6 +1,7 @@
 #include "iplan/collision/robot_model.h"
 
 #include <cmath>
+#include <cstdio>
 #include <functional>
 #include <limits>
 #include <set>
@@ -103,6 +104,59 @@ Eigen::VectorXd RobotModel::UpperLimits() const {
   Eigen::VectorXd v(nq);
   for (int i = 0; i < nq; ++i) v[i] = joints[q_joints[i]].limits.upper;
   return v;
+}
+
+namespace {
+
+std::string Num(double x) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%g", x);
+  return buf;
+}
+
+const char* Unit(const Joint& j, bool per_second) {
+  if (j.type == JointType::kPrismatic) return per_second ? "m/s" : "m";
+  return per_second ? "rad/s" : "rad";
+}
+
+}  // namespace
+
+std::optional<std::string> CheckJointPositions(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                               double tolerance) {
+  if (q.size() != model.nq) {
+    return std::to_string(q.size()) + " joint positions for a robot of " + std::to_string(model.nq) + " joints";
+  }
+  for (int i = 0; i < model.nq; ++i) {
+    const Joint& j = model.joints[static_cast<std::size_t>(model.q_joints[static_cast<std::size_t>(i)])];
+    const double v = q[i];
+    if (!std::isfinite(v)) return "joint '" + j.name + "' at " + Num(v) + " " + Unit(j, false) + " is not finite";
+    // Written so that the infinite limits of continuous joints pass.
+    if (!(v >= j.limits.lower - tolerance && v <= j.limits.upper + tolerance)) {
+      return "joint '" + j.name + "' at " + Num(v) + " " + Unit(j, false) + " is outside its limits [" +
+             Num(j.limits.lower) + ", " + Num(j.limits.upper) + "] " + Unit(j, false) + " by more than " +
+             Num(tolerance);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckJointVelocities(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& qd,
+                                                double tolerance_factor) {
+  if (qd.size() != model.nq) {
+    return std::to_string(qd.size()) + " joint velocities for a robot of " + std::to_string(model.nq) + " joints";
+  }
+  for (int i = 0; i < model.nq; ++i) {
+    const Joint& j = model.joints[static_cast<std::size_t>(model.q_joints[static_cast<std::size_t>(i)])];
+    const double v = qd[i];
+    if (!std::isfinite(v)) return "joint '" + j.name + "' at " + Num(v) + " " + Unit(j, true) + " is not finite";
+    const double limit = j.limits.velocity;
+    if (!(limit > 0) || std::isinf(limit)) continue;  // no limit stated (URDF without <limit velocity>)
+    if (std::abs(v) > tolerance_factor * limit) {
+      return "joint '" + j.name + "' at " + Num(v) + " " + Unit(j, true) + " is beyond " + Num(tolerance_factor) +
+             " x its limit " + Num(limit) + " " + Unit(j, true);
+    }
+  }
+  return std::nullopt;
 }
 
 RobotData::RobotData(const RobotModel& model)

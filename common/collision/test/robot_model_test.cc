@@ -3,6 +3,7 @@
 #include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -382,6 +383,57 @@ TEST(RobotModelTest, ForwardKinematicsDoesNotAllocate) {
   CalcForwardKinematics(yaml, q, &data);
   EXPECT_EQ(test_support::StopCountingAllocations(), 0);
   EXPECT_GT(data.p_WS.cwiseAbs().sum(), 0.0);
+}
+
+// Measured states against the limits: inside passes, beyond the limit by less
+// than the tolerance passes, a corrupted value is named with joint and limit.
+TEST(RobotModelTest, JointPositionsAreCheckedAgainstTheLimits) {
+  const RobotModel m = LoadRobotModelFromYaml(kYaml);
+  const Eigen::VectorXd lo = m.LowerLimits(), hi = m.UpperLimits();
+  EXPECT_EQ(CheckJointPositions(m, 0.5 * (lo + hi), 0.05), std::nullopt);
+  EXPECT_EQ(CheckJointPositions(m, lo, 0.0), std::nullopt);  // the limits themselves are inside
+  Eigen::VectorXd q = hi;
+  q[3] += 0.049;
+  EXPECT_EQ(CheckJointPositions(m, q, 0.05), std::nullopt);
+  q[3] = 100.0;
+  EXPECT_EQ(CheckJointPositions(m, q, 0.05),
+            std::string("joint 'panda_joint4' at 100 rad is outside its limits [-3.0718, -0.0698] rad by more than 0.05"));
+  q = lo;
+  q[0] -= 0.051;
+  ASSERT_TRUE(CheckJointPositions(m, q, 0.05).has_value());
+  EXPECT_EQ(CheckJointPositions(m, q, 0.05)->rfind("joint 'panda_joint1' at -2.9483 rad", 0), 0u);
+  q = lo;
+  q[6] = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(CheckJointPositions(m, q, 0.05), std::string("joint 'panda_joint7' at nan rad is not finite"));
+  EXPECT_EQ(CheckJointPositions(m, Eigen::VectorXd::Zero(6), 0.05),
+            std::string("6 joint positions for a robot of 7 joints"));
+}
+
+TEST(RobotModelTest, JointVelocitiesAreCheckedAgainstTheLimit) {
+  const RobotModel m = LoadRobotModelFromYaml(kYaml);
+  Eigen::VectorXd qd = Eigen::VectorXd::Zero(7);
+  qd[0] = -2.175 * 1.19;  // panda_joint1: 2.175 rad/s
+  EXPECT_EQ(CheckJointVelocities(m, qd, 1.2), std::nullopt);
+  qd[0] = -5.0;
+  EXPECT_EQ(CheckJointVelocities(m, qd, 1.2),
+            std::string("joint 'panda_joint1' at -5 rad/s is beyond 1.2 x its limit 2.175 rad/s"));
+}
+
+// Continuous joints have no position limit; prismatic ones are reported in m.
+TEST(RobotModelTest, JointLimitCheckOfContinuousAndPrismaticJoints) {
+  const std::string path = WriteTemp("toy_limits.urdf", R"(<robot name="toy">
+  <link name="base"/><link name="l1"/><link name="l2"/>
+  <joint name="j1" type="continuous"><parent link="base"/><child link="l1"/><axis xyz="0 0 1"/></joint>
+  <joint name="j2" type="prismatic"><parent link="l1"/><child link="l2"/><axis xyz="1 0 0"/>
+    <limit lower="0" upper="0.3" velocity="0.5" effort="10"/></joint>
+</robot>)");
+  const RobotModel m = LoadRobotModelFromUrdf(path);
+  EXPECT_EQ(CheckJointPositions(m, Eigen::Vector2d(1000.0, 0.3), 0.01), std::nullopt);
+  EXPECT_EQ(CheckJointPositions(m, Eigen::Vector2d(0.0, 0.4), 0.01),
+            std::string("joint 'j2' at 0.4 m is outside its limits [0, 0.3] m by more than 0.01"));
+  EXPECT_EQ(CheckJointVelocities(m, Eigen::Vector2d(1000.0, -0.5), 1.0), std::nullopt);  // j1: no velocity limit
+  EXPECT_EQ(CheckJointVelocities(m, Eigen::Vector2d(0.0, 0.6), 1.0),
+            std::string("joint 'j2' at 0.6 m/s is beyond 1 x its limit 0.5 m/s"));
 }
 
 TEST(RobotModelTest, LockedFingersLeaveSevenJoints) {

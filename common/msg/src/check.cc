@@ -1,8 +1,11 @@
 #include "iplan/msg/check.h"
 
+#include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
 #include <cstdio>
-#include <set>
+#include <utility>
 
 namespace iplan::msg {
 namespace {
@@ -51,7 +54,190 @@ std::optional<std::string> CheckUnit(double x, const char* what) {
   return CheckUnit(x, [what] { return std::string(what); });
 }
 
+// "<field> has <n> <unit>, limit <limit>": names the field and the limit, so
+// the sender can tell which rule it broke.
+std::string Over(const std::string& field, uint64_t n, uint64_t limit, const char* unit = "entries") {
+  return field + " has " + std::to_string(n) + " " + unit + ", limit " + std::to_string(limit);
+}
+
+// `field` is only called when there is something to report.
+template <class FieldFn>
+std::optional<std::string> CheckLength(const std::string& s, std::size_t limit, FieldFn field) {
+  if (s.size() > limit) return Over(field(), s.size(), limit, "characters");
+  return std::nullopt;
+}
+std::optional<std::string> CheckLength(const std::string& s, std::size_t limit, const char* field) {
+  return CheckLength(s, limit, [field] { return std::string(field); });
+}
+
+// A sequence of at most `count` names of at most Limits::kName characters.
+std::optional<std::string> CheckNames(const std::vector<std::string>& v, std::size_t count, const char* field) {
+  if (v.size() > count) return Over(field, v.size(), count);
+  for (std::size_t i = 0; i < v.size(); ++i) {
+    if (auto e = CheckLength(v[i], Limits::kName, [&] { return std::string(field) + "[" + std::to_string(i) + "]"; })) {
+      return e;
+    }
+  }
+  return std::nullopt;
+}
+
 }  // namespace
+
+std::optional<std::string> CheckSizes(const Header& m) {
+  return CheckLength(m.frame_id, Limits::kName, "header.frame_id");
+}
+
+std::optional<std::string> CheckSizes(const HumanSkeleton& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.joints.size() > Limits::kSkeletonJoints) return Over("joints", m.joints.size(), Limits::kSkeletonJoints);
+  for (std::size_t i = 0; i < m.joints.size(); ++i) {
+    auto field = [i] { return "joints[" + std::to_string(i) + "].name"; };
+    if (auto e = CheckLength(m.joints[i].name, Limits::kName, field)) return e;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const ActionBelief& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckNames(m.actions, Limits::kActions, "actions")) return e;
+  if (m.probabilities.size() > Limits::kActions) return Over("probabilities", m.probabilities.size(), Limits::kActions);
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const HumanPrediction& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.num_steps > Limits::kPredictionSteps) {
+    return "num_steps is " + std::to_string(m.num_steps) + ", limit " + std::to_string(Limits::kPredictionSteps);
+  }
+  if (auto e = CheckNames(m.joint_names, Limits::kPredictionJoints, "joint_names")) return e;
+  if (m.actions.size() > Limits::kActions) return Over("actions", m.actions.size(), Limits::kActions);
+  // Each factor is bounded now, so the product cannot wrap.
+  const uint64_t declared = uint64_t{m.num_steps} * m.joint_names.size() * m.actions.size();
+  if (declared > Limits::kPredictionGaussians) {
+    return "actions x num_steps x joint_names = " + std::to_string(declared) + " Gaussians, limit " +
+           std::to_string(Limits::kPredictionGaussians);
+  }
+  // What is sent may differ from what is declared (CheckSemantics tells);
+  // the walk over it must be bounded all the same.
+  uint64_t sent = 0;
+  for (std::size_t a = 0; a < m.actions.size(); ++a) {
+    auto field = [a] { return "actions[" + std::to_string(a) + "].action"; };
+    if (auto e = CheckLength(m.actions[a].action, Limits::kName, field)) return e;
+    sent += m.actions[a].joints.size();
+  }
+  if (sent > Limits::kPredictionGaussians) return Over("actions[].joints", sent, Limits::kPredictionGaussians);
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const JointState& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckNames(m.name, Limits::kRobotJoints, "name")) return e;
+  if (m.position.size() > Limits::kRobotJoints) return Over("position", m.position.size(), Limits::kRobotJoints);
+  if (m.velocity.size() > Limits::kRobotJoints) return Over("velocity", m.velocity.size(), Limits::kRobotJoints);
+  if (m.effort.size() > Limits::kRobotJoints) return Over("effort", m.effort.size(), Limits::kRobotJoints);
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const JointTrajectory& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckNames(m.joint_names, Limits::kRobotJoints, "joint_names")) return e;
+  if (m.points.size() > Limits::kTrajectoryPoints) return Over("points", m.points.size(), Limits::kTrajectoryPoints);
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const auto& p = m.points[i];
+    const std::pair<const char*, const std::vector<double>*> values[] = {
+        {"positions", &p.positions},
+        {"velocities", &p.velocities},
+        {"accelerations", &p.accelerations},
+        {"effort", &p.effort}};
+    for (const auto& [field, v] : values) {
+      if (v->size() > Limits::kRobotJoints) {
+        return Over("points[" + std::to_string(i) + "]." + field, v->size(), Limits::kRobotJoints);
+      }
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const PointCloud2& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  const uint64_t points = uint64_t{m.width} * m.height;  // both 32-bit: cannot wrap
+  if (points > Limits::kCloudPoints) {
+    return "width x height = " + std::to_string(points) + " points, limit " + std::to_string(Limits::kCloudPoints);
+  }
+  if (m.point_step > Limits::kCloudPointStep) {
+    return "point_step is " + std::to_string(m.point_step) + " bytes, limit " + std::to_string(Limits::kCloudPointStep);
+  }
+  if (m.data.size() > Limits::kCloudBytes) return Over("data", m.data.size(), Limits::kCloudBytes, "bytes");
+  if (m.fields.size() > Limits::kCloudFields) return Over("fields", m.fields.size(), Limits::kCloudFields);
+  for (std::size_t i = 0; i < m.fields.size(); ++i) {
+    auto field = [i] { return "fields[" + std::to_string(i) + "].name"; };
+    if (auto e = CheckLength(m.fields[i].name, Limits::kName, field)) return e;
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const TaskCommand& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckLength(m.task_name, Limits::kName, "task_name")) return e;
+  if (m.goal_positions.size() > Limits::kRobotJoints) {
+    return Over("goal_positions", m.goal_positions.size(), Limits::kRobotJoints);
+  }
+  if (m.retreat_positions.size() > Limits::kRobotJoints) {
+    return Over("retreat_positions", m.retreat_positions.size(), Limits::kRobotJoints);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const TaskOutcome& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckLength(m.task_name, Limits::kName, "task_name")) return e;
+  return CheckLength(m.reason, Limits::kText, "reason");
+}
+
+std::optional<std::string> CheckSizes(const PlanStatus& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  return CheckLength(m.status, Limits::kText, "status");
+}
+
+std::optional<std::string> CheckSizes(const CollisionRisk& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.waypoint_bounds.size() > Limits::kTrajectoryPoints) {
+    return Over("waypoint_bounds", m.waypoint_bounds.size(), Limits::kTrajectoryPoints);
+  }
+  if (auto e = CheckLength(m.max_robot_link, Limits::kName, "max_robot_link")) return e;
+  if (auto e = CheckLength(m.max_human_segment, Limits::kName, "max_human_segment")) return e;
+  if (auto e = CheckLength(m.max_action, Limits::kName, "max_action")) return e;
+  return CheckLength(m.reason, Limits::kText, "reason");
+}
+
+std::optional<std::string> CheckSizes(const SafetyPermit& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckLength(m.source, Limits::kName, "source")) return e;
+  return CheckLength(m.reason, Limits::kText, "reason");
+}
+
+std::optional<std::string> CheckSizes(const DiagnosticArray& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.status.size() > Limits::kDiagnosticStatuses) {
+    return Over("status", m.status.size(), Limits::kDiagnosticStatuses);
+  }
+  for (std::size_t i = 0; i < m.status.size(); ++i) {
+    const auto& st = m.status[i];
+    auto path = [i] { return "status[" + std::to_string(i) + "]"; };
+    if (auto e = CheckLength(st.name, Limits::kName, [&] { return path() + ".name"; })) return e;
+    if (auto e = CheckLength(st.hardware_id, Limits::kName, [&] { return path() + ".hardware_id"; })) return e;
+    if (auto e = CheckLength(st.message, Limits::kText, [&] { return path() + ".message"; })) return e;
+    if (st.values.size() > Limits::kDiagnosticValues) {
+      return Over(path() + ".values", st.values.size(), Limits::kDiagnosticValues);
+    }
+    for (std::size_t k = 0; k < st.values.size(); ++k) {
+      auto value = [&] { return path() + ".values[" + std::to_string(k) + "]"; };
+      if (auto e = CheckLength(st.values[k].key, Limits::kName, [&] { return value() + ".key"; })) return e;
+      if (auto e = CheckLength(st.values[k].value, Limits::kText, [&] { return value() + ".value"; })) return e;
+    }
+  }
+  return std::nullopt;
+}
 
 std::optional<std::string> CheckSemantics(const Header& m) {
   if (m.stamp.nanosec >= 1000000000u) return "header.stamp.nanosec >= 1e9";
@@ -66,11 +252,27 @@ std::optional<std::string> CheckSemantics(const HumanSkeleton& m) {
     const auto& j = m.joints[i];
     auto path = [i] { return "joints[" + std::to_string(i) + "]"; };
     if (j.name.empty()) return path() + ": empty joint name";
-    for (std::size_t k = 0; k < i; ++k) {
-      if (m.joints[k].name == j.name) return path() + ": joint '" + j.name + "' appears twice";
-    }
     if (auto e = CheckUnit(j.confidence, [&] { return path() + ".confidence"; })) return e;
     if (auto e = CheckCovariance(j.covariance, [&] { return path() + ".covariance"; })) return e;
+  }
+  // Duplicates in O(n log n): joint indices sorted by (name, index), on the
+  // stack (CheckSizes bounds n; a caller that skipped it is refused here).
+  if (m.joints.size() > Limits::kSkeletonJoints) return Over("joints", m.joints.size(), Limits::kSkeletonJoints);
+  static_assert(Limits::kSkeletonJoints <= UINT16_MAX, "joint indices are 16-bit");
+  std::array<uint16_t, Limits::kSkeletonJoints> order;
+  const auto n = static_cast<uint16_t>(m.joints.size());
+  for (uint16_t i = 0; i < n; ++i) order[i] = i;
+  std::sort(order.begin(), order.begin() + n, [&m](uint16_t a, uint16_t b) {
+    const int c = m.joints[a].name.compare(m.joints[b].name);
+    return c < 0 || (c == 0 && a < b);
+  });
+  // Report the first joint, in message order, whose name came before.
+  std::size_t repeat = n;
+  for (uint16_t k = 1; k < n; ++k) {
+    if (m.joints[order[k]].name == m.joints[order[k - 1]].name) repeat = std::min<std::size_t>(repeat, order[k]);
+  }
+  if (repeat < n) {
+    return "joints[" + std::to_string(repeat) + "]: joint '" + m.joints[repeat].name + "' appears twice";
   }
   return std::nullopt;
 }
@@ -96,6 +298,12 @@ std::optional<std::string> CheckSemantics(const HumanPrediction& m) {
   if (m.observation_stamp.nanosec >= 1000000000u) return std::string("observation_stamp.nanosec >= 1e9");
   if (!(m.time_step > 0)) return "time_step " + Num(m.time_step) + " is not positive";
   const std::size_t expected = static_cast<std::size_t>(m.num_steps) * m.joint_names.size();
+  // Unsigned wrap-around is defined, so test the product after the fact;
+  // CheckSizes bounds both factors, but this holds without it too.
+  if (!m.joint_names.empty() && expected / m.joint_names.size() != m.num_steps) {
+    return "num_steps " + std::to_string(m.num_steps) + " x " + std::to_string(m.joint_names.size()) +
+           " joint_names overflows";
+  }
   double sum = 0;
   for (std::size_t a = 0; a < m.actions.size(); ++a) {
     const auto& act = m.actions[a];

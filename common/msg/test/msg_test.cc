@@ -170,6 +170,226 @@ TEST(MsgCheck, RejectsBeliefThatDoesNotSumToOne) {
   EXPECT_EQ(Check(b), std::string("probabilities sum to 1.1"));
 }
 
+// Size limits: each at the limit passes, one above is rejected naming the
+// field and the limit (Limits in check.h).
+
+// `n` skeleton joints with distinct names and valid numbers.
+HumanSkeleton SkeletonWithJoints(std::size_t n) {
+  HumanSkeleton s = MakeSkeleton();
+  s.joints.resize(n, s.joints[0]);
+  for (std::size_t i = 0; i < n; ++i) s.joints[i].name = "j" + std::to_string(i);
+  return s;
+}
+
+// A consistent prediction of the given shape.
+HumanPrediction PredictionOf(std::size_t actions, uint32_t steps, std::size_t joints) {
+  HumanPrediction p;
+  p.time_step = 1.0 / 15;
+  p.num_steps = steps;
+  for (std::size_t j = 0; j < joints; ++j) p.joint_names.push_back("j" + std::to_string(j));
+  for (std::size_t a = 0; a < actions; ++a) {
+    ActionPrediction act;
+    act.action = "a" + std::to_string(a);
+    act.probability = 1.0 / static_cast<double>(actions);
+    act.joints.resize(std::size_t{steps} * joints);
+    for (auto& g : act.joints) g.covariance = {1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4};
+    p.actions.push_back(std::move(act));
+  }
+  return p;
+}
+
+std::vector<std::string> Names(std::size_t n) {
+  std::vector<std::string> v;
+  for (std::size_t i = 0; i < n; ++i) v.push_back("joint" + std::to_string(i));
+  return v;
+}
+
+TEST(MsgLimits, SkeletonJoints) {
+  EXPECT_EQ(Check(SkeletonWithJoints(Limits::kSkeletonJoints)), std::nullopt);
+  EXPECT_EQ(Check(SkeletonWithJoints(Limits::kSkeletonJoints + 1)), std::string("joints has 129 entries, limit 128"));
+}
+
+TEST(MsgLimits, TwentyThousandJointSkeletonIsRejectedBySize) {
+  // The size is refused before any per-joint work (formerly an O(n^2)
+  // duplicate search); even a NaN in the last joint is not looked at.
+  HumanSkeleton s = SkeletonWithJoints(20000);
+  s.joints.back().position.x = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(Check(s), std::string("joints has 20000 entries, limit 128"));
+  // CheckSemantics on its own refuses it too, before its duplicate search.
+  EXPECT_EQ(CheckSemantics(SkeletonWithJoints(20000)), std::string("joints has 20000 entries, limit 128"));
+}
+
+TEST(MsgLimits, DuplicateJointNamesAmongManyAreFound) {
+  HumanSkeleton s = SkeletonWithJoints(Limits::kSkeletonJoints);
+  s.joints[100].name = "j7";
+  s.joints[50].name = "j90";
+  // The first joint, in message order, whose name came earlier.
+  EXPECT_EQ(Check(s), std::string("joints[90]: joint 'j90' appears twice"));
+}
+
+TEST(MsgLimits, StringLengths) {
+  HumanSkeleton s = MakeSkeleton();
+  s.header.frame_id = std::string(Limits::kName, 'w');
+  s.joints[1].name = std::string(Limits::kName, 'n');
+  EXPECT_EQ(Check(s), std::nullopt);
+  s.header.frame_id += "w";
+  EXPECT_EQ(Check(s), std::string("header.frame_id has 257 characters, limit 256"));
+  s.header.frame_id.pop_back();
+  s.joints[1].name += "n";
+  EXPECT_EQ(Check(s), std::string("joints[1].name has 257 characters, limit 256"));
+
+  TaskCommand c;
+  c.command = TaskCommand::CANCEL;
+  c.task_name = std::string(Limits::kName, 't');
+  EXPECT_EQ(Check(c), std::nullopt);
+  c.task_name += "t";
+  EXPECT_EQ(Check(c), std::string("task_name has 257 characters, limit 256"));
+
+  TaskOutcome o;
+  o.reason = std::string(Limits::kText, 'r');
+  EXPECT_EQ(Check(o), std::nullopt);
+  o.reason += "r";
+  EXPECT_EQ(Check(o), std::string("reason has 4097 characters, limit 4096"));
+
+  SafetyPermit sc;
+  sc.validity = 0.2;
+  sc.source = std::string(Limits::kName, 's');
+  EXPECT_EQ(Check(sc), std::nullopt);
+  sc.source += "s";
+  EXPECT_EQ(Check(sc), std::string("source has 257 characters, limit 256"));
+
+  CollisionRisk r;
+  r.max_robot_link = std::string(Limits::kName + 1, 'l');
+  EXPECT_EQ(Check(r), std::string("max_robot_link has 257 characters, limit 256"));
+
+  // A type without size rules of its own (a new message) still has its header checked.
+  struct NewMessage {
+    Header header;
+  } n;
+  n.header.frame_id = std::string(Limits::kName + 1, 'w');
+  EXPECT_EQ(CheckSizes(n), std::string("header.frame_id has 257 characters, limit 256"));
+}
+
+TEST(MsgLimits, JointStateNamesAndValues) {
+  JointState js;
+  js.name = Names(Limits::kRobotJoints);
+  js.position.assign(Limits::kRobotJoints, 0.0);
+  js.velocity.assign(Limits::kRobotJoints, 0.0);
+  EXPECT_EQ(Check(js), std::nullopt);
+  js.name = Names(Limits::kRobotJoints + 1);
+  EXPECT_EQ(Check(js), std::string("name has 65 entries, limit 64"));
+  js.name = Names(Limits::kRobotJoints);
+  js.velocity.assign(Limits::kRobotJoints + 1, 0.0);
+  EXPECT_EQ(Check(js), std::string("velocity has 65 entries, limit 64"));
+  js.velocity.clear();
+  js.name[3] = std::string(Limits::kName + 1, 'x');
+  EXPECT_EQ(Check(js), std::string("name[3] has 257 characters, limit 256"));
+}
+
+TEST(MsgLimits, TrajectoryJointsAndPoints) {
+  JointTrajectory t;
+  t.joint_names = Names(Limits::kRobotJoints);
+  t.points.resize(Limits::kTrajectoryPoints);
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    t.points[i].positions.assign(Limits::kRobotJoints, 0.0);
+    t.points[i].time_from_start.nanosec = static_cast<uint32_t>(i * 1000);
+  }
+  EXPECT_EQ(Check(t), std::nullopt);
+  t.points[5].effort.assign(Limits::kRobotJoints + 1, 0.0);
+  EXPECT_EQ(Check(t), std::string("points[5].effort has 65 entries, limit 64"));
+  t.points[5].effort.clear();
+  t.points.push_back(t.points.back());
+  EXPECT_EQ(Check(t), std::string("points has 2001 entries, limit 2000"));
+  t.points.pop_back();
+  t.joint_names = Names(Limits::kRobotJoints + 1);
+  EXPECT_EQ(Check(t), std::string("joint_names has 65 entries, limit 64"));
+}
+
+TEST(MsgLimits, TaskCommandPositions) {
+  TaskCommand c;
+  c.goal_positions.assign(Limits::kRobotJoints, 0.0);
+  c.retreat_positions.assign(Limits::kRobotJoints, 0.0);
+  EXPECT_EQ(Check(c), std::nullopt);
+  c.retreat_positions.push_back(0.0);
+  EXPECT_EQ(Check(c), std::string("retreat_positions has 65 entries, limit 64"));
+}
+
+TEST(MsgLimits, BeliefActions) {
+  ActionBelief b;
+  b.actions = Names(Limits::kActions);
+  b.probabilities.assign(Limits::kActions, 1.0 / Limits::kActions);
+  EXPECT_EQ(Check(b), std::nullopt);
+  b.actions = Names(Limits::kActions + 1);
+  EXPECT_EQ(Check(b), std::string("actions has 33 entries, limit 32"));
+  b.actions = Names(Limits::kActions);
+  b.probabilities.assign(Limits::kActions + 1, 0.0);
+  EXPECT_EQ(Check(b), std::string("probabilities has 33 entries, limit 32"));
+}
+
+TEST(MsgLimits, PredictionShape) {
+  EXPECT_EQ(Check(PredictionOf(1, Limits::kPredictionSteps, 1)), std::nullopt);
+  EXPECT_EQ(Check(PredictionOf(1, Limits::kPredictionSteps + 1, 1)), std::string("num_steps is 201, limit 200"));
+  EXPECT_EQ(Check(PredictionOf(1, 1, Limits::kPredictionJoints)), std::nullopt);
+  EXPECT_EQ(Check(PredictionOf(1, 1, Limits::kPredictionJoints + 1)), std::string("joint_names has 129 entries, limit 128"));
+  EXPECT_EQ(Check(PredictionOf(Limits::kActions, 1, 1)), std::nullopt);
+  EXPECT_EQ(Check(PredictionOf(Limits::kActions + 1, 1, 1)), std::string("actions has 33 entries, limit 32"));
+  // Each factor within its limit, the product not: 8 x 64 x 128 = 65536 fits, 8 x 65 x 128 does not.
+  EXPECT_EQ(Check(PredictionOf(8, 64, 128)), std::nullopt);
+  EXPECT_EQ(Check(PredictionOf(8, 65, 128)),
+            std::string("actions x num_steps x joint_names = 66560 Gaussians, limit 65536"));
+  // A wire value of num_steps near 2^32 is refused before any product is formed.
+  HumanPrediction p = PredictionOf(1, 1, 2);
+  p.num_steps = std::numeric_limits<uint32_t>::max();
+  EXPECT_EQ(Check(p), std::string("num_steps is 4294967295, limit 200"));
+  // Sent Gaussians beyond the limit are refused before they are walked,
+  // whatever is declared.
+  p = PredictionOf(1, 1, 1);
+  p.actions[0].joints.resize(Limits::kPredictionGaussians + 1);
+  EXPECT_EQ(Check(p), std::string("actions[].joints has 65537 entries, limit 65536"));
+}
+
+TEST(MsgLimits, PointCloud) {
+  PointCloud2 c;
+  c.width = 640 * 4;
+  c.height = 480;
+  c.point_step = 16;
+  c.row_step = c.point_step * c.width;
+  EXPECT_EQ(CheckSizes(c), std::nullopt);  // 19 MB of data not needed for the size rules
+  c.height = 481;
+  EXPECT_EQ(Check(c), std::string("width x height = 1231360 points, limit 1228800"));
+  c.height = 1;
+  c.width = 1;
+  c.point_step = Limits::kCloudPointStep;
+  c.row_step = c.point_step;
+  c.data.resize(c.row_step);
+  EXPECT_EQ(Check(c), std::nullopt);
+  c.point_step = Limits::kCloudPointStep + 1;
+  EXPECT_EQ(Check(c), std::string("point_step is 257 bytes, limit 256"));
+  c.point_step = 16;
+  c.width = 1;
+  c.data.resize(Limits::kCloudBytes);
+  c.row_step = static_cast<uint32_t>(Limits::kCloudBytes);
+  EXPECT_EQ(Check(c), std::nullopt);
+  c.data.push_back(0);
+  EXPECT_EQ(Check(c), std::string("data has 67108865 bytes, limit 67108864"));
+}
+
+TEST(MsgLimits, Diagnostics) {
+  DiagnosticArray a;
+  a.status.resize(Limits::kDiagnosticStatuses);
+  a.status[2].values.resize(Limits::kDiagnosticValues);
+  a.status[2].values[7].value = std::string(Limits::kText, 'v');
+  EXPECT_EQ(Check(a), std::nullopt);
+  a.status[2].values[7].value += "v";
+  EXPECT_EQ(Check(a), std::string("status[2].values[7].value has 4097 characters, limit 4096"));
+  a.status[2].values[7].value.clear();
+  a.status[2].values.emplace_back();
+  EXPECT_EQ(Check(a), std::string("status[2].values has 257 entries, limit 256"));
+  a.status[2].values.pop_back();
+  a.status.emplace_back();
+  EXPECT_EQ(Check(a), std::string("status has 65 entries, limit 64"));
+}
+
 TEST(MsgTime, NanosecondRoundTrip) {
   const Time t = TimeFromSeconds(1700000000.123456789);
   EXPECT_EQ(t.sec, 1700000000);

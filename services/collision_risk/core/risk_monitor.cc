@@ -44,6 +44,7 @@ std::string RiskParams::Validate() const {
   if (!(slow_down_fraction > 0 && slow_down_fraction <= 1)) return "slow_down_fraction must be in (0, 1]";
   if (!(slow_down_margin >= 0)) return "slow_down_margin must be >= 0";
   if (!(stale_after > 0)) return "stale_after must be > 0";
+  if (!(joint_limit_tolerance >= 0)) return "joint_limit_tolerance must be >= 0";
   const SsmParams& s = ssm;
   for (double v : {s.default_human_speed, s.speed_window, s.reaction_time, s.stopping_time, s.stopping_distance,
                    s.intrusion_distance, s.sensing_uncertainty, s.robot_uncertainty}) {
@@ -72,6 +73,10 @@ std::optional<std::string> RiskMonitor::UpdateRobotState(int64_t stamp_ns, const
   if (auto e = MapNames(names, RobotJointNames(robot_), &idx)) return "joint state: " + *e;
   Eigen::VectorXd q(robot_.nq);
   for (int i = 0; i < robot_.nq; ++i) q[i] = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
+  // A state the arm cannot be in is a wrong or corrupted measurement: the
+  // robot's spheres placed from it would be nowhere near the real arm. Refused
+  // (and counted), it ages into "robot state is stale", a protective stop.
+  if (auto e = collision::CheckJointPositions(robot_, q, params_.joint_limit_tolerance)) return "joint state: " + *e;
   previous_state_ = state_;
   state_ = std::make_pair(stamp_ns, q);
   return std::nullopt;

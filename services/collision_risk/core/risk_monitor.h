@@ -73,6 +73,9 @@ struct RiskParams {
   /// be anywhere. false: "no person seen" is clear (a cell whose perception
   /// publishes nothing when nobody is there).
   bool person_required = true;
+  /// rad (m for prismatic joints); a robot state further outside the joint
+  /// limits is refused as corrupt (encoder noise and a stop's overshoot stay within)
+  double joint_limit_tolerance = 0.05;
   SsmParams ssm;
   /// Empty when valid, else the reason.
   std::string Validate() const;
@@ -112,7 +115,8 @@ class RiskMonitor {
   RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params);
 
   /// Each Update returns nullopt when accepted, else why it was rejected
-  /// (unknown joint names, wrong sizes); rejected input leaves state alone.
+  /// (unknown joint names, wrong sizes, a robot state outside the joint
+  /// limits); rejected input leaves state alone.
   std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                               const std::vector<double>& positions);
   /// `times` in s from `start_ns`, increasing; positions one vector per point.

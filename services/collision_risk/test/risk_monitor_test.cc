@@ -242,6 +242,21 @@ TEST_F(RiskMonitorTest, ExecutingTrajectoryIsWhatIsChecked) {
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
 }
 
+TEST_F(RiskMonitorTest, RejectsRobotStatesOutsideTheJointLimits) {
+  const std::vector<double> ready = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+  std::vector<double> q = ready;
+  q[3] = 100.0;  // panda_joint4
+  const auto why = monitor_.UpdateRobotState(kSec, kRobotJoints, q);
+  ASSERT_TRUE(why.has_value());
+  EXPECT_EQ(why->rfind("joint state: joint 'panda_joint4' at 100 rad is outside its limits", 0), 0u) << *why;
+  // The refused state is not used: with no state the verdict stays a stop.
+  EXPECT_EQ(monitor_.Evaluate(kSec).reason, "no robot state yet");
+  // Beyond the limit by less than the tolerance (panda_joint4 upper -0.0698 rad) is accepted.
+  q[3] = -0.0698 + 0.9 * RiskParams{}.joint_limit_tolerance;
+  EXPECT_EQ(monitor_.UpdateRobotState(kSec, kRobotJoints, q), std::nullopt);
+  EXPECT_EQ(monitor_.UpdateRobotState(kSec, kRobotJoints, ready), std::nullopt);
+}
+
 TEST_F(RiskMonitorTest, RejectsInputsItCannotMap) {
   EXPECT_EQ(*monitor_.UpdateRobotState(0, {"j1"}, {0.0}), "joint state: missing joint 'panda_joint1'");
   EXPECT_EQ(*monitor_.UpdateSkeleton(0, {"head"}, {Eigen::Vector3d::Zero()}), "skeleton: missing joint 'neck'");

@@ -16,6 +16,8 @@ std::string ReplannerParams::Validate() const {
   if (!(settle_speed > 0)) return "settle_speed must be > 0";
   if (!(stale_after > 0)) return "stale_after must be > 0";
   if (!(max_tracking_error > 0)) return "max_tracking_error must be > 0";
+  if (!(joint_limit_tolerance >= 0)) return "joint_limit_tolerance must be >= 0";
+  if (!(joint_velocity_factor >= 1)) return "joint_velocity_factor must be >= 1";
   return "";
 }
 
@@ -43,6 +45,12 @@ std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const s
     qq[static_cast<Eigen::Index>(m)] = q[i];
     if (qd.size() == q.size()) vv[static_cast<Eigen::Index>(m)] = qd[i];
   }
+  // A state the arm cannot be in is a wrong or corrupted measurement;
+  // planning from it would start every plan from a jump. Refused (and
+  // counted), the last good state ages out and no plan is published.
+  const collision::RobotModel& robot = planner_.robot();
+  if (auto e = collision::CheckJointPositions(robot, qq, params_.joint_limit_tolerance)) return "joint state: " + *e;
+  if (auto e = collision::CheckJointVelocities(robot, vv, params_.joint_velocity_factor)) return "joint state: " + *e;
   q_ = std::make_pair(stamp_ns, qq);
   qd_ = vv;
   return std::nullopt;

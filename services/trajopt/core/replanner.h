@@ -35,6 +35,12 @@ struct ReplannerParams {
   /// says it should be (e.g. after a protective stop), replan from the
   /// measured state instead of continuing the plan.
   double max_tracking_error = 0.05;
+  /// rad; a robot state further outside the joint position limits is refused
+  /// as corrupt (encoder noise and a stop's overshoot stay within).
+  double joint_limit_tolerance = 0.05;
+  /// A robot state whose joint speed exceeds this many times the joint's
+  /// velocity limit is refused; above 1 for noisy measured velocities.
+  double joint_velocity_factor = 1.2;
   std::string Validate() const;
 };
 
@@ -98,7 +104,8 @@ class Replanner {
   void SetRobotStopped(bool stopped) { robot_stopped_ = stopped; }
   std::optional<uint32_t> current_task_id() const { return task_ ? std::optional<uint32_t>(task_->spec.id) : std::nullopt; }
 
-  /// Newest robot state (model joint order). Returns why it was refused.
+  /// Newest robot state. Returns why it was refused (a joint missing, a
+  /// position or velocity outside the limits by more than the tolerance).
   std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                               const std::vector<double>& q, const std::vector<double>& qd);
   /// Newest prediction. Returns why it was refused.

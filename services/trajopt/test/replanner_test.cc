@@ -251,6 +251,33 @@ TEST_F(ReplannerTest, RobotOffThePlanIsReplannedFromItsState) {
   EXPECT_EQ(c.start_ns, t);
 }
 
+TEST_F(ReplannerTest, RobotStatesOutsideTheJointLimitsAreRefused) {
+  const std::vector<std::string> names = replanner_.joint_names();
+  auto update = [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+    return replanner_.UpdateRobotState(kSec, names, std::vector<double>(q.data(), q.data() + q.size()),
+                                       std::vector<double>(qd.data(), qd.data() + qd.size()));
+  };
+  const Eigen::VectorXd zero = Eigen::VectorXd::Zero(7);
+  Eigen::VectorXd q = Ready();
+  q[1] = 100.0;  // panda_joint2
+  const auto why = update(q, zero);
+  ASSERT_TRUE(why.has_value());
+  EXPECT_EQ(why->rfind("joint state: joint 'panda_joint2' at 100 rad is outside its limits", 0), 0u) << *why;
+  // Refused states are not planned from.
+  EXPECT_EQ(replanner_.Cycle(kSec).status, "waiting for a current robot state");
+  // Beyond the limit by less than the tolerance (panda_joint2 upper 1.7628 rad) is accepted.
+  q[1] = 1.7628 + 0.9 * ReplannerParams{}.joint_limit_tolerance;
+  EXPECT_EQ(update(q, zero), std::nullopt);
+  // Velocities: panda_joint1's limit is 2.175 rad/s.
+  Eigen::VectorXd qd = zero;
+  qd[0] = 10.0;
+  const auto fast = update(Ready(), qd);
+  ASSERT_TRUE(fast.has_value());
+  EXPECT_EQ(fast->rfind("joint state: joint 'panda_joint1' at 10 rad/s is beyond", 0), 0u) << *fast;
+  qd[0] = 2.175;
+  EXPECT_EQ(update(Ready(), qd), std::nullopt);
+}
+
 TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
   int64_t t = 100 * kSec;
   SetState(t, Ready(), Eigen::VectorXd::Zero(7));

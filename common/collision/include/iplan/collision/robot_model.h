@@ -9,6 +9,7 @@
 #pragma once
 
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -104,6 +105,27 @@ struct RobotData {
 /// (caller contract). Thread-safe for distinct data; does not allocate.
 void CalcForwardKinematics(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
                            RobotData* data);
+
+/// Why the configuration `q` (model order, size model.nq; rad / m) is outside
+/// the position limits by more than `tolerance` (rad / m, >= 0), e.g. "joint
+/// 'panda_joint4' at 100 rad is outside its limits [-3.0718, -0.0698] rad by
+/// more than 0.05"; nullopt when every joint is within. For measured states:
+/// the tolerance absorbs encoder noise and a stop's overshoot, a value beyond
+/// it means a wrong or corrupted state. Non-finite values and a size other
+/// than nq are reported too. Continuous joints are unbounded. Allocates only
+/// for the returned text.
+std::optional<std::string> CheckJointPositions(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& q,
+                                               double tolerance);
+
+/// Why the joint velocities `qd` (model order, size model.nq; rad/s / m/s)
+/// exceed `tolerance_factor` (>= 1) times the velocity limit in magnitude,
+/// e.g. "joint 'panda_joint1' at 5 rad/s is beyond 1.2 x its limit 2.175
+/// rad/s"; nullopt when every joint is within. A joint whose model states
+/// no velocity limit (not positive or infinite) is not checked. Non-finite
+/// values and a size other than nq are reported. Allocates only for the
+/// returned text.
+std::optional<std::string> CheckJointVelocities(const RobotModel& model, const Eigen::Ref<const Eigen::VectorXd>& qd,
+                                                double tolerance_factor);
 
 /// Options of the loaders.
 struct RobotModelOptions {
