@@ -258,8 +258,15 @@ void TaskPlanner::Save(const std::string& path) const {
   Put(&file, Fnv(body.data(), body.size()));
   file += body;
   // Keep the previous good table: if the new one is ever damaged, the
-  // loader falls back to it.
-  if (std::ifstream(path).good()) core::WriteFileAtomically(path + ".bak", core::ReadFile(path));
+  // loader falls back to it. Only a file that passes Load's checks becomes
+  // the backup: after Load refused a corrupt main file and used the backup,
+  // rotating blindly would copy the corrupt bytes over the one good copy.
+  if (std::ifstream(path).good()) {
+    const std::string previous = core::ReadFile(path);
+    std::map<State, std::vector<double>> unused_q;
+    uint64_t unused_episodes = 0;
+    if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
+  }
   core::WriteFileAtomically(path, file);
 }
 
@@ -270,6 +277,17 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   } catch (const std::exception& e) {
     return std::string(e.what());
   }
+  std::map<State, std::vector<double>> q;
+  uint64_t episodes = 0;
+  if (auto error = Parse(data, path, &q, &episodes)) return error;
+  q_ = std::move(q);
+  episodes_learned_ = episodes;
+  return std::nullopt;
+}
+
+std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path,
+                                              std::map<State, std::vector<double>>* q_out,
+                                              uint64_t* episodes_out) const {
   if (data.size() < sizeof(kMagic) + 8) return path + " is not an iplan Q-table";
   const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
   if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
@@ -294,8 +312,8 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
     q[s] = std::move(row);
   }
   if (pos != data.size()) return path + " has trailing bytes";
-  q_ = std::move(q);
-  episodes_learned_ = episodes;
+  *q_out = std::move(q);
+  *episodes_out = episodes;
   return std::nullopt;
 }
 

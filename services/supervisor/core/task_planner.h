@@ -5,8 +5,10 @@
 // person is predicted to do and penalises the delay a task caused:
 //   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
-// with a message and the previous good copy is used. No DDS types. Not
-// thread-safe.
+// with a message and the previous good copy is used. The backup is only
+// ever replaced by a file that passes the loader's checks, so it stays good
+// however often a damaged main file is refused and saved over. No DDS
+// types. Not thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -88,8 +90,10 @@ class TaskPlanner {
 
   double Q(State s, int task) const;
 
-  /// Writes the Q-table atomically to `path`, keeping the previous file as
-  /// `path.bak`. Throws std::runtime_error on I/O errors.
+  /// Writes the Q-table atomically to `path`. The previous `path` becomes
+  /// `path.bak` only if it passes Load's checks (magic, checksum, this task
+  /// graph, finite values); otherwise the backup is left as it is. Throws
+  /// std::runtime_error on I/O errors.
   void Save(const std::string& path) const;
   /// Loads `path`; if it is missing returns false (fresh table); if it is
   /// corrupt or belongs to another task graph, tries `path.bak`. Throws
@@ -100,6 +104,11 @@ class TaskPlanner {
  private:
   std::vector<double>& Row(State s);
   std::optional<std::string> TryLoad(const std::string& path);
+  /// Checks the bytes of a table file named `path` (for messages); empty
+  /// and fills the outputs when it is a good table of this graph, else the
+  /// reason. Does not touch the planner.
+  std::optional<std::string> Parse(const std::string& data, const std::string& path,
+                                   std::map<State, std::vector<double>>* q, uint64_t* episodes) const;
   uint64_t GraphHash() const;
 
   TaskGraph graph_;

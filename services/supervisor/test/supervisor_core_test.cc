@@ -251,6 +251,68 @@ TEST(TaskPlanner, CorruptTableIsRefusedAndThePreviousGoodOneKept) {
   std::filesystem::remove(path + ".bak");
 }
 
+// Flips one byte of the body, so the checksum no longer matches.
+void Damage(const std::string& path) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekg(30);
+  const char c = static_cast<char>(f.get());
+  f.seekp(30);
+  f.put(static_cast<char>(c ^ 0x5a));
+}
+
+// Q(0, 1) of the table in `path` alone (no fallback), or NaN when that file
+// does not load.
+double LoadedQ01(const std::string& path) {
+  const std::string copy = path + ".alone";
+  std::filesystem::copy_file(path, copy, std::filesystem::copy_options::overwrite_existing);
+  TaskPlanner p(Graph(), QLearningParams{});
+  std::string note;
+  double q = std::nan("");
+  try {
+    if (p.Load(copy, &note) && note.rfind("loaded " + copy, 0) == 0) q = p.Q(0, 1);
+  } catch (const std::runtime_error&) {
+  }
+  std::filesystem::remove(copy);
+  return q;
+}
+
+TEST(TaskPlanner, ARefusedTableNeverReplacesTheGoodBackup) {
+  const std::string path = TempPath("rotation.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  const double q_a = p.Q(0, 1);
+  p.Save(path);  // A
+  p.ResetEpisode();
+  p.Complete(1, true, 0.0, {});
+  p.Save(path);  // B; A is now path.bak
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  Damage(path);
+
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("refused it and loaded the previous good table"), std::string::npos) << note;
+  EXPECT_EQ(q.Q(0, 1), q_a);
+  q.ResetEpisode();
+  q.Complete(1, true, 2.0, {});
+  const double q_c = q.Q(0, 1);
+  q.Save(path);  // C over the damaged B: B must not become the backup
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  EXPECT_EQ(LoadedQ01(path), q_c);
+
+  Damage(path);
+  TaskPlanner r(Graph(), QLearningParams{});
+  ASSERT_TRUE(r.Load(path, &note)) << note;
+  EXPECT_TRUE(r.Q(0, 1) == q_a || r.Q(0, 1) == q_c) << r.Q(0, 1);
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  // A good main file is rotated as before.
+  r.Save(path);  // main damaged: backup still A
+  r.Save(path);  // main good: it becomes the backup
+  EXPECT_EQ(LoadedQ01(path + ".bak"), r.Q(0, 1));
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
 TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {
   SafetyMonitor m({"rt/a", "rt/b"});
   bool changed = false;
