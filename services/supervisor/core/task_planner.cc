@@ -4,6 +4,7 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
@@ -213,10 +214,16 @@ int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
 }
 
 double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief) {
-  const double reward = Harmony(task, belief) - params_.delay_weight * delay;
   const State s = state_;
   const State next = succeeded ? (s | (1ULL << task)) : s;
-  if (params_.learning) {
+  // A delay that is not a number says nothing about the task: learn
+  // nothing from it, but the task did end, so the state still moves on.
+  const bool refused = !std::isfinite(delay);
+  const double reward =
+      refused ? std::numeric_limits<double>::quiet_NaN()
+              : Harmony(task, belief) - params_.delay_weight * std::clamp(delay, 0.0, kMaxDelay);
+  if (refused) ++refused_outcomes_;
+  if (params_.learning && !refused) {
     double best_next = 0;
     bool any = false;
     for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
@@ -228,7 +235,15 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
       }
     }
     double& q = Row(s)[static_cast<std::size_t>(task)];
-    q += params_.alpha * (reward + params_.gamma * best_next - q);
+    // Bounded rewards keep Q bounded by |r| / (1 - gamma); only an absurd
+    // delay_weight could still overflow it, and an inf in the table would
+    // make every later save unloadable: keep the old value then.
+    const double updated = q + params_.alpha * (reward + params_.gamma * best_next - q);
+    if (std::isfinite(updated)) {
+      q = updated;
+    } else {
+      ++refused_outcomes_;
+    }
   }
   state_ = next;
   if (params_.learning && succeeded && episode_done()) ++episodes_learned_;
@@ -306,8 +321,17 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
     State s = 0;
     std::vector<double> row(ntasks);
     if (!Get(data, &pos, &s)) return path + " is truncated";
-    for (auto& v : row) {
-      if (!Get(data, &pos, &v) || !std::isfinite(v)) return path + " has an invalid value";
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      if (!Get(data, &pos, &row[i])) return path + " is truncated";
+      // The checksum is right, so the planner that saved it overflowed
+      // (e.g. an older one fed an absurd delay): learning from it would
+      // spread the inf or NaN to every state.
+      if (!std::isfinite(row[i])) {
+        std::ostringstream why;
+        why << path << " has a non-finite Q-value (" << row[i] << " in state 0x" << std::hex << s << std::dec
+            << " for task '" << graph_.tasks[i].name << "')";
+        return why.str();
+      }
     }
     q[s] = std::move(row);
   }

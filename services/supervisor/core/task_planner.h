@@ -81,10 +81,18 @@ class TaskPlanner {
   /// deployment; ties broken by the harmony with the current belief, then by
   /// index. -1 when the episode is done.
   int Choose(const std::map<std::string, double>& belief);
-  /// Q-learning update after `task` ended with `delay` (s); advances the
-  /// state when `succeeded` (counting the episode when that finishes it, in
-  /// learning mode). Returns the reward.
+  /// The largest delay (s) one task is charged: a finite but absurd delay
+  /// from the network (1.7e308) would otherwise overflow the Q-values.
+  static constexpr double kMaxDelay = 3600.0;
+  /// Q-learning update after `task` ended with `delay` (s), clamped to
+  /// [0, kMaxDelay]; advances the state when `succeeded` (counting the
+  /// episode when that finishes it, in learning mode). Returns the reward.
+  /// A non-finite delay (NaN, inf) is refused: no update, NaN returned,
+  /// counted in refused_outcomes(); the state still advances. So is an
+  /// update that would make the Q-value non-finite (absurd delay_weight).
   double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief);
+  /// Outcomes Complete() did not learn from (see there), since construction.
+  uint64_t refused_outcomes() const { return refused_outcomes_; }
   /// Starts a new episode (state 0).
   void ResetEpisode() { state_ = 0; }
 
@@ -96,7 +104,8 @@ class TaskPlanner {
   /// std::runtime_error on I/O errors.
   void Save(const std::string& path) const;
   /// Loads `path`; if it is missing returns false (fresh table); if it is
-  /// corrupt or belongs to another task graph, tries `path.bak`. Throws
+  /// corrupt, has non-finite values or belongs to another task graph, tries
+  /// `path.bak`. Throws
   /// std::runtime_error when neither is usable, with both reasons. `*note`
   /// says what happened (e.g. "qtable.bin is corrupt (...); using the backup").
   bool Load(const std::string& path, std::string* note);
@@ -116,6 +125,7 @@ class TaskPlanner {
   std::map<State, std::vector<double>> q_;
   State state_ = 0;
   uint64_t episodes_learned_ = 0;
+  uint64_t refused_outcomes_ = 0;
   std::vector<uint64_t> prerequisites_;  // bitmask per task
   std::mt19937_64 rng_;
 };

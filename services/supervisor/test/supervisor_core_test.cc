@@ -3,6 +3,7 @@
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -12,6 +13,7 @@
 
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
+#include "iplan/core/atomic_file.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -309,6 +311,74 @@ TEST(TaskPlanner, ARefusedTableNeverReplacesTheGoodBackup) {
   r.Save(path);  // main damaged: backup still A
   r.Save(path);  // main good: it becomes the backup
   EXPECT_EQ(LoadedQ01(path + ".bak"), r.Q(0, 1));
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, AnAbsurdDelayIsClampedAndANonFiniteOneRefused) {
+  QLearningParams params;
+  params.delay_weight = 2.0;  // 2 * 1.7e308 overflowed to -inf before the clamp
+  TaskPlanner p(Graph(), params);
+  const double reward = p.Complete(1, true, 1.7e308, {});
+  EXPECT_DOUBLE_EQ(reward, 1.0 - 2.0 * TaskPlanner::kMaxDelay);
+  EXPECT_DOUBLE_EQ(p.Q(0, 1), params.alpha * reward);
+  EXPECT_EQ(p.Complete(0, true, -5.0, {}), p.Harmony(0, {}));  // a negative delay is no bonus
+  EXPECT_EQ(p.refused_outcomes(), 0u);
+
+  // Many absurd episodes with the default weight: Q stays finite and the
+  // table saves and reloads (an inf made the supervisor unable to start).
+  TaskPlanner d(Graph(), QLearningParams{});
+  for (int episode = 0; episode < 200; ++episode) {
+    d.ResetEpisode();
+    while (!d.episode_done()) d.Complete(d.Available().front(), true, 1.7e308, {});
+  }
+  for (int t = 0; t < 3; ++t) EXPECT_TRUE(std::isfinite(d.Q(0, t))) << t;
+  const std::string path = TempPath("absurd.bin");
+  d.Save(path);
+  TaskPlanner e(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(e.Load(path, &note)) << note;
+  EXPECT_EQ(note.rfind("loaded " + path, 0), 0u) << note;
+
+  // NaN and inf: nothing learned, but the task did end.
+  TaskPlanner n(Graph(), QLearningParams{});
+  EXPECT_TRUE(std::isnan(n.Complete(1, true, std::nan(""), {})));
+  EXPECT_TRUE(std::isnan(n.Complete(0, true, std::numeric_limits<double>::infinity(), {})));
+  EXPECT_EQ(n.Q(0, 1), 0.0);
+  EXPECT_EQ(n.Q(2, 0), 0.0);
+  EXPECT_EQ(n.state(), 3u);
+  EXPECT_EQ(n.refused_outcomes(), 2u);
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
+  // A table poisoned by an older planner: the checksum is right, a Q-value is
+  // -inf. Layout: magic (8), checksum (8), then the body: graph hash, task
+  // count, row count, episodes (8 each), rows of state (8) and 3 doubles.
+  const std::string path = TempPath("poisoned.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  p.Save(path);
+  p.Save(path);  // a good backup
+  std::string data = core::ReadFile(path);
+  ASSERT_EQ(data.size(), 48u + 8 + 3 * 8);
+  const double inf = -std::numeric_limits<double>::infinity();
+  std::memcpy(&data[48 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
+  uint64_t sum = 1469598103934665603ULL;
+  for (std::size_t i = 16; i < data.size(); ++i) {
+    sum ^= static_cast<unsigned char>(data[i]);
+    sum *= 1099511628211ULL;
+  }
+  std::memcpy(&data[8], &sum, 8);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << data;
+
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_EQ(note, path + " has a non-finite Q-value (-inf in state 0x0 for task 'pick_right'); refused it and "
+                         "loaded the previous good table " + path + ".bak");
+  EXPECT_EQ(q.Q(0, 1), p.Q(0, 1));
   std::filesystem::remove(path);
   std::filesystem::remove(path + ".bak");
 }
