@@ -259,7 +259,17 @@ uint64_t TaskPlanner::GraphHash() const {
   return h;
 }
 
-void TaskPlanner::Save(const std::string& path) const {
+void TaskPlanner::Save(const std::string& path) {
+  try {
+    Write(path);
+  } catch (const std::exception& e) {
+    ++save_failures_;
+    last_save_error_ = e.what();
+    throw;
+  }
+}
+
+void TaskPlanner::Write(const std::string& path) const {
   std::string body;
   Put(&body, GraphHash());
   Put(&body, static_cast<uint64_t>(graph_.tasks.size()));

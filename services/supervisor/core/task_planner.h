@@ -101,8 +101,15 @@ class TaskPlanner {
   /// Writes the Q-table atomically to `path`. The previous `path` becomes
   /// `path.bak` only if it passes Load's checks (magic, checksum, this task
   /// graph, finite values); otherwise the backup is left as it is. Throws
-  /// std::runtime_error on I/O errors.
-  void Save(const std::string& path) const;
+  /// std::runtime_error on I/O errors, after counting the failure in
+  /// save_failures() and keeping its message in last_save_error().
+  void Save(const std::string& path);
+  /// Save() calls that failed (threw), since construction.
+  uint64_t save_failures() const { return save_failures_; }
+  /// The message of the latest failed Save(); empty until one fails. A later
+  /// successful save does not clear it: save_failures() tells whether
+  /// failures go on.
+  const std::string& last_save_error() const { return last_save_error_; }
   /// Loads `path`; if it is missing returns false (fresh table); if it is
   /// corrupt, has non-finite values or belongs to another task graph, tries
   /// `path.bak`. Throws
@@ -112,6 +119,7 @@ class TaskPlanner {
 
  private:
   std::vector<double>& Row(State s);
+  void Write(const std::string& path) const;
   std::optional<std::string> TryLoad(const std::string& path);
   /// Checks the bytes of a table file named `path` (for messages); empty
   /// and fills the outputs when it is a good table of this graph, else the
@@ -126,6 +134,8 @@ class TaskPlanner {
   State state_ = 0;
   uint64_t episodes_learned_ = 0;
   uint64_t refused_outcomes_ = 0;
+  uint64_t save_failures_ = 0;
+  std::string last_save_error_;
   std::vector<uint64_t> prerequisites_;  // bitmask per task
   std::mt19937_64 rng_;
 };

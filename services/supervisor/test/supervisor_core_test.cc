@@ -383,6 +383,20 @@ TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
   std::filesystem::remove(path + ".bak");
 }
 
+TEST(TaskPlanner, SaveFailuresAreCountedWithTheirReason) {
+  TaskPlanner p(Graph(), QLearningParams{});
+  EXPECT_EQ(p.save_failures(), 0u);
+  EXPECT_EQ(p.last_save_error(), "");
+  EXPECT_THROW(p.Save("/nonexistent-dir/q.bin"), std::runtime_error);
+  EXPECT_THROW(p.Save("/nonexistent-dir/q.bin"), std::runtime_error);
+  EXPECT_EQ(p.save_failures(), 2u);
+  EXPECT_NE(p.last_save_error().find("/nonexistent-dir/q.bin"), std::string::npos) << p.last_save_error();
+  const std::string path = TempPath("saved.bin");
+  p.Save(path);
+  EXPECT_EQ(p.save_failures(), 2u);  // a success does not hide that saves failed
+  std::filesystem::remove(path);
+}
+
 TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {
   SafetyMonitor m({"rt/a", "rt/b"});
   bool changed = false;
