@@ -352,6 +352,16 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
 }
 
 bool TaskPlanner::Load(const std::string& path, std::string* note) {
+  // Temporaries of saves killed before their rename (kill -9, power loss)
+  // are never read; without this they pile up beside the table.
+  const std::size_t stale =
+      core::RemoveStaleTempFiles(path).size() + core::RemoveStaleTempFiles(path + ".bak").size();
+  const bool loaded = LoadTable(path, note);
+  if (note && stale > 0) *note += "; removed " + std::to_string(stale) + " stale temporary file(s)";
+  return loaded;
+}
+
+bool TaskPlanner::LoadTable(const std::string& path, std::string* note) {
   const bool main_exists = std::ifstream(path).good(), backup_exists = std::ifstream(path + ".bak").good();
   if (!main_exists && !backup_exists) {
     if (note) *note = path + " does not exist: starting with an empty Q-table";

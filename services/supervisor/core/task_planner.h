@@ -112,14 +112,17 @@ class TaskPlanner {
   const std::string& last_save_error() const { return last_save_error_; }
   /// Loads `path`; if it is missing returns false (fresh table); if it is
   /// corrupt, has non-finite values or belongs to another task graph, tries
-  /// `path.bak`. Throws
-  /// std::runtime_error when neither is usable, with both reasons. `*note`
-  /// says what happened (e.g. "qtable.bin is corrupt (...); using the backup").
+  /// `path.bak`. Throws std::runtime_error when neither is usable, with both
+  /// reasons. `*note` says what happened (e.g. "qtable.bin is corrupt
+  /// (...); refused it and loaded the previous good table qtable.bin.bak").
+  /// First removes the temporaries of `path` and `path.bak` left by saves
+  /// killed mid-write (core::RemoveStaleTempFiles), noted in `*note`.
   bool Load(const std::string& path, std::string* note);
 
  private:
   std::vector<double>& Row(State s);
   void Write(const std::string& path) const;
+  bool LoadTable(const std::string& path, std::string* note);
   std::optional<std::string> TryLoad(const std::string& path);
   /// Checks the bytes of a table file named `path` (for messages); empty
   /// and fills the outputs when it is a good table of this graph, else the

@@ -1,5 +1,6 @@
 // The task planner (task graph, Q-learning, persistence) and the safety
 // monitor of the supervisor, without DDS.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
@@ -394,6 +395,25 @@ TEST(TaskPlanner, SaveFailuresAreCountedWithTheirReason) {
   const std::string path = TempPath("saved.bin");
   p.Save(path);
   EXPECT_EQ(p.save_failures(), 2u);  // a success does not hide that saves failed
+  std::filesystem::remove(path);
+}
+
+TEST(TaskPlanner, LoadRemovesTheTemporariesOfKilledSaves) {
+  const std::string path = TempPath("stale.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Save(path);
+  // A pid that is not running: a reaped child.
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = std::to_string(child);
+  for (const std::string& f : {path + ".tmp." + dead, path + ".bak.tmp." + dead}) std::ofstream(f) << "half";
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("; removed 2 stale temporary file(s)"), std::string::npos) << note;
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp." + dead));
+  EXPECT_FALSE(std::filesystem::exists(path + ".bak.tmp." + dead));
   std::filesystem::remove(path);
 }
 
