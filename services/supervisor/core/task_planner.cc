@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "iplan/core/atomic_file.h"
+#include "iplan/core/yaml.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -96,7 +97,7 @@ std::string TaskGraph::Validate() const {
 TaskGraph LoadTaskGraph(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = core::LoadYamlFile(path);  // a task written twice under one key is an error
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }

@@ -39,7 +39,8 @@ struct TaskGraph {
   std::string Validate() const;
 };
 
-/// Loads a task graph from YAML (strict). Throws std::runtime_error naming the file and key.
+/// Loads a task graph from YAML (strict: unknown keys and keys written twice
+/// in one mapping are errors). Throws std::runtime_error naming the file and key.
 TaskGraph LoadTaskGraph(const std::string& path);
 
 struct QLearningParams {

@@ -81,6 +81,22 @@ TEST(TaskGraph, LoadsRetreatsAndNamesTheFileOnErrors) {
   std::filesystem::remove(path);
 }
 
+TEST(TaskGraph, AKeyWrittenTwiceIsAnError) {
+  // yaml-cpp would keep the first goal and ignore the corrected one below it.
+  const std::string path = TempPath("twice.yaml");
+  std::ofstream(path) << "robot_tasks:\n"
+                         "  - name: hand_over\n"
+                         "    goal: [0.3, 0.4]\n"
+                         "    goal: [0.5, 0.4]\n";
+  try {
+    LoadTaskGraph(path);
+    ADD_FAILURE() << "a key written twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks[0].goal': appears twice (lines 3 and 4)");
+  }
+  std::filesystem::remove(path);
+}
+
 TEST(TaskPlanner, PrecedenceAndHarmony) {
   TaskPlanner p(Graph(), QLearningParams{});
   EXPECT_EQ(p.Available(), (std::vector<int>{0, 1}));
