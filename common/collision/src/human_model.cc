@@ -8,6 +8,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "iplan/core/yaml.h"
+
 #include "check.h"
 
 namespace iplan::collision {
@@ -79,7 +81,7 @@ HumanBodyParams LoadHumanBodyParams(const std::string& path) {
   };
   HumanBodyParams p;
   try {
-    const YAML::Node root = YAML::LoadFile(path);
+    const YAML::Node root = core::LoadYamlFile(path);  // a key twice is an error
     if (!root.IsMap()) fail("top level must be a map");
     for (const auto& kv : root) {
       const std::string key = kv.first.as<std::string>();

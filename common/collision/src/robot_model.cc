@@ -11,6 +11,8 @@
 #include <urdf_parser/urdf_parser.h>
 #include <yaml-cpp/yaml.h>
 
+#include "iplan/core/yaml.h"
+
 #include "check.h"
 
 namespace iplan::collision {
@@ -403,7 +405,7 @@ RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptio
   if (const std::string why = options.cover.Validate(); !why.empty()) Fail(path, why);
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = core::LoadYamlFile(path);  // a key twice is an error
   } catch (const YAML::Exception& e) {
     Fail(path, std::string("cannot read YAML: ") + e.what());
   }

@@ -10,6 +10,8 @@
 #include <fcl/narrowphase/distance.h>
 #include <yaml-cpp/yaml.h>
 
+#include "iplan/core/yaml.h"
+
 #include "check.h"
 
 namespace iplan::collision {
@@ -41,7 +43,7 @@ SceneParams LoadSceneParams(const std::string& path) {
   auto fail = [&](const std::string& what) { throw std::runtime_error(path + ": " + what); };
   SceneParams p;
   try {
-    const YAML::Node root = YAML::LoadFile(path);
+    const YAML::Node root = core::LoadYamlFile(path);  // a key twice is an error
     if (!root.IsMap()) fail("top level must be a map");
     for (const auto& kv : root) {
       if (kv.first.as<std::string>() != "objects") {

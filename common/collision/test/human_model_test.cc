@@ -133,6 +133,20 @@ TEST(HumanModelTest, LoadsYamlStrictly) {
   }
 }
 
+TEST(HumanModelTest, AKeyWrittenTwiceIsAnError) {
+  const std::string bad = ::testing::TempDir() + "body_twice.yaml";
+  std::ofstream(bad) << "joints: [a, b]\n"
+                        "segments:\n"
+                        "  - {name: s1, joint_a: a, joint_b: b, count: 3, radius: 0.1}\n"
+                        "joints: [a, b, c]\n";
+  try {
+    LoadHumanBodyParams(bad);
+    ADD_FAILURE() << "a key written twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ": key 'joints': appears twice (lines 1 and 4)");
+  }
+}
+
 }  // namespace
 }  // namespace iplan::collision
 

@@ -305,6 +305,15 @@ joints:
   - {name: j1, link: l1, a: 0, d: 0.1, alpha: 0, lower: 1, upper: -1, velocity: 1}
 )");
   ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_limits); }, "lower=1 upper=-1");
+  // yaml-cpp would keep the first limit and ignore the corrected one.
+  const std::string twice = WriteTemp("twice.yaml", R"(
+name: x
+convention: modified_dh
+base_link: l0
+joints:
+  - {name: j1, link: l1, a: 0, d: 0.1, alpha: 0, lower: -1, upper: 1, velocity: 1, upper: 2}
+)");
+  ExpectThrowsWith([&] { LoadRobotModelFromYaml(twice); }, twice + ": key 'joints[0].upper': appears twice (lines 6 and 6)");
   const std::string mesh = WriteTemp("mesh.urdf", R"(<robot name="m">
   <link name="a"><collision><geometry><mesh filename="x.stl"/></geometry></collision></link>
 </robot>)");

@@ -117,5 +117,17 @@ TEST(SceneTest, LoadsShippedConfigAndRejectsBadFiles) {
   EXPECT_THROW(LoadSceneParams(bad), std::runtime_error);
 }
 
+TEST(SceneTest, AKeyWrittenTwiceIsAnError) {
+  // yaml-cpp would keep the first position and ignore the moved one.
+  const std::string bad = ::testing::TempDir() + "scene_twice.yaml";
+  std::ofstream(bad) << "objects:\n  - {name: t, type: box, xyz: [0, 0, 0], size: [1, 1, 1], xyz: [1, 0, 0]}\n";
+  try {
+    LoadSceneParams(bad);
+    ADD_FAILURE() << "a key written twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ": key 'objects[0].xyz': appears twice (lines 2 and 2)");
+  }
+}
+
 }  // namespace
 }  // namespace iplan::collision

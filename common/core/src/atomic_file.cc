@@ -1,10 +1,13 @@
 #include "iplan/core/atomic_file.h"
 
 #include <fcntl.h>
+#include <signal.h>
 #include <unistd.h>
 
 #include <cerrno>
+#include <climits>
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
@@ -15,6 +18,20 @@ namespace {
 [[noreturn]] void Fail(const std::string& what, const std::string& path) {
   throw std::runtime_error(what + " " + path + ": " + std::strerror(errno));
 }
+
+// The pid of a temporary's name suffix, or 0 when the suffix is not a pid.
+pid_t PidOf(const std::string& suffix) {
+  if (suffix.empty() || suffix.size() > 10) return 0;
+  long long v = 0;
+  for (char c : suffix) {
+    if (c < '0' || c > '9') return 0;
+    v = v * 10 + (c - '0');
+  }
+  return v > 0 && v <= INT_MAX ? static_cast<pid_t>(v) : 0;
+}
+
+// kill(pid, 0) sends nothing; EPERM means the process exists under another user.
+bool Running(pid_t pid) { return ::kill(pid, 0) == 0 || errno == EPERM; }
 
 }  // namespace
 
@@ -51,6 +68,25 @@ void WriteFileAtomically(const std::string& path, const std::string& content) {
     ::fsync(dfd);
     ::close(dfd);
   }
+}
+
+std::vector<std::string> RemoveStaleTempFiles(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::vector<std::string> removed;
+  const fs::path target(path);
+  const std::string prefix = target.filename().string() + ".tmp.";
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  fs::directory_iterator it(dir, ec), end;
+  for (; !ec && it != end; it.increment(ec)) {
+    const std::string name = it->path().filename().string();
+    if (name.compare(0, prefix.size(), prefix) != 0) continue;
+    const pid_t pid = PidOf(name.substr(prefix.size()));
+    if (pid == 0 || pid == ::getpid() || Running(pid)) continue;
+    const std::string stale = target.has_parent_path() ? (dir / name).string() : name;
+    if (::unlink(stale.c_str()) == 0) removed.push_back(stale);
+  }
+  return removed;
 }
 
 std::string ReadFile(const std::string& path) {

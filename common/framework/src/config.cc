@@ -5,6 +5,8 @@
 #include <fstream>
 #include <sstream>
 
+#include "iplan/core/yaml.h"
+
 namespace iplan::framework {
 namespace {
 
@@ -82,7 +84,11 @@ ConfigSection ConfigSection::FromString(const std::string& yaml, const std::stri
     throw ConfigError(name + ": line " + std::to_string(e.mark.line + 1) + ", column " +
                       std::to_string(e.mark.column + 1) + ": " + e.msg);
   }
-  if (state->root.IsNull()) state->root = YAML::Node(YAML::NodeType::Map);
+  // An empty file is a mistake (a truncated copy, a wrong path to an empty
+  // file), not "all defaults": a service's keys live in its section. An
+  // explicitly empty mapping ("{}") still means all defaults.
+  if (state->root.IsNull()) throw ConfigError(name + ": the file is empty");
+  if (const std::string dup = core::FindDuplicateKey(state->root); !dup.empty()) throw ConfigError(name + ": " + dup);
   if (!state->root.IsMap()) throw ConfigError(name + ": the top level must be a mapping of keys");
   YAML::Node root = state->root;
   return ConfigSection(state, root, "");
@@ -114,6 +120,9 @@ void ConfigSection::Override(const std::string& dotted_key, const std::string& y
     value = YAML::Load(yaml);
   } catch (const YAML::Exception& e) {
     throw ConfigError("--set " + dotted_key + "=" + yaml + ": the value is not valid YAML: " + e.msg);
+  }
+  if (const std::string dup = core::FindDuplicateKey(value); !dup.empty()) {
+    throw ConfigError("--set " + dotted_key + "=" + yaml + ": " + dup);
   }
   std::vector<std::string> parts;
   for (size_t b = 0;;) {

@@ -1,5 +1,8 @@
 // Strict configuration: unknown and mistyped keys are errors naming the key
 // and the file; values are validated; defaults stay when keys are absent.
+#include <cstdio>
+#include <fstream>
+
 #include <gtest/gtest.h>
 
 #include "iplan/framework/config.h"
@@ -90,6 +93,48 @@ TEST(Config, SyntaxErrorNamesLine) {
     EXPECT_NE(std::string(e.what()).find("bad.yaml: line"), std::string::npos) << e.what();
   }
   EXPECT_THROW(ConfigSection::Load("/nonexistent/x.yaml"), ConfigError);
+}
+
+TEST(Config, AKeyWrittenTwiceIsAnErrorAtAnyDepth) {
+  // yaml-cpp would keep the first value and ignore the edit further down.
+  auto error = [](const std::string& yaml) {
+    try {
+      ConfigSection::FromString(yaml, "cfg/svc.yaml");
+    } catch (const ConfigError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(error("svc:\n  rate_hz: 30\nsvc:\n  rate_hz: 15\n"), "cfg/svc.yaml: key 'svc': appears twice (lines 1 and 3)");
+  EXPECT_EQ(error("svc:\n  rate_hz: 30\n  name: cam\n  rate_hz: 15\n"),
+            "cfg/svc.yaml: key 'svc.rate_hz': appears twice (lines 2 and 4)");
+  EXPECT_EQ(error("svc:\n  cams:\n    - {id: 1, id: 2}\n"), "cfg/svc.yaml: key 'svc.cams[0].id': appears twice (lines 3 and 3)");
+  EXPECT_EQ(error("svc:\n  rate_hz: 30\nother:\n  rate_hz: 30\n"), "");  // the same name in two mappings is fine
+  auto c = ConfigSection::FromString("svc:\n  a: 1\n", "svc.yaml");
+  EXPECT_THROW(c.Override("svc.b", "{x: 1, x: 2}"), ConfigError);
+}
+
+TEST(Config, AnEmptyFileIsAnErrorButAnEmptyMappingIsNot) {
+  for (const std::string yaml : {"", "\n\n", "# svc:\n#   rate_hz: 30\n", "~\n", "null\n", "---\n"}) {
+    try {
+      ConfigSection::FromString(yaml, "cfg/svc.yaml");
+      ADD_FAILURE() << "accepted '" << yaml << "'";
+    } catch (const ConfigError& e) {
+      EXPECT_EQ(std::string(e.what()), "cfg/svc.yaml: the file is empty") << yaml;
+    }
+  }
+  auto c = ConfigSection::FromString("{}", "(no configuration file)");
+  EXPECT_TRUE(c.Keys().empty());
+  EXPECT_EQ(FinishError(c), "");
+  const std::string path = testing::TempDir() + "iplan-empty-config.yaml";
+  std::ofstream(path) << "# nothing yet\n";
+  try {
+    ConfigSection::Load(path);
+    ADD_FAILURE() << "an empty file was accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": the file is empty");
+  }
+  std::remove(path.c_str());
 }
 
 TEST(Config, OverridesReplaceAndCreateValuesAndAreCheckedLikeTheFile) {

@@ -7,6 +7,8 @@
 
 #include <yaml-cpp/yaml.h>
 
+#include "iplan/core/yaml.h"
+
 namespace iplan::planning {
 namespace {
 
@@ -92,7 +94,7 @@ T Read(const YAML::Node& node, const std::string& key, const std::string& path) 
 PlannerParams LoadPlannerParams(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = core::LoadYamlFile(path);  // a key twice is an error
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": cannot read planner params: " + e.what());
   }

@@ -44,6 +44,17 @@ TEST(PlannerParams, LoadsTheRepositoryConfig) {
   EXPECT_EQ(p.num_optimizers, 8);
 }
 
+TEST(PlannerParams, AKeyWrittenTwiceIsAnError) {
+  // yaml-cpp would keep the first dt; the loop over the pairs would take the last.
+  const std::string path = Write("twice.yaml", "dt: 0.05\nweights: {goal: 2.0}\ndt: 0.1\n");
+  try {
+    LoadPlannerParams(path);
+    FAIL() << "a key written twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'dt': appears twice (lines 1 and 3)");
+  }
+}
+
 TEST(PlannerParams, LoadsValuesAndRejectsUnknownKeys) {
   const auto good = Write("good.yaml", "dt: 0.05\nnum_optimizers: 4\nweights: {goal: 2.0}\n"
                                        "allowed_collisions: [[panda_link0, table]]\n");

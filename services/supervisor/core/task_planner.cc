@@ -4,12 +4,14 @@
 #include <cmath>
 #include <cstring>
 #include <fstream>
+#include <limits>
 #include <sstream>
 #include <stdexcept>
 
 #include <yaml-cpp/yaml.h>
 
 #include "iplan/core/atomic_file.h"
+#include "iplan/core/yaml.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -95,7 +97,7 @@ std::string TaskGraph::Validate() const {
 TaskGraph LoadTaskGraph(const std::string& path) {
   YAML::Node root;
   try {
-    root = YAML::LoadFile(path);
+    root = core::LoadYamlFile(path);  // a task written twice under one key is an error
   } catch (const YAML::Exception& e) {
     throw std::runtime_error(path + ": " + e.what());
   }
@@ -213,10 +215,16 @@ int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
 }
 
 double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief) {
-  const double reward = Harmony(task, belief) - params_.delay_weight * delay;
   const State s = state_;
   const State next = succeeded ? (s | (1ULL << task)) : s;
-  if (params_.learning) {
+  // A delay that is not a number says nothing about the task: learn
+  // nothing from it, but the task did end, so the state still moves on.
+  const bool refused = !std::isfinite(delay);
+  const double reward =
+      refused ? std::numeric_limits<double>::quiet_NaN()
+              : Harmony(task, belief) - params_.delay_weight * std::clamp(delay, 0.0, kMaxDelay);
+  if (refused) ++refused_outcomes_;
+  if (params_.learning && !refused) {
     double best_next = 0;
     bool any = false;
     for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
@@ -228,7 +236,15 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
       }
     }
     double& q = Row(s)[static_cast<std::size_t>(task)];
-    q += params_.alpha * (reward + params_.gamma * best_next - q);
+    // Bounded rewards keep Q bounded by |r| / (1 - gamma); only an absurd
+    // delay_weight could still overflow it, and an inf in the table would
+    // make every later save unloadable: keep the old value then.
+    const double updated = q + params_.alpha * (reward + params_.gamma * best_next - q);
+    if (std::isfinite(updated)) {
+      q = updated;
+    } else {
+      ++refused_outcomes_;
+    }
   }
   state_ = next;
   if (params_.learning && succeeded && episode_done()) ++episodes_learned_;
@@ -244,7 +260,17 @@ uint64_t TaskPlanner::GraphHash() const {
   return h;
 }
 
-void TaskPlanner::Save(const std::string& path) const {
+void TaskPlanner::Save(const std::string& path) {
+  try {
+    Write(path);
+  } catch (const std::exception& e) {
+    ++save_failures_;
+    last_save_error_ = e.what();
+    throw;
+  }
+}
+
+void TaskPlanner::Write(const std::string& path) const {
   std::string body;
   Put(&body, GraphHash());
   Put(&body, static_cast<uint64_t>(graph_.tasks.size()));
@@ -258,8 +284,15 @@ void TaskPlanner::Save(const std::string& path) const {
   Put(&file, Fnv(body.data(), body.size()));
   file += body;
   // Keep the previous good table: if the new one is ever damaged, the
-  // loader falls back to it.
-  if (std::ifstream(path).good()) core::WriteFileAtomically(path + ".bak", core::ReadFile(path));
+  // loader falls back to it. Only a file that passes Load's checks becomes
+  // the backup: after Load refused a corrupt main file and used the backup,
+  // rotating blindly would copy the corrupt bytes over the one good copy.
+  if (std::ifstream(path).good()) {
+    const std::string previous = core::ReadFile(path);
+    std::map<State, std::vector<double>> unused_q;
+    uint64_t unused_episodes = 0;
+    if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
+  }
   core::WriteFileAtomically(path, file);
 }
 
@@ -270,6 +303,17 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   } catch (const std::exception& e) {
     return std::string(e.what());
   }
+  std::map<State, std::vector<double>> q;
+  uint64_t episodes = 0;
+  if (auto error = Parse(data, path, &q, &episodes)) return error;
+  q_ = std::move(q);
+  episodes_learned_ = episodes;
+  return std::nullopt;
+}
+
+std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path,
+                                              std::map<State, std::vector<double>>* q_out,
+                                              uint64_t* episodes_out) const {
   if (data.size() < sizeof(kMagic) + 8) return path + " is not an iplan Q-table";
   const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
   if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
@@ -288,18 +332,37 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
     State s = 0;
     std::vector<double> row(ntasks);
     if (!Get(data, &pos, &s)) return path + " is truncated";
-    for (auto& v : row) {
-      if (!Get(data, &pos, &v) || !std::isfinite(v)) return path + " has an invalid value";
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      if (!Get(data, &pos, &row[i])) return path + " is truncated";
+      // The checksum is right, so the planner that saved it overflowed
+      // (e.g. an older one fed an absurd delay): learning from it would
+      // spread the inf or NaN to every state.
+      if (!std::isfinite(row[i])) {
+        std::ostringstream why;
+        why << path << " has a non-finite Q-value (" << row[i] << " in state 0x" << std::hex << s << std::dec
+            << " for task '" << graph_.tasks[i].name << "')";
+        return why.str();
+      }
     }
     q[s] = std::move(row);
   }
   if (pos != data.size()) return path + " has trailing bytes";
-  q_ = std::move(q);
-  episodes_learned_ = episodes;
+  *q_out = std::move(q);
+  *episodes_out = episodes;
   return std::nullopt;
 }
 
 bool TaskPlanner::Load(const std::string& path, std::string* note) {
+  // Temporaries of saves killed before their rename (kill -9, power loss)
+  // are never read; without this they pile up beside the table.
+  const std::size_t stale =
+      core::RemoveStaleTempFiles(path).size() + core::RemoveStaleTempFiles(path + ".bak").size();
+  const bool loaded = LoadTable(path, note);
+  if (note && stale > 0) *note += "; removed " + std::to_string(stale) + " stale temporary file(s)";
+  return loaded;
+}
+
+bool TaskPlanner::LoadTable(const std::string& path, std::string* note) {
   const bool main_exists = std::ifstream(path).good(), backup_exists = std::ifstream(path + ".bak").good();
   if (!main_exists && !backup_exists) {
     if (note) *note = path + " does not exist: starting with an empty Q-table";

@@ -5,8 +5,10 @@
 // person is predicted to do and penalises the delay a task caused:
 //   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
-// with a message and the previous good copy is used. No DDS types. Not
-// thread-safe.
+// with a message and the previous good copy is used. The backup is only
+// ever replaced by a file that passes the loader's checks, so it stays good
+// however often a damaged main file is refused and saved over. No DDS
+// types. Not thread-safe.
 #pragma once
 
 #include <cstdint>
@@ -37,7 +39,8 @@ struct TaskGraph {
   std::string Validate() const;
 };
 
-/// Loads a task graph from YAML (strict). Throws std::runtime_error naming the file and key.
+/// Loads a task graph from YAML (strict: unknown keys and keys written twice
+/// in one mapping are errors). Throws std::runtime_error naming the file and key.
 TaskGraph LoadTaskGraph(const std::string& path);
 
 struct QLearningParams {
@@ -79,27 +82,54 @@ class TaskPlanner {
   /// deployment; ties broken by the harmony with the current belief, then by
   /// index. -1 when the episode is done.
   int Choose(const std::map<std::string, double>& belief);
-  /// Q-learning update after `task` ended with `delay` (s); advances the
-  /// state when `succeeded` (counting the episode when that finishes it, in
-  /// learning mode). Returns the reward.
+  /// The largest delay (s) one task is charged: a finite but absurd delay
+  /// from the network (1.7e308) would otherwise overflow the Q-values.
+  static constexpr double kMaxDelay = 3600.0;
+  /// Q-learning update after `task` ended with `delay` (s), clamped to
+  /// [0, kMaxDelay]; advances the state when `succeeded` (counting the
+  /// episode when that finishes it, in learning mode). Returns the reward.
+  /// A non-finite delay (NaN, inf) is refused: no update, NaN returned,
+  /// counted in refused_outcomes(); the state still advances. So is an
+  /// update that would make the Q-value non-finite (absurd delay_weight).
   double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief);
+  /// Outcomes Complete() did not learn from (see there), since construction.
+  uint64_t refused_outcomes() const { return refused_outcomes_; }
   /// Starts a new episode (state 0).
   void ResetEpisode() { state_ = 0; }
 
   double Q(State s, int task) const;
 
-  /// Writes the Q-table atomically to `path`, keeping the previous file as
-  /// `path.bak`. Throws std::runtime_error on I/O errors.
-  void Save(const std::string& path) const;
+  /// Writes the Q-table atomically to `path`. The previous `path` becomes
+  /// `path.bak` only if it passes Load's checks (magic, checksum, this task
+  /// graph, finite values); otherwise the backup is left as it is. Throws
+  /// std::runtime_error on I/O errors, after counting the failure in
+  /// save_failures() and keeping its message in last_save_error().
+  void Save(const std::string& path);
+  /// Save() calls that failed (threw), since construction.
+  uint64_t save_failures() const { return save_failures_; }
+  /// The message of the latest failed Save(); empty until one fails. A later
+  /// successful save does not clear it: save_failures() tells whether
+  /// failures go on.
+  const std::string& last_save_error() const { return last_save_error_; }
   /// Loads `path`; if it is missing returns false (fresh table); if it is
-  /// corrupt or belongs to another task graph, tries `path.bak`. Throws
-  /// std::runtime_error when neither is usable, with both reasons. `*note`
-  /// says what happened (e.g. "qtable.bin is corrupt (...); using the backup").
+  /// corrupt, has non-finite values or belongs to another task graph, tries
+  /// `path.bak`. Throws std::runtime_error when neither is usable, with both
+  /// reasons. `*note` says what happened (e.g. "qtable.bin is corrupt
+  /// (...); refused it and loaded the previous good table qtable.bin.bak").
+  /// First removes the temporaries of `path` and `path.bak` left by saves
+  /// killed mid-write (core::RemoveStaleTempFiles), noted in `*note`.
   bool Load(const std::string& path, std::string* note);
 
  private:
   std::vector<double>& Row(State s);
+  void Write(const std::string& path) const;
+  bool LoadTable(const std::string& path, std::string* note);
   std::optional<std::string> TryLoad(const std::string& path);
+  /// Checks the bytes of a table file named `path` (for messages); empty
+  /// and fills the outputs when it is a good table of this graph, else the
+  /// reason. Does not touch the planner.
+  std::optional<std::string> Parse(const std::string& data, const std::string& path,
+                                   std::map<State, std::vector<double>>* q, uint64_t* episodes) const;
   uint64_t GraphHash() const;
 
   TaskGraph graph_;
@@ -107,6 +137,9 @@ class TaskPlanner {
   std::map<State, std::vector<double>> q_;
   State state_ = 0;
   uint64_t episodes_learned_ = 0;
+  uint64_t refused_outcomes_ = 0;
+  uint64_t save_failures_ = 0;
+  std::string last_save_error_;
   std::vector<uint64_t> prerequisites_;  // bitmask per task
   std::mt19937_64 rng_;
 };

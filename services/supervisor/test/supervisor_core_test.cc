@@ -1,8 +1,10 @@
 // The task planner (task graph, Q-learning, persistence) and the safety
 // monitor of the supervisor, without DDS.
+#include <sys/wait.h>
 #include <unistd.h>
 
 #include <cmath>
+#include <cstring>
 #include <filesystem>
 #include <fstream>
 #include <iterator>
@@ -12,6 +14,7 @@
 
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
+#include "iplan/core/atomic_file.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -74,6 +77,22 @@ TEST(TaskGraph, LoadsRetreatsAndNamesTheFileOnErrors) {
     ADD_FAILURE() << "a retreat of the wrong size was accepted";
   } catch (const std::runtime_error& e) {
     EXPECT_EQ(std::string(e.what()), path + ": task 'hand_over' has a retreat of 1 joint positions and a goal of 2");
+  }
+  std::filesystem::remove(path);
+}
+
+TEST(TaskGraph, AKeyWrittenTwiceIsAnError) {
+  // yaml-cpp would keep the first goal and ignore the corrected one below it.
+  const std::string path = TempPath("twice.yaml");
+  std::ofstream(path) << "robot_tasks:\n"
+                         "  - name: hand_over\n"
+                         "    goal: [0.3, 0.4]\n"
+                         "    goal: [0.5, 0.4]\n";
+  try {
+    LoadTaskGraph(path);
+    ADD_FAILURE() << "a key written twice was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks[0].goal': appears twice (lines 3 and 4)");
   }
   std::filesystem::remove(path);
 }
@@ -249,6 +268,169 @@ TEST(TaskPlanner, CorruptTableIsRefusedAndThePreviousGoodOneKept) {
   EXPECT_THROW(s.Load(path, &note), std::runtime_error);
   std::filesystem::remove(path);
   std::filesystem::remove(path + ".bak");
+}
+
+// Flips one byte of the body, so the checksum no longer matches.
+void Damage(const std::string& path) {
+  std::fstream f(path, std::ios::in | std::ios::out | std::ios::binary);
+  f.seekg(30);
+  const char c = static_cast<char>(f.get());
+  f.seekp(30);
+  f.put(static_cast<char>(c ^ 0x5a));
+}
+
+// Q(0, 1) of the table in `path` alone (no fallback), or NaN when that file
+// does not load.
+double LoadedQ01(const std::string& path) {
+  const std::string copy = path + ".alone";
+  std::filesystem::copy_file(path, copy, std::filesystem::copy_options::overwrite_existing);
+  TaskPlanner p(Graph(), QLearningParams{});
+  std::string note;
+  double q = std::nan("");
+  try {
+    if (p.Load(copy, &note) && note.rfind("loaded " + copy, 0) == 0) q = p.Q(0, 1);
+  } catch (const std::runtime_error&) {
+  }
+  std::filesystem::remove(copy);
+  return q;
+}
+
+TEST(TaskPlanner, ARefusedTableNeverReplacesTheGoodBackup) {
+  const std::string path = TempPath("rotation.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  const double q_a = p.Q(0, 1);
+  p.Save(path);  // A
+  p.ResetEpisode();
+  p.Complete(1, true, 0.0, {});
+  p.Save(path);  // B; A is now path.bak
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  Damage(path);
+
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("refused it and loaded the previous good table"), std::string::npos) << note;
+  EXPECT_EQ(q.Q(0, 1), q_a);
+  q.ResetEpisode();
+  q.Complete(1, true, 2.0, {});
+  const double q_c = q.Q(0, 1);
+  q.Save(path);  // C over the damaged B: B must not become the backup
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  EXPECT_EQ(LoadedQ01(path), q_c);
+
+  Damage(path);
+  TaskPlanner r(Graph(), QLearningParams{});
+  ASSERT_TRUE(r.Load(path, &note)) << note;
+  EXPECT_TRUE(r.Q(0, 1) == q_a || r.Q(0, 1) == q_c) << r.Q(0, 1);
+  EXPECT_EQ(LoadedQ01(path + ".bak"), q_a);
+  // A good main file is rotated as before.
+  r.Save(path);  // main damaged: backup still A
+  r.Save(path);  // main good: it becomes the backup
+  EXPECT_EQ(LoadedQ01(path + ".bak"), r.Q(0, 1));
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, AnAbsurdDelayIsClampedAndANonFiniteOneRefused) {
+  QLearningParams params;
+  params.delay_weight = 2.0;  // 2 * 1.7e308 overflowed to -inf before the clamp
+  TaskPlanner p(Graph(), params);
+  const double reward = p.Complete(1, true, 1.7e308, {});
+  EXPECT_DOUBLE_EQ(reward, 1.0 - 2.0 * TaskPlanner::kMaxDelay);
+  EXPECT_DOUBLE_EQ(p.Q(0, 1), params.alpha * reward);
+  EXPECT_EQ(p.Complete(0, true, -5.0, {}), p.Harmony(0, {}));  // a negative delay is no bonus
+  EXPECT_EQ(p.refused_outcomes(), 0u);
+
+  // Many absurd episodes with the default weight: Q stays finite and the
+  // table saves and reloads (an inf made the supervisor unable to start).
+  TaskPlanner d(Graph(), QLearningParams{});
+  for (int episode = 0; episode < 200; ++episode) {
+    d.ResetEpisode();
+    while (!d.episode_done()) d.Complete(d.Available().front(), true, 1.7e308, {});
+  }
+  for (int t = 0; t < 3; ++t) EXPECT_TRUE(std::isfinite(d.Q(0, t))) << t;
+  const std::string path = TempPath("absurd.bin");
+  d.Save(path);
+  TaskPlanner e(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(e.Load(path, &note)) << note;
+  EXPECT_EQ(note.rfind("loaded " + path, 0), 0u) << note;
+
+  // NaN and inf: nothing learned, but the task did end.
+  TaskPlanner n(Graph(), QLearningParams{});
+  EXPECT_TRUE(std::isnan(n.Complete(1, true, std::nan(""), {})));
+  EXPECT_TRUE(std::isnan(n.Complete(0, true, std::numeric_limits<double>::infinity(), {})));
+  EXPECT_EQ(n.Q(0, 1), 0.0);
+  EXPECT_EQ(n.Q(2, 0), 0.0);
+  EXPECT_EQ(n.state(), 3u);
+  EXPECT_EQ(n.refused_outcomes(), 2u);
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
+  // A table poisoned by an older planner: the checksum is right, a Q-value is
+  // -inf. Layout: magic (8), checksum (8), then the body: graph hash, task
+  // count, row count, episodes (8 each), rows of state (8) and 3 doubles.
+  const std::string path = TempPath("poisoned.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Complete(1, true, 0.5, {});
+  p.Save(path);
+  p.Save(path);  // a good backup
+  std::string data = core::ReadFile(path);
+  ASSERT_EQ(data.size(), 48u + 8 + 3 * 8);
+  const double inf = -std::numeric_limits<double>::infinity();
+  std::memcpy(&data[48 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
+  uint64_t sum = 1469598103934665603ULL;
+  for (std::size_t i = 16; i < data.size(); ++i) {
+    sum ^= static_cast<unsigned char>(data[i]);
+    sum *= 1099511628211ULL;
+  }
+  std::memcpy(&data[8], &sum, 8);
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << data;
+
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_EQ(note, path + " has a non-finite Q-value (-inf in state 0x0 for task 'pick_right'); refused it and "
+                         "loaded the previous good table " + path + ".bak");
+  EXPECT_EQ(q.Q(0, 1), p.Q(0, 1));
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+TEST(TaskPlanner, SaveFailuresAreCountedWithTheirReason) {
+  TaskPlanner p(Graph(), QLearningParams{});
+  EXPECT_EQ(p.save_failures(), 0u);
+  EXPECT_EQ(p.last_save_error(), "");
+  EXPECT_THROW(p.Save("/nonexistent-dir/q.bin"), std::runtime_error);
+  EXPECT_THROW(p.Save("/nonexistent-dir/q.bin"), std::runtime_error);
+  EXPECT_EQ(p.save_failures(), 2u);
+  EXPECT_NE(p.last_save_error().find("/nonexistent-dir/q.bin"), std::string::npos) << p.last_save_error();
+  const std::string path = TempPath("saved.bin");
+  p.Save(path);
+  EXPECT_EQ(p.save_failures(), 2u);  // a success does not hide that saves failed
+  std::filesystem::remove(path);
+}
+
+TEST(TaskPlanner, LoadRemovesTheTemporariesOfKilledSaves) {
+  const std::string path = TempPath("stale.bin");
+  TaskPlanner p(Graph(), QLearningParams{});
+  p.Save(path);
+  // A pid that is not running: a reaped child.
+  const pid_t child = ::fork();
+  if (child == 0) ::_exit(0);
+  ::waitpid(child, nullptr, 0);
+  const std::string dead = std::to_string(child);
+  for (const std::string& f : {path + ".tmp." + dead, path + ".bak.tmp." + dead}) std::ofstream(f) << "half";
+  TaskPlanner q(Graph(), QLearningParams{});
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note));
+  EXPECT_NE(note.find("; removed 2 stale temporary file(s)"), std::string::npos) << note;
+  EXPECT_FALSE(std::filesystem::exists(path + ".tmp." + dead));
+  EXPECT_FALSE(std::filesystem::exists(path + ".bak.tmp." + dead));
+  std::filesystem::remove(path);
 }
 
 TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {

@@ -50,7 +50,10 @@ Check<std::string> OneOf(std::vector<std::string> allowed);
 class ConfigSection {
  public:
   /// Loads a YAML file. Throws ConfigError when it cannot be read or parsed
-  /// (with the line and column) or its top level is not a mapping.
+  /// (with the line and column), is empty (nothing but comments or a null:
+  /// "FILE: the file is empty"; "{}" is an empty mapping and fine), has a key
+  /// twice in one mapping at any depth ("FILE: key 'a.b': appears twice
+  /// (lines 2 and 5)") or its top level is not a mapping.
   static ConfigSection Load(const std::string& path);
   /// From YAML text (tests); `name` stands for the file in messages.
   static ConfigSection FromString(const std::string& yaml, const std::string& name);
@@ -73,7 +76,7 @@ class ConfigSection {
   /// mapping keys from this section (e.g. "supervisor.max_episodes"), `yaml`
   /// the new value as YAML text ("3", "[1, 2]", "true"). Missing mappings on
   /// the path are created. Throws ConfigError when `yaml` does not parse or
-  /// the path runs through a non-mapping.
+  /// the path runs through a non-mapping or `yaml` has a key twice.
   void Override(const std::string& dotted_key, const std::string& yaml);
   /// Records a problem found by the caller (cross-field checks).
   void AddError(const std::string& key, const std::string& problem);
