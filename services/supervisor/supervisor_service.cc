@@ -227,11 +227,11 @@ class SupervisorService : public framework::Service {
       try {
         planner_->Save(q_table_);
       } catch (const std::exception& e) {
-        ++save_failures_;
         node.log().error("Q-table not saved: {}", e.what());
-        node.SetDiagnosticValue("q_table_last_save_error", e.what());
+        node.SetDiagnosticValue("q_table_last_save_error", planner_->last_save_error());
       }
-      node.SetDiagnosticValue("q_table_save_failures", std::to_string(save_failures_));
+      node.SetDiagnosticValue("q_table_save_failures", std::to_string(planner_->save_failures()));
+      node.SetDiagnosticValue("refused_outcomes", std::to_string(planner_->refused_outcomes()));
     }
   }
 
@@ -245,7 +245,6 @@ class SupervisorService : public framework::Service {
   double permit_period_ = 0.05, permit_validity_ = 0.2, resend_period_ = 1.0;  // s
   std::vector<std::pair<std::string, double>> deadlines_;  // watched topic, s
   std::chrono::steady_clock::time_point last_permit_at_{}, last_command_at_{};
-  uint64_t save_failures_ = 0;
   std::map<std::string, double> belief_;
   msg::TaskCommand command_;  // the running task's command (re-sent on resume)
   int current_task_ = -1;
