@@ -42,7 +42,11 @@ struct Scenario {
 
 std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
   const int domain = UniqueDomain(41 + static_cast<int>(sc.velocity.norm() * 10));
-  Process svc({BinPath("iplan-collision-risk"), "--dds", "fastdds", "--domain", std::to_string(domain)});
+  // The test plays robot, trajectory optimiser, perception and intent from
+  // one participant: entitle it to write what trajopt and intent write.
+  Process svc({BinPath("iplan-collision-risk"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
+               "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]", "--set",
+               "node.entitled_writers./iplan/human/prediction=[scripted_cell]"});
   TestNode cell("scripted_cell", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
   auto& js = node.Advertise(framework::topics::JointStates());
@@ -104,6 +108,7 @@ std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
     if (now >= next_pred) {
       msg::HumanPrediction m;
       m.header.stamp = stamp;
+      m.observation_stamp = stamp;
       m.header.frame_id = "world";
       m.body_id = 1;
       m.time_step = 1.0 / 15;

@@ -153,14 +153,17 @@ TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) 
   node.Subscribe(framework::topics::ActionBelief(),
                  std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
                      [&](const msg::ActionBelief& b, const dds::SampleInfo&) {
-                       duplicate_outputs += beliefs.count(msg::ToNanoseconds(b.header.stamp));
-                       beliefs[msg::ToNanoseconds(b.header.stamp)] = b;
+                       // Outputs carry intent's own stamp, never older than the skeleton's.
+                       EXPECT_GE(msg::ToNanoseconds(b.header.stamp), msg::ToNanoseconds(b.observation_stamp));
+                       duplicate_outputs += beliefs.count(msg::ToNanoseconds(b.observation_stamp));
+                       beliefs[msg::ToNanoseconds(b.observation_stamp)] = b;
                      }));
   node.Subscribe(framework::topics::HumanPrediction(),
                  std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
                      [&](const msg::HumanPrediction& p, const dds::SampleInfo&) {
-                       duplicate_outputs += predictions.count(msg::ToNanoseconds(p.header.stamp));
-                       predictions[msg::ToNanoseconds(p.header.stamp)] = p;
+                       EXPECT_GE(msg::ToNanoseconds(p.header.stamp), msg::ToNanoseconds(p.observation_stamp));
+                       duplicate_outputs += predictions.count(msg::ToNanoseconds(p.observation_stamp));
+                       predictions[msg::ToNanoseconds(p.observation_stamp)] = p;
                      }));
 
   const std::vector<std::string>& joints = model_->config.joints.joints;

@@ -3,7 +3,12 @@
 // publishes a trajectory every cycle and an outcome at the end; with a person
 // standing on the goal the outcome reports waits and delay, and the simulated
 // robot never touches the person's true body; a task with a retreat ends
-// there, and a retreat of the wrong size is refused.
+// there, and a retreat of the wrong size is refused. The test process plays
+// the supervisor (commands and the robot's only permit), intent and the
+// simulated person, entitled to by the services' --set overrides. A command
+// repeated after its task ended is answered with the same outcome again (how
+// a supervisor that missed it catches up); a stranger's command changes
+// nothing.
 #include <signal.h>
 
 #include <cmath>
@@ -35,6 +40,8 @@ std::vector<Eigen::Vector3d> PersonWithHandAt(const Eigen::Vector3d& hand) {
 
 struct Result {
   std::optional<msg::TaskOutcome> outcome;
+  std::optional<msg::TaskOutcome> repeated;  // answer to the command sent again after the outcome
+  int outcomes = 0;
   std::vector<double> last_waypoint;  // of the last trajectory before the outcome
   int trajectories = 0;
   double seconds = 0;
@@ -45,11 +52,17 @@ struct Result {
 // stands on the goal for `block_for_s`.
 Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
   const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10) + static_cast<int>(retreat.size()));
-  Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain)});
-  Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain)});
+  Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
+               "robot_sim.permits.monitors=[test_cell]"});
+  Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
+               "node.entitled_writers./iplan/task/command=[test_cell]", "--set",
+               "node.entitled_writers./iplan/human/prediction=[test_cell]"});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
+  TestNode stranger("stranger", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
+  auto& rogue_cmd = stranger.node->Advertise(framework::topics::TaskCommand());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit());
   auto& pred = node.Advertise(framework::topics::HumanPrediction());
   auto& truth = node.Advertise(framework::topics::HumanTruth());
   Result r;
@@ -65,7 +78,10 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
                      }));
   node.Subscribe(framework::topics::TaskOutcome(),
                  std::function<void(const msg::TaskOutcome&, const dds::SampleInfo&)>(
-                     [&](const msg::TaskOutcome& m, const dds::SampleInfo&) { r.outcome = m; }),
+                     [&](const msg::TaskOutcome& m, const dds::SampleInfo&) {
+                       ++r.outcomes;
+                       (r.outcome ? r.repeated : r.outcome) = m;
+                     }),
                  framework::SubscribeOptions{false});
   node.Subscribe(framework::topics::Diagnostics(),
                  std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
@@ -103,7 +119,21 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
   auto next = start;
   started = true;
   cmd.Write(c);
+  // A stranger cancels the task: ignored (only test_cell is entitled).
+  msg::TaskCommand cancel = c;
+  cancel.command = msg::TaskCommand::CANCEL;
+  rogue_cmd.Write(cancel);
+  auto next_permit = start;
   while (!r.outcome && Clock::now() - start < 40s) {
+    if (Clock::now() >= next_permit) {
+      msg::SafetyPermit p;
+      p.header.stamp = msg::Now();
+      p.state = msg::SafetyPermit::PERMIT;
+      p.validity = 0.2;
+      p.source = "test";
+      permit.Write(p);
+      next_permit += 50ms;
+    }
     if (Clock::now() >= next) {
       const double t = std::chrono::duration<double>(Clock::now() - start).count();
       const Eigen::Vector3d hand = t < block_for_s ? goal_hand : Eigen::Vector3d(1.8, 0.8, 1.0);
@@ -111,6 +141,8 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
       const msg::Time stamp = msg::Now();
       msg::HumanPrediction m;
       m.header.stamp = stamp;
+      m.header.frame_id = "world";
+      m.observation_stamp = stamp;
       m.time_step = 0.1;
       m.num_steps = 10;
       m.joint_names = kJoints;
@@ -129,6 +161,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
       pred.Write(m);
       msg::HumanSkeleton s;
       s.header.stamp = stamp;
+      s.header.frame_id = "world";
       s.confidence = 1;
       for (std::size_t j = 0; j < joints.size(); ++j) {
         msg::HumanJoint h;
@@ -143,8 +176,11 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
     node.SpinOnce(10ms);
   }
   r.seconds = std::chrono::duration<double>(Clock::now() - start).count();
+  // The same command again, as a supervisor that missed the outcome sends it.
+  c.header.stamp = msg::Now();
+  cmd.Write(c);
   const auto diag_end = Clock::now() + 2s;
-  while (Clock::now() < diag_end) node.SpinOnce(20ms);  // the simulator's next diagnostics
+  while (Clock::now() < diag_end) node.SpinOnce(20ms);  // the simulator's next diagnostics, the repeat's answer
   opt.Signal(SIGTERM);
   sim.Signal(SIGTERM);
   EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
@@ -163,6 +199,12 @@ TEST(TrajoptService, ReachesTheGoalPublishingEveryCycle) {
   EXPECT_GE(r.trajectories, static_cast<int>(0.7 * r.outcome->duration / 0.1)) << r.outcome->duration;
   EXPECT_GT(r.outcome->planning_time_p50, 0.0);
   EXPECT_EQ(r.contacts, "0");
+  // The stranger's CANCEL changed nothing; the repeated command got the same outcome again.
+  ASSERT_TRUE(r.repeated.has_value());
+  EXPECT_EQ(r.outcomes, 2);
+  EXPECT_EQ(r.repeated->task_id, 42u);
+  EXPECT_EQ(r.repeated->status, msg::TaskOutcome::SUCCEEDED);
+  EXPECT_EQ(r.repeated->duration, r.outcome->duration);
 }
 
 TEST(TrajoptService, PersonOnTheGoalIsReportedAsWaitAndDelayNotContact) {

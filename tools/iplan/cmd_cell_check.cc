@@ -145,6 +145,10 @@ int RunCellCheck(const CheckOptions& o) {
     risk = collision_risk::ReadRiskConfig(rsec);
     check(rconf);
     if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
+    // The check asks about the working cell, where predictions flow: the
+    // separation layer with the person's measured speed, not the degraded
+    // mode the monitor falls back to when intent is gone.
+    risk.params.ssm.degrade_without_prediction = false;
     monitor = collision_risk::MakeRiskMonitor(risk);
     framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
     framework::ConfigSection ssec = sconf.Section("supervisor");
