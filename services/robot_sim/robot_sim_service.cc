@@ -66,9 +66,10 @@ class RobotSimService : public framework::Service {
                                                                    m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
                                                                    msg::ToNanoseconds(msg::Now())));
                    }));
-    node.OnReaderEvent([this, permit_topic](const std::string& topic, const dds::ReaderEvent& e) {
-      if (topic == permit_topic.name && e.kind == dds::EventKind::kLivelinessLost) gate_->OnWriterLost();
-    });
+    // A monitor that vanishes (crash, freeze, network) sends no more permits:
+    // its last one lapses within its validity, which is shorter than the
+    // liveliness lease. Liveliness events are not used: they do not say
+    // whose writer was lost, and a stranger's writer must not stop the robot.
     node.Subscribe(framework::topics::HumanTruth(),
                    std::function<void(const msg::HumanSkeleton&, SI)>([this, &node](const msg::HumanSkeleton& m, SI) {
                      Eigen::Matrix3Xd joints(3, body_->num_joints());

@@ -193,11 +193,24 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
   const auto sent = Clock::now();
   skel_w.Write(huge);
   cell.SpinFor(2s);
-  EXPECT_NE(cell.Diag("intent", "last_rejection/rt/iplan/human/skeleton").find("joints has 20000 entries"),
-            std::string::npos)
-      << cell.Diag("intent", "last_rejection/rt/iplan/human/skeleton");
-  EXPECT_NE(cell.Diag("collision_risk", "last_rejection/rt/iplan/human/skeleton").find("joints has 20000 entries"),
-            std::string::npos);
+  // About 2.3 MB: Cyclone delivers it; Fast DDS's best-effort readers may
+  // lose one of its many fragments and drop it, which spares the services
+  // too. Where it reached the observer's own reader, every service that
+  // reads skeletons must have refused it by size.
+  const bool delivered =
+      node.stats(framework::topics::HumanSkeleton().name).last_rejection.find("joints has 20000 entries") !=
+      std::string::npos;
+  std::cout << "20k-joint skeleton " << (delivered ? "delivered" : "not delivered by the vendor to the observer")
+            << "; intent: " << cell.Diag("intent", "last_rejection/rt/iplan/human/skeleton")
+            << "; collision risk: " << cell.Diag("collision_risk", "last_rejection/rt/iplan/human/skeleton") << "\n";
+  if (GetParam().vendor == dds::Vendor::kCyclone) EXPECT_TRUE(delivered);
+  if (delivered) {
+    for (const std::string svc : {"intent", "collision_risk", "supervisor"}) {
+      EXPECT_NE(cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton").find("joints has 20000 entries"),
+                std::string::npos)
+          << svc << ": " << cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton");
+    }
+  }
   const double sup_gap = LargestPermitGap(cell, "supervisor", sent - 500ms, Clock::now());
   const double risk_gap = LargestPermitGap(cell, "collision_risk", sent - 500ms, Clock::now());
   std::cout << "20k-joint skeleton: largest permit gap supervisor " << sup_gap << " s, collision risk " << risk_gap

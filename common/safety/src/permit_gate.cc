@@ -61,10 +61,6 @@ std::optional<std::string> PermitGate::OnPermit(const std::string& monitor, bool
   return std::nullopt;
 }
 
-void PermitGate::OnWriterLost() {
-  for (auto& [name, h] : held_) h.expires_ns = std::numeric_limits<int64_t>::min();
-}
-
 PermitDecision PermitGate::Evaluate(int64_t now_ns) const {
   PermitDecision d;
   std::string why;
@@ -74,9 +70,7 @@ PermitDecision PermitGate::Evaluate(int64_t now_ns) const {
     if (it == held_.end()) {
       add("no permit from " + m + " yet");
     } else if (now_ns >= it->second.expires_ns) {
-      add(it->second.expires_ns == std::numeric_limits<int64_t>::min()
-              ? "permit from " + m + " revoked (a permit writer was lost)"
-              : "permit from " + m + " lapsed " + Seconds((now_ns - it->second.expires_ns) * 1e-9) + " ago");
+      add("permit from " + m + " lapsed " + Seconds((now_ns - it->second.expires_ns) * 1e-9) + " ago");
     } else if (!it->second.permit) {
       add(m + " stops: " + it->second.reason);
     }

@@ -96,20 +96,6 @@ TEST(PermitGate, StrangersAreRefused) {
   EXPECT_FALSE(g.Evaluate(kT0).permitted);
 }
 
-TEST(PermitGate, ALostWriterRevokesEveryPermitUntilRenewed) {
-  PermitGate g = TwoMonitors();
-  g.OnPermit("iplan-supervisor", true, 0.2, "healthy", kT0, kT0);
-  g.OnPermit("iplan-collision_risk", true, 0.2, "clear", kT0, kT0);
-  g.OnWriterLost();
-  const PermitDecision d = g.Evaluate(kT0 + kMs);
-  EXPECT_FALSE(d.permitted);
-  EXPECT_NE(d.reason.find("revoked"), std::string::npos) << d.reason;
-  g.OnPermit("iplan-supervisor", true, 0.2, "healthy", kT0 + 50 * kMs, kT0 + 50 * kMs);
-  EXPECT_FALSE(g.Evaluate(kT0 + 51 * kMs).permitted);  // collision risk not renewed yet
-  g.OnPermit("iplan-collision_risk", true, 0.2, "clear", kT0 + 50 * kMs, kT0 + 50 * kMs);
-  EXPECT_TRUE(g.Evaluate(kT0 + 52 * kMs).permitted);
-}
-
 TEST(PermitGate, ParamsAreChecked) {
   EXPECT_THROW(PermitGate(PermitGateParams{}), std::invalid_argument);
   PermitGateParams p;

@@ -63,10 +63,6 @@ class PermitGate {
   /// permit changes nothing.
   std::optional<std::string> OnPermit(const std::string& monitor, bool permit, double validity_s,
                                       const std::string& reason, int64_t stamp_ns, int64_t now_ns);
-  /// A writer of permits lost liveliness (crashed or hung) and the caller
-  /// cannot tell whose: every permit held so far lapses now; each live
-  /// monitor restores its own with its next permit.
-  void OnWriterLost();
   /// The decision at `now_ns`.
   PermitDecision Evaluate(int64_t now_ns) const;
 
