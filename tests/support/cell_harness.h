@@ -16,6 +16,7 @@
 #include <cmath>
 #include <filesystem>
 #include <functional>
+#include <iostream>
 #include <map>
 #include <memory>
 #include <string>
@@ -107,7 +108,12 @@ class CellHarness {
     }
     procs_.clear();
     observer_.reset();
-    std::filesystem::remove_all(dir_);
+    // Service logs stay for a failed test (each start: <svc>-<n>.out/.err).
+    if (::testing::Test::HasFailure()) {
+      std::cout << "service logs kept in " << dir_.string() << "\n";
+    } else {
+      std::filesystem::remove_all(dir_);
+    }
   }
 
   bool ready() const { return observer_ != nullptr; }
