@@ -187,34 +187,46 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
 
   // 4. Huge skeletons: 20,000 joints (about 2.3 MB), then 5,000 (580 kB):
   // refused by size before any other work, and no monitor misses a permit
-  // period over them (50 ms supervisor, 1/15 s collision risk). Cyclone
-  // delivers both to every reader; Fast DDS's best-effort readers in other
-  // processes may lose such a sample in transport (one of its many
-  // fragments), which spares that service too. So: every service that got
-  // one refused it by size, and on Cyclone every service got both.
+  // period over them (50 ms supervisor, 1/15 s collision risk). The readers
+  // are best effort (sensor profile): a sample of hundreds of fragments can
+  // be lost in transport on a loaded machine, which spares that service too.
+  // So each is sent again (up to 8 times) until every service that reads
+  // skeletons has received and refused one; on Cyclone every service must
+  // have, on Fast DDS (which drops such samples far more often here) every
+  // one it reached must have refused it by size, and at least one must.
   const auto sent = Clock::now();
   int refusals = 0;
   for (const int joints : {20000, 5000}) {
+    const std::string expected = "joints has " + std::to_string(joints) + " entries, limit 128";
     std::map<std::string, double> rejected_before;
+    std::map<std::string, bool> got;
     for (const std::string svc : {"intent", "collision_risk", "supervisor"}) {
       rejected_before[svc] = cell.DiagNumber(svc, "rejected/rt/iplan/human/skeleton");
+      got[svc] = false;
     }
-    msg::HumanSkeleton huge = *skeleton;
-    huge.header.stamp = msg::Now();
-    huge.joints.resize(static_cast<std::size_t>(joints));
-    for (std::size_t j = 0; j < huge.joints.size(); ++j) huge.joints[j].name = "j" + std::to_string(j);
-    skel_w.Write(huge);
-    cell.SpinFor(2s);
-    const std::string expected = "joints has " + std::to_string(joints) + " entries, limit 128";
-    for (const auto& [svc, before] : rejected_before) {
-      const bool got = cell.DiagNumber(svc, "rejected/rt/iplan/human/skeleton") > before;
-      const std::string last = cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton");
-      std::cout << joints << "-joint skeleton, " << svc << ": " << (got ? last : "not delivered") << "\n";
-      if (GetParam().vendor == dds::Vendor::kCyclone) EXPECT_TRUE(got) << svc;
-      if (got) {
+    int sends = 0;
+    auto all = [&] { return std::all_of(got.begin(), got.end(), [](const auto& g) { return g.second; }); };
+    while (!all() && sends < 8) {
+      msg::HumanSkeleton huge = *skeleton;
+      huge.header.stamp = msg::Now();
+      huge.joints.resize(static_cast<std::size_t>(joints));
+      for (std::size_t j = 0; j < huge.joints.size(); ++j) huge.joints[j].name = "j" + std::to_string(j);
+      skel_w.Write(huge);
+      ++sends;
+      cell.SpinFor(1200ms);  // a diagnostics period
+      for (auto& [svc, g] : got) {
+        if (g || cell.DiagNumber(svc, "rejected/rt/iplan/human/skeleton") <= rejected_before[svc]) continue;
+        g = true;
+        const std::string last = cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton");
         EXPECT_NE(last.find(expected), std::string::npos) << svc << ": " << last;
         ++refusals;
       }
+    }
+    for (const auto& [svc, g] : got) {
+      std::cout << joints << "-joint skeleton, " << svc << ": "
+                << (g ? cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton") : "not delivered") << " (" << sends
+                << " sent)\n";
+      if (GetParam().vendor == dds::Vendor::kCyclone) EXPECT_TRUE(g) << svc << " never received one";
     }
   }
   EXPECT_GT(refusals, 0) << "no service received a huge skeleton: the case was not exercised";
@@ -255,12 +267,7 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
     cell.SpinFor(500ms);
   }
 
-  cell.SpinFor(1500ms);
-  EXPECT_EQ(cell.DiagNumber("robot_sim", "true_contacts", -1), 0);
-  for (const std::string& svc : CellHarness::Services()) {
-    cell[svc].Signal(SIGTERM);
-    EXPECT_EQ(cell[svc].Wait(10s), 0) << svc << ":\n" << cell.Logs(svc);
-  }
+  cell.ExpectNoContactAndCleanShutdown();
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellAttack,

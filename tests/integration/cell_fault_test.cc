@@ -109,12 +109,7 @@ TEST_P(CellFault, EveryServiceKilledOrFrozenStopsTheArmAndTheCellResumes) {
       }
     }
   }
-  cell.SpinFor(1500ms);  // a diagnostics period
-  EXPECT_EQ(cell.DiagNumber("robot_sim", "true_contacts", -1), 0);
-  for (const std::string& svc : CellHarness::Services()) {
-    cell[svc].Signal(SIGTERM);
-    EXPECT_EQ(cell[svc].Wait(10s), 0) << svc << ":\n" << cell.Logs(svc);
-  }
+  cell.ExpectNoContactAndCleanShutdown();
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellFault,

@@ -147,6 +147,17 @@ class CellHarness {
     return it == procs_.end() || !it->second ? "" : it->second->Stderr();
   }
 
+  /// After a diagnostics period: the simulated robot never touched the
+  /// person (since its last start), and every service exits 0 on SIGTERM.
+  void ExpectNoContactAndCleanShutdown() {
+    SpinFor(std::chrono::milliseconds(1500));
+    EXPECT_EQ(DiagNumber("robot_sim", "true_contacts", -1), 0);
+    for (const std::string& svc : Services()) {
+      (*this)[svc].Signal(SIGTERM);
+      EXPECT_EQ((*this)[svc].Wait(std::chrono::seconds(10)), 0) << svc << ":\n" << Logs(svc);
+    }
+  }
+
   /// Spins the observer until `done()` or `timeout`; returns done().
   bool SpinUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
     const auto end = Clock::now() + timeout;
