@@ -2,6 +2,7 @@
 // (IVM action classifier + per-action SPGP forecasters) on recorded skeleton
 // data and evaluate it. The work is done by iplan::intent; this file only
 // parses options and prints.
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -80,11 +81,26 @@ void RunTrain(const TrainOptions& o) {
   const SkeletonDataset all = LoadSkeletonCsv(o.data);
   const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
   IntentModelConfig config;
-  config.joints = DefaultJointConfig(data.joint_names);
-  if (!o.joints.empty()) config.joints.joints = SplitList(o.joints);
-  if (!o.torso.empty()) config.joints.torso = SplitList(o.torso);
-  if (!o.hands.empty()) config.joints.hands = SplitList(o.hands == "none" ? "" : o.hands);
+  // The options first; defaults only for what they leave unset, computed
+  // from the chosen joints (a one-joint tracker has no default skeleton).
+  JointSelection selection;
+  if (!o.joints.empty()) selection.joints = SplitList(o.joints);
+  if (!o.torso.empty()) selection.torso = o.torso == "none" ? std::vector<std::string>{} : SplitList(o.torso);
+  if (!o.hands.empty()) selection.hands = o.hands == "none" ? std::vector<std::string>{} : SplitList(o.hands);
+  try {
+    config.joints = ResolveJointConfig(data.joint_names, selection);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(e.what()) + " (options --joints, --torso, --hands)");
+  }
   if (!o.objects.empty()) config.joints.objects = ParseObjects(o.objects);
+  if (o.normalise_size) {
+    for (const char* s : {"shoulder_l", "shoulder_r"}) {
+      if (std::find(config.joints.joints.begin(), config.joints.joints.end(), s) == config.joints.joints.end()) {
+        throw std::invalid_argument(std::string("--normalise-size needs the model joints shoulder_l and "
+                                                "shoulder_r; '") + s + "' is not one");
+      }
+    }
+  }
   config.rate = o.rate;
   config.window = o.window;
   config.horizon = o.horizon;
@@ -118,6 +134,10 @@ void RunTrain(const TrainOptions& o) {
   for (const std::string& j : config.joints.joints) std::cout << " " << j;
   std::cout << "\ntorso:";
   for (const std::string& j : config.joints.torso) std::cout << " " << j;
+  if (config.joints.torso.empty()) std::cout << " none (features are positions in the data frame)";
+  std::cout << "\nhands:";
+  for (const std::string& j : config.joints.hands) std::cout << " " << j;
+  if (config.joints.hands.empty()) std::cout << " none";
   std::cout << "\nactions:";
   for (const std::string& a : model.actions) std::cout << " " << a;
   std::cout << "\nclassifier: " << rep.num_classifier_samples << " windows, median DTW "
@@ -188,9 +208,14 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--data", t.data, "Skeleton CSV (shared layout)")->required();
   train->add_option("--subjects", t.subjects, "Training subjects, comma separated")->required();
   train->add_option("--out", t.out, "Model file to write")->required();
-  train->add_option("--joints", t.joints, "Model joints (default: upper-body set found in the data)");
-  train->add_option("--torso", t.torso, "Joints whose mean is the torso reference");
-  train->add_option("--hands", t.hands, "Hand joints for object distances ('none' for none)");
+  train->add_option("--joints", t.joints,
+                    "Model joints, any names of the data, 1 or more (default: upper-body set found in the data)");
+  train->add_option("--torso", t.torso,
+                    "Joints whose mean is the torso reference, or 'none': positions in the data frame "
+                    "(default: torso, spine, or shoulder_l+shoulder_r among the model joints)");
+  train->add_option("--hands", t.hands,
+                    "Hand joints for object distances, or 'none' (default: hand_l/hand_r, else "
+                    "wrist_l/wrist_r, among the model joints)");
   train->add_option("--objects", t.objects, "Task objects 'x,y,z;x,y,z' (m, data frame)");
   train->add_option("--rate", t.rate, "Model rate, Hz")->capture_default_str();
   train->add_option("--window,-T", t.window, "Window length T, frames")->capture_default_str();
@@ -210,7 +235,8 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--noise", t.noise, "Sensor noise std added to covariances, m")->capture_default_str();
   train->add_option("--max-gap", t.max_gap, "Recording gaps longer than this split sequences, s")->capture_default_str();
   train->add_option("--torso-weight", t.torso_weight, "Classifier weight of torso motion")->capture_default_str();
-  train->add_flag("--normalise-size", t.normalise_size, "Classifier features divided by shoulder width");
+  train->add_flag("--normalise-size", t.normalise_size,
+                  "Classifier features divided by shoulder width (needs joints shoulder_l, shoulder_r)");
   train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
   train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
 
