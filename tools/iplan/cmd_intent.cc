@@ -61,8 +61,12 @@ std::vector<Eigen::Vector3d> ParseObjects(const std::string& text) {
 
 struct TrainOptions {
   std::string data, subjects, out, joints, torso, hands, objects;
-  std::string sigma_factors, lambdas, prefixes, belief_taus;
-  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 1.0;
+  // Defaults: the settings of the figures in docs/intent.md (Florence 3D);
+  // the torso weight and the lambda grid differ from the library's
+  // (FrameFeatureOptions, TrainParams), see docs/intent.md "Known limits".
+  std::string sigma_factors, prefixes, belief_taus;
+  std::string lambdas = "1e-5,1e-4,1e-3";
+  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 3.0;
   bool normalise_size = false;
   double ivm_tolerance = 1e-3;
   int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80;
@@ -203,7 +207,9 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   intent->require_subcommand(1);
 
   auto train_opts = std::make_shared<TrainOptions>();
-  CLI::App* train = intent->add_subcommand("train", "Train an intent model from a skeleton CSV");
+  CLI::App* train = intent->add_subcommand(
+      "train", "Train an intent model from a skeleton CSV (defaults: the settings of the Florence figures in "
+               "docs/intent.md)");
   TrainOptions& t = *train_opts;
   train->add_option("--data", t.data, "Skeleton CSV (shared layout)")->required();
   train->add_option("--subjects", t.subjects, "Training subjects, comma separated")->required();
@@ -225,7 +231,7 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
   train->add_option("--ivm-tolerance", t.ivm_tolerance, "IVM stopping: relative decrease over 3 additions")->capture_default_str();
   train->add_option("--sigma-factors", t.sigma_factors, "CV kernel widths x median DTW (default 0.5,1,2)");
-  train->add_option("--lambdas", t.lambdas, "CV regularisers (default 1e-4,1e-3,1e-2)");
+  train->add_option("--lambdas", t.lambdas, "CV regularisers")->capture_default_str();
   train->add_option("--belief-taus", t.belief_taus,
                     "CV belief-filter time constants, s; inf allowed (default 0,0.25,0.5,1,2,4,inf)");
   train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
