@@ -2,6 +2,7 @@
 // (IVM action classifier + per-action SPGP forecasters) on recorded skeleton
 // data and evaluate it. The work is done by iplan::intent; this file only
 // parses options and prints.
+#include <algorithm>
 #include <chrono>
 #include <iostream>
 #include <memory>
@@ -60,8 +61,12 @@ std::vector<Eigen::Vector3d> ParseObjects(const std::string& text) {
 
 struct TrainOptions {
   std::string data, subjects, out, joints, torso, hands, objects;
-  std::string sigma_factors, lambdas, prefixes, belief_taus;
-  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 1.0;
+  // Defaults: the settings of the figures in docs/intent.md (Florence 3D);
+  // the torso weight and the lambda grid differ from the library's
+  // (FrameFeatureOptions, TrainParams), see docs/intent.md "Known limits".
+  std::string sigma_factors, prefixes, belief_taus;
+  std::string lambdas = "1e-5,1e-4,1e-3";
+  double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 3.0;
   bool normalise_size = false;
   double ivm_tolerance = 1e-3;
   int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80;
@@ -80,11 +85,26 @@ void RunTrain(const TrainOptions& o) {
   const SkeletonDataset all = LoadSkeletonCsv(o.data);
   const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
   IntentModelConfig config;
-  config.joints = DefaultJointConfig(data.joint_names);
-  if (!o.joints.empty()) config.joints.joints = SplitList(o.joints);
-  if (!o.torso.empty()) config.joints.torso = SplitList(o.torso);
-  if (!o.hands.empty()) config.joints.hands = SplitList(o.hands == "none" ? "" : o.hands);
+  // The options first; defaults only for what they leave unset, computed
+  // from the chosen joints (a one-joint tracker has no default skeleton).
+  JointSelection selection;
+  if (!o.joints.empty()) selection.joints = SplitList(o.joints);
+  if (!o.torso.empty()) selection.torso = o.torso == "none" ? std::vector<std::string>{} : SplitList(o.torso);
+  if (!o.hands.empty()) selection.hands = o.hands == "none" ? std::vector<std::string>{} : SplitList(o.hands);
+  try {
+    config.joints = ResolveJointConfig(data.joint_names, selection);
+  } catch (const std::invalid_argument& e) {
+    throw std::invalid_argument(std::string(e.what()) + " (options --joints, --torso, --hands)");
+  }
   if (!o.objects.empty()) config.joints.objects = ParseObjects(o.objects);
+  if (o.normalise_size) {
+    for (const char* s : {"shoulder_l", "shoulder_r"}) {
+      if (std::find(config.joints.joints.begin(), config.joints.joints.end(), s) == config.joints.joints.end()) {
+        throw std::invalid_argument(std::string("--normalise-size needs the model joints shoulder_l and "
+                                                "shoulder_r; '") + s + "' is not one");
+      }
+    }
+  }
   config.rate = o.rate;
   config.window = o.window;
   config.horizon = o.horizon;
@@ -118,6 +138,10 @@ void RunTrain(const TrainOptions& o) {
   for (const std::string& j : config.joints.joints) std::cout << " " << j;
   std::cout << "\ntorso:";
   for (const std::string& j : config.joints.torso) std::cout << " " << j;
+  if (config.joints.torso.empty()) std::cout << " none (features are positions in the data frame)";
+  std::cout << "\nhands:";
+  for (const std::string& j : config.joints.hands) std::cout << " " << j;
+  if (config.joints.hands.empty()) std::cout << " none";
   std::cout << "\nactions:";
   for (const std::string& a : model.actions) std::cout << " " << a;
   std::cout << "\nclassifier: " << rep.num_classifier_samples << " windows, median DTW "
@@ -183,14 +207,21 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   intent->require_subcommand(1);
 
   auto train_opts = std::make_shared<TrainOptions>();
-  CLI::App* train = intent->add_subcommand("train", "Train an intent model from a skeleton CSV");
+  CLI::App* train = intent->add_subcommand(
+      "train", "Train an intent model from a skeleton CSV (defaults: the settings of the Florence figures in "
+               "docs/intent.md)");
   TrainOptions& t = *train_opts;
   train->add_option("--data", t.data, "Skeleton CSV (shared layout)")->required();
   train->add_option("--subjects", t.subjects, "Training subjects, comma separated")->required();
   train->add_option("--out", t.out, "Model file to write")->required();
-  train->add_option("--joints", t.joints, "Model joints (default: upper-body set found in the data)");
-  train->add_option("--torso", t.torso, "Joints whose mean is the torso reference");
-  train->add_option("--hands", t.hands, "Hand joints for object distances ('none' for none)");
+  train->add_option("--joints", t.joints,
+                    "Model joints, any names of the data, 1 or more (default: upper-body set found in the data)");
+  train->add_option("--torso", t.torso,
+                    "Joints whose mean is the torso reference, or 'none': positions in the data frame "
+                    "(default: torso, spine, or shoulder_l+shoulder_r among the model joints)");
+  train->add_option("--hands", t.hands,
+                    "Hand joints for object distances, or 'none' (default: hand_l/hand_r, else "
+                    "wrist_l/wrist_r, among the model joints)");
   train->add_option("--objects", t.objects, "Task objects 'x,y,z;x,y,z' (m, data frame)");
   train->add_option("--rate", t.rate, "Model rate, Hz")->capture_default_str();
   train->add_option("--window,-T", t.window, "Window length T, frames")->capture_default_str();
@@ -200,7 +231,7 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
   train->add_option("--ivm-tolerance", t.ivm_tolerance, "IVM stopping: relative decrease over 3 additions")->capture_default_str();
   train->add_option("--sigma-factors", t.sigma_factors, "CV kernel widths x median DTW (default 0.5,1,2)");
-  train->add_option("--lambdas", t.lambdas, "CV regularisers (default 1e-4,1e-3,1e-2)");
+  train->add_option("--lambdas", t.lambdas, "CV regularisers")->capture_default_str();
   train->add_option("--belief-taus", t.belief_taus,
                     "CV belief-filter time constants, s; inf allowed (default 0,0.25,0.5,1,2,4,inf)");
   train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
@@ -210,7 +241,8 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--noise", t.noise, "Sensor noise std added to covariances, m")->capture_default_str();
   train->add_option("--max-gap", t.max_gap, "Recording gaps longer than this split sequences, s")->capture_default_str();
   train->add_option("--torso-weight", t.torso_weight, "Classifier weight of torso motion")->capture_default_str();
-  train->add_flag("--normalise-size", t.normalise_size, "Classifier features divided by shoulder width");
+  train->add_flag("--normalise-size", t.normalise_size,
+                  "Classifier features divided by shoulder width (needs joints shoulder_l, shoulder_r)");
   train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
   train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
 

@@ -87,8 +87,16 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   const intent::SkeletonDataset data =
       perception::RecordDemonstrations(person, kSubjects, kRepetitions, kSeconds, 30.0);
   intent::IntentModelConfig config;
-  config.joints = intent::DefaultJointConfig(data.joint_names);
-  config.joints.joints = joints;
+  // The configured joints, torso and hands defaulted among them (not among
+  // the person's), so that any joint set of intent.yaml trains or is refused
+  // with the joint named.
+  intent::JointSelection selection;
+  selection.joints = joints;
+  try {
+    config.joints = intent::ResolveJointConfig(data.joint_names, selection);
+  } catch (const std::invalid_argument& e) {
+    throw std::runtime_error(intent_yaml + ": key 'intent.joints': " + e.what());
+  }
   for (const auto& a : person.actions) {
     if (a.kind != perception::MotionKind::kRest) config.joints.objects.push_back(a.target_W);
   }

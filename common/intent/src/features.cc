@@ -18,20 +18,34 @@ bool Has(const std::vector<std::string>& names, const std::string& n) {
   return IndexOf(names, n) >= 0;
 }
 
+std::string Join(const std::vector<std::string>& names) {
+  std::string s = "[";
+  for (size_t i = 0; i < names.size(); ++i) s += (i ? "," : "") + names[i];
+  return s + "]";
+}
+
 }  // namespace
 
 std::string JointConfig::Validate() const {
   if (joints.empty()) return "joint list is empty";
   std::set<std::string> unique;
   for (const std::string& j : joints) {
+    if (j.empty()) return "a joint name is empty";
     if (!unique.insert(j).second) return "joint '" + j + "' listed twice";
   }
-  if (torso.empty()) return "no torso reference joint given";
+  std::set<std::string> torso_unique;
   for (const std::string& t : torso) {
-    if (!Has(joints, t)) return "torso joint '" + t + "' is not a model joint";
+    if (!Has(joints, t)) {
+      return "torso joint '" + t + "' is not a model joint (joints: " + Join(joints) + ")";
+    }
+    if (!torso_unique.insert(t).second) return "torso joint '" + t + "' listed twice";
   }
+  std::set<std::string> hand_unique;
   for (const std::string& h : hands) {
-    if (!Has(joints, h)) return "hand joint '" + h + "' is not a model joint";
+    if (!Has(joints, h)) {
+      return "hand joint '" + h + "' is not a model joint (joints: " + Join(joints) + ")";
+    }
+    if (!hand_unique.insert(h).second) return "hand joint '" + h + "' listed twice";
   }
   for (const Eigen::Vector3d& o : objects) {
     if (!o.allFinite()) return "task object position is not finite";
@@ -40,41 +54,66 @@ std::string JointConfig::Validate() const {
 }
 
 JointConfig DefaultJointConfig(const std::vector<std::string>& available) {
+  return ResolveJointConfig(available, JointSelection{});
+}
+
+JointConfig ResolveJointConfig(const std::vector<std::string>& available,
+                               const JointSelection& selection) {
   JointConfig c;
-  auto pick = [&](std::initializer_list<const char*> aliases) -> std::string {
+  // The first of `aliases` found in `names`, or "".
+  auto pick = [](const std::vector<std::string>& names,
+                 std::initializer_list<const char*> aliases) -> std::string {
     for (const char* a : aliases) {
-      if (Has(available, a)) return a;
+      if (Has(names, a)) return a;
     }
     return "";
   };
-  const std::string head = pick({"head"});
-  const std::string neck = pick({"neck", "shoulder_center"});
-  const std::string torso = pick({"torso", "spine"});
-  const std::string hand_l = pick({"hand_l", "wrist_l"});
-  const std::string hand_r = pick({"hand_r", "wrist_r"});
-  for (const std::string& j :
-       {head, neck, torso, std::string(pick({"shoulder_l"})),
-        std::string(pick({"elbow_l"})), hand_l,
-        std::string(pick({"shoulder_r"})), std::string(pick({"elbow_r"})),
-        hand_r}) {
-    if (!j.empty()) c.joints.push_back(j);
+  if (selection.joints.has_value()) {
+    for (const std::string& j : *selection.joints) {
+      if (!Has(available, j)) {
+        throw std::invalid_argument("joint '" + j + "' is not in the data (data joints: " +
+                                    Join(available) + ")");
+      }
+    }
+    c.joints = *selection.joints;
+  } else {
+    for (const std::string& j :
+         {pick(available, {"head"}), pick(available, {"neck", "shoulder_center"}),
+          pick(available, {"torso", "spine"}), pick(available, {"shoulder_l"}),
+          pick(available, {"elbow_l"}), pick(available, {"hand_l", "wrist_l"}),
+          pick(available, {"shoulder_r"}), pick(available, {"elbow_r"}),
+          pick(available, {"hand_r", "wrist_r"})}) {
+      if (!j.empty()) c.joints.push_back(j);
+    }
+    if (c.joints.size() < 2) {
+      throw std::invalid_argument(
+          "the data has fewer than two of the default "
+          "upper-body joints (head, neck, torso, shoulder/elbow/hand l/r); "
+          "name the model joints (data joints: " + Join(available) + ")");
+    }
   }
-  if (c.joints.size() < 2) {
-    throw std::invalid_argument(
-        "DefaultJointConfig: the data has fewer than two of the default "
-        "upper-body joints (head, neck, torso, shoulder/elbow/hand l/r)");
-  }
-  if (!torso.empty()) {
+  if (selection.torso.has_value()) {
+    c.torso = *selection.torso;
+  } else if (const std::string torso = pick(c.joints, {"torso", "spine"}); !torso.empty()) {
     c.torso = {torso};
   } else if (Has(c.joints, "shoulder_l") && Has(c.joints, "shoulder_r")) {
     c.torso = {"shoulder_l", "shoulder_r"};
   } else {
     throw std::invalid_argument(
-        "DefaultJointConfig: no torso joint and no pair of shoulders to "
-        "define the torso reference");
+        "no default torso reference among the joints " + Join(c.joints) +
+        " (torso, spine, or shoulder_l and shoulder_r): name the torso "
+        "joints, e.g. one of the joints itself, or none");
   }
-  if (!hand_l.empty()) c.hands.push_back(hand_l);
-  if (!hand_r.empty()) c.hands.push_back(hand_r);
+  if (selection.hands.has_value()) {
+    c.hands = *selection.hands;
+  } else {
+    for (const std::string& h : {pick(c.joints, {"hand_l", "wrist_l"}),
+                                 pick(c.joints, {"hand_r", "wrist_r"})}) {
+      if (!h.empty()) c.hands.push_back(h);
+    }
+  }
+  const std::string error = c.Validate();
+  if (!error.empty()) throw std::invalid_argument("JointConfig: " + error);
   return c;
 }
 
@@ -93,6 +132,7 @@ FeatureLayout::FeatureLayout(const JointConfig& config, const FrameFeatureOption
 Eigen::Vector3d FeatureLayout::Torso(
     const Eigen::Ref<const Eigen::RowVectorXd>& frame) const {
   Eigen::Vector3d p = Eigen::Vector3d::Zero();
+  if (torso_index_.empty()) return p;  // no torso: the origin of W
   for (int t : torso_index_) p += frame.segment<3>(3 * t).transpose();
   return p / static_cast<double>(torso_index_.size());
 }

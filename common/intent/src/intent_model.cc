@@ -149,6 +149,14 @@ int MixturePrediction::MostLikely() const {
 
 std::vector<Track> MakeTracks(const SkeletonDataset& data, const IntentModelConfig& config,
                               double max_gap) {
+  for (const std::string& j : config.joints.joints) {
+    if (std::find(data.joint_names.begin(), data.joint_names.end(), j) == data.joint_names.end()) {
+      std::string list;
+      for (const std::string& a : data.joint_names) list += (list.empty() ? "" : ",") + a;
+      throw std::invalid_argument("model joint '" + j + "' is not in the data (data joints: " +
+                                  list + ")");
+    }
+  }
   const std::vector<int> idx = JointIndices(data.joint_names, config.joints.joints);
   std::vector<Track> tracks;
   for (const SkeletonSequence& s : data.sequences) {

@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -120,6 +121,29 @@ std::string JoinNames(const std::vector<std::string>& v) {
   std::string s = "[";
   for (size_t i = 0; i < v.size(); ++i) s += (i ? "," : "") + v[i];
   return s + "]";
+}
+
+// The first difference between the model's and the configured joint lists,
+// naming the joint.
+std::string JointDifference(const std::vector<std::string>& model,
+                            const std::vector<std::string>& configured) {
+  for (const std::string& j : configured) {
+    if (std::find(model.begin(), model.end(), j) == model.end()) {
+      return "configured joint '" + j + "' is not a model joint";
+    }
+  }
+  for (const std::string& j : model) {
+    if (std::find(configured.begin(), configured.end(), j) == configured.end()) {
+      return "model joint '" + j + "' is not configured";
+    }
+  }
+  for (size_t i = 0; i < model.size() && i < configured.size(); ++i) {
+    if (model[i] != configured[i]) {
+      return "joint " + std::to_string(i + 1) + " is '" + model[i] + "' in the model but '" +
+             configured[i] + "' in the configuration (same joints, other order)";
+    }
+  }
+  return "a joint is listed twice";
 }
 
 void ThrowErrno(const std::string& what, const std::string& path) {
@@ -332,7 +356,8 @@ IntentModel LoadIntentModel(const std::string& path, const ModelExpectation& exp
   IntentModel m = DeserializeIntentModel(ss.str(), path);
   if (!expected.joints.empty() && expected.joints != m.config.joints.joints) {
     throw std::runtime_error(path + ": model joints " + JoinNames(m.config.joints.joints) +
-                             " do not match the configured joints " + JoinNames(expected.joints));
+                             " do not match the configured joints " + JoinNames(expected.joints) +
+                             ": " + JointDifference(m.config.joints.joints, expected.joints));
   }
   if (expected.rate.has_value() &&
       std::abs(*expected.rate - m.config.rate) > 1e-9 * std::abs(*expected.rate)) {

@@ -190,6 +190,133 @@ TEST_F(IntentModelTest, EvalJsonHasTheDocumentedKeys) {
   }
 }
 
+// Recorded Florence 3D sequences of `subjects` as a tracker that gives only
+// the joints `keep` would deliver them (the other columns are dropped).
+SkeletonDataset FlorenceOnly(const std::vector<std::string>& keep,
+                             const std::vector<std::string>& subjects) {
+  static const SkeletonDataset all =
+      LoadSkeletonCsv(std::string(IPLAN_SHARED_DIR) + "/data/florence3d.csv");
+  SkeletonDataset d = SelectSubjects(all, subjects);
+  const std::vector<int> idx = JointIndices(d.joint_names, keep);
+  for (SkeletonSequence& s : d.sequences) {
+    Eigen::MatrixXd p(s.positions.rows(), 3 * static_cast<Eigen::Index>(idx.size()));
+    for (size_t j = 0; j < idx.size(); ++j) p.middleCols(3 * j, 3) = s.positions.middleCols(3 * idx[j], 3);
+    s.positions = p;
+  }
+  d.joint_names = keep;
+  return d;
+}
+
+IntentModelConfig OneJointConfig(const std::vector<std::string>& torso) {
+  IntentModelConfig c;
+  JointSelection wrist;
+  wrist.joints = std::vector<std::string>{"wrist_r"};
+  wrist.torso = torso;
+  wrist.hands = std::vector<std::string>{};
+  c.joints = ResolveJointConfig({"wrist_r"}, wrist);
+  c.rate = 15.0;
+  c.window = 8;
+  c.horizon = 5;
+  return c;
+}
+
+void ExpectFinitePrediction(const MixturePrediction& pred, int horizon) {
+  ASSERT_EQ(pred.num_joints, 1);
+  ASSERT_EQ(pred.horizon, horizon);
+  double sum = 0.0;
+  for (const ActionHypothesis& h : pred.actions) {
+    sum += h.probability;
+    ASSERT_EQ(h.joints.size(), static_cast<size_t>(horizon));
+    for (const JointGaussian& g : h.joints) {
+      EXPECT_TRUE(g.mean.allFinite());
+      EXPECT_TRUE(g.covariance.allFinite());
+      EXPECT_GT(g.covariance.diagonal().minCoeff(), 0.0);
+    }
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+}
+
+// A wrist-only tracker (METHOD 1: any joint set): the model trains, predicts,
+// evaluates and survives its file, with the wrist itself or no torso as the
+// reference.
+TEST(OneJointModelTest, WristOnlyModelTrainsPredictsAndEvaluates) {
+  const SkeletonDataset train = FlorenceOnly({"wrist_r"}, {"s01", "s03"});
+  const SkeletonDataset test = FlorenceOnly({"wrist_r"}, {"s02"});
+  for (const std::vector<std::string>& torso : {std::vector<std::string>{"wrist_r"}, std::vector<std::string>{}}) {
+    SCOPED_TRACE(torso.empty() ? "torso none" : "torso wrist_r");
+    const IntentModel model = TrainIntentModel(train, OneJointConfig(torso), SmallParams());
+    EXPECT_EQ(model.config.joints.torso, torso);
+    EXPECT_EQ(model.actions.size(), 9u);
+    MixturePrediction pred;
+    PredictIntent(model, test.sequences[0].positions.topRows(10), &pred);
+    ExpectFinitePrediction(pred, 5);
+    PredictIntent(model, test.sequences[3].positions.topRows(1), &pred);  // a single frame
+    ExpectFinitePrediction(pred, 5);
+    const EvalReport r = EvaluateIntentModel(model, test, EvalParams{});
+    EXPECT_EQ(r.num_sequences, static_cast<int>(test.sequences.size()));
+    for (double a : r.accuracy) EXPECT_TRUE(std::isfinite(a));
+    const IntentModel loaded = DeserializeIntentModel(SerializeIntentModel(model), "one-joint");
+    EXPECT_EQ(loaded.config.joints.torso, torso);
+    EXPECT_EQ(SerializeIntentModel(loaded), SerializeIntentModel(model));
+  }
+}
+
+TEST(OneJointModelTest, MismatchedJointSetsAreRefusedNamingTheJoint) {
+  // Train time: the configuration names a joint the data does not have.
+  const SkeletonDataset wrist = FlorenceOnly({"wrist_r"}, {"s01", "s03"});
+  IntentModelConfig two = OneJointConfig({});
+  two.joints.joints = {"wrist_r", "wrist_l"};
+  try {
+    TrainIntentModel(wrist, two, SmallParams());
+    ADD_FAILURE() << "training on data without wrist_l should fail";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("model joint 'wrist_l' is not in the data (data joints: wrist_r)"),
+              std::string::npos)
+        << e.what();
+  }
+  // Evaluation data without the model's joint.
+  TrainParams p = SmallParams();
+  p.belief_time_constants = {0.0};
+  const IntentModel model = TrainIntentModel(wrist, OneJointConfig({"wrist_r"}), p);
+  try {
+    EvaluateIntentModel(model, FlorenceOnly({"wrist_l"}, {"s02"}), EvalParams{});
+    ADD_FAILURE() << "evaluating on data without wrist_r should fail";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("model joint 'wrist_r' is not in the data"), std::string::npos) << e.what();
+  }
+  // Service start: the configured joints against the model's.
+  const std::string path = ::testing::TempDir() + "/one_joint.model";
+  SaveIntentModel(model, path);
+  ModelExpectation other;
+  other.joints = {"hand_r"};
+  ExpectLoadFails(path, other,
+                  "model joints [wrist_r] do not match the configured joints [hand_r]: configured joint 'hand_r' "
+                  "is not a model joint");
+  other.joints = {"wrist_r", "wrist_l"};
+  ExpectLoadFails(path, other, "configured joint 'wrist_l' is not a model joint");
+  other.joints = {"wrist_r"};
+  EXPECT_NO_THROW(LoadIntentModel(path, other));
+}
+
+TEST(ModelIoTest, JointMismatchMessagesNameTheJoint) {
+  const SkeletonDataset d = MakeDataset(4);
+  TrainParams p = SmallParams();
+  p.belief_time_constants = {0.0};
+  p.gp_iterations = 2;
+  const IntentModel model = TrainIntentModel(d, SmallConfig(d), p);
+  const std::string path = ::testing::TempDir() + "/six_joints.model";
+  SaveIntentModel(model, path);
+  ModelExpectation e;
+  e.joints = model.config.joints.joints;
+  e.joints.pop_back();
+  ExpectLoadFails(path, e, "model joint '" + model.config.joints.joints.back() + "' is not configured");
+  e.joints = model.config.joints.joints;
+  std::swap(e.joints[0], e.joints[1]);
+  ExpectLoadFails(path, e,
+                  "joint 1 is '" + model.config.joints.joints[0] + "' in the model but '" +
+                      model.config.joints.joints[1] + "' in the configuration");
+}
+
 TEST(IntentModelConfigTest, InvalidConfigurationIsNamed) {
   IntentModelConfig c;
   c.joints.joints = {"a"};

@@ -133,6 +133,99 @@ TEST(FeaturesTest, FeaturesRelativeToTorsoAndObjects) {
   EXPECT_NE(bad.Validate().find("torso joint 'pelvis'"), std::string::npos);
 }
 
+// Throws std::invalid_argument whose message contains `fragment`.
+template <typename F>
+void ExpectInvalid(const F& f, const std::string& fragment) {
+  try {
+    f();
+    ADD_FAILURE() << "expected std::invalid_argument with: " << fragment;
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find(fragment), std::string::npos) << "message: " << e.what();
+  }
+}
+
+TEST(FeaturesTest, SelectedJointsAreHonouredBeforeAnyDefault) {
+  // A tracker that gives one wrist only: no default skeleton exists, so the
+  // default must not be computed for the parts that are named.
+  const std::vector<std::string> wrist = {"wrist_r"};
+  ExpectInvalid([&] { DefaultJointConfig(wrist); }, "fewer than two of the default");
+  JointSelection one;
+  one.joints = wrist;
+  one.torso = wrist;
+  one.hands = std::vector<std::string>{};
+  const JointConfig self = ResolveJointConfig(wrist, one);
+  EXPECT_EQ(self.joints, wrist);
+  EXPECT_EQ(self.torso, wrist);
+  EXPECT_TRUE(self.hands.empty());
+  one.torso = std::vector<std::string>{};  // none
+  EXPECT_TRUE(ResolveJointConfig(wrist, one).torso.empty());
+  // Hands default among the chosen joints; the torso has no default there.
+  one.hands.reset();
+  EXPECT_EQ(ResolveJointConfig(wrist, one).hands, wrist);
+  one.torso.reset();
+  ExpectInvalid([&] { ResolveJointConfig(wrist, one); }, "no default torso reference among the joints [wrist_r]");
+  // Names are the data's own, e.g. a 33-joint body tracker's.
+  JointSelection own;
+  own.joints = std::vector<std::string>{"left_index", "right_index", "nose"};
+  own.torso = std::vector<std::string>{"nose"};
+  const JointConfig mp = ResolveJointConfig({"nose", "left_index", "right_index", "left_heel"}, own);
+  EXPECT_EQ(mp.joints.size(), 3u);
+  EXPECT_TRUE(mp.hands.empty());
+  // Default torso and hands among a chosen subset of a full skeleton.
+  JointSelection arms;
+  arms.joints = std::vector<std::string>{"shoulder_l", "shoulder_r", "wrist_r"};
+  const JointConfig a = ResolveJointConfig({"head", "torso", "shoulder_l", "shoulder_r", "wrist_r"}, arms);
+  EXPECT_EQ(a.torso, (std::vector<std::string>{"shoulder_l", "shoulder_r"}));  // not the data's torso
+  EXPECT_EQ(a.hands, wrist);
+}
+
+TEST(FeaturesTest, MismatchedJointSetsAreRefusedNamingTheJoint) {
+  JointSelection s;
+  s.joints = std::vector<std::string>{"wrist_r", "wrist_l"};
+  ExpectInvalid([&] { ResolveJointConfig({"wrist_r", "elbow_r"}, s); },
+                "joint 'wrist_l' is not in the data (data joints: [wrist_r,elbow_r])");
+  s.joints = std::vector<std::string>{"wrist_r"};
+  s.torso = std::vector<std::string>{"elbow_r"};
+  ExpectInvalid([&] { ResolveJointConfig({"wrist_r", "elbow_r"}, s); },
+                "torso joint 'elbow_r' is not a model joint (joints: [wrist_r])");
+  s.torso = std::vector<std::string>{};
+  s.hands = std::vector<std::string>{"hand_r"};
+  ExpectInvalid([&] { ResolveJointConfig({"wrist_r", "elbow_r"}, s); }, "hand joint 'hand_r' is not a model joint");
+}
+
+TEST(FeaturesTest, OneJointFeaturesWithTheJointOrNoTorsoAsReference) {
+  // One wrist moving by (0.1, 0.2, 0) per frame at 10 Hz.
+  Eigen::MatrixXd w(3, 3);
+  w << 1.0, 0.0, 2.0, 1.1, 0.2, 2.0, 1.2, 0.4, 2.0;
+  JointConfig self;
+  self.joints = {"wrist_r"};
+  self.torso = {"wrist_r"};
+  const FeatureLayout own(self);
+  ASSERT_EQ(own.frame_feature_size(), 6);
+  ASSERT_EQ(own.forecast_input_size(), 12);
+  const Eigen::MatrixXd f = own.FrameFeatures(w);
+  EXPECT_EQ(f.leftCols(3).norm(), 0.0);                      // the joint relative to itself
+  EXPECT_NEAR(f(0, 3), -0.2, 1e-12);                         // its motion relative to the newest frame
+  EXPECT_NEAR(f(0, 4), -0.4, 1e-12);
+  const Eigen::VectorXd x = own.ForecastInput(w, 10.0, 1);
+  EXPECT_EQ(x.head(6).norm(), 0.0);                          // pose and velocity relative to itself
+  EXPECT_NEAR((x.segment<3>(6) - Eigen::Vector3d(1.0, 2.0, 0.0)).norm(), 0.0, 1e-12);  // its velocity, m/s
+  EXPECT_NEAR((x.segment<3>(9) - Eigen::Vector3d(0.2, 0.4, 0.0)).norm(), 0.0, 1e-12);  // displacement, m
+
+  JointConfig none = self;
+  none.torso.clear();
+  ASSERT_EQ(none.Validate(), "");
+  const FeatureLayout abs(none);
+  EXPECT_EQ(abs.Torso(w.row(2)), Eigen::Vector3d::Zero());
+  const Eigen::MatrixXd g = abs.FrameFeatures(w);
+  EXPECT_EQ(g.leftCols(3), w);                               // positions in W
+  EXPECT_EQ(g.rightCols(3).norm(), 0.0);                     // no torso motion
+  const Eigen::VectorXd y = abs.ForecastInput(w, 10.0, 1);
+  EXPECT_NEAR((y.head(3) - w.row(2).transpose()).norm(), 0.0, 1e-12);
+  EXPECT_NEAR((y.segment<3>(3) - Eigen::Vector3d(1.0, 2.0, 0.0)).norm(), 0.0, 1e-12);
+  EXPECT_EQ(y.tail(6).norm(), 0.0);
+}
+
 }  // namespace
 }  // namespace iplan::intent
 

@@ -274,6 +274,75 @@ TEST_F(IntentEstimatorTest, HistoryIsBoundedByTheWindowSpan) {
   EXPECT_LE(est.buffered_frames(1), static_cast<int>(std::ceil(span * 30)) + 2);
 }
 
+// A tracker that gives one wrist only (recorded Florence 3D wrist_r): the
+// model has one joint and no torso, the service's skeletons one joint.
+TEST(OneJointEstimatorTest, AcceptsOneJointSkeletonsAndRejectsFramesWithoutIt) {
+  const intent::SkeletonDataset all = intent::LoadSkeletonCsv(std::string(IPLAN_SHARED_DIR) + "/data/florence3d.csv");
+  const int wrist = intent::JointIndices(all.joint_names, {"wrist_r"})[0];
+  auto only_wrist = [&](const std::vector<std::string>& subjects) {
+    intent::SkeletonDataset d = intent::SelectSubjects(all, subjects);
+    for (auto& s : d.sequences) s.positions = Eigen::MatrixXd(s.positions.middleCols(3 * wrist, 3));
+    d.joint_names = {"wrist_r"};
+    return d;
+  };
+  intent::IntentModelConfig c;
+  intent::JointSelection sel;
+  sel.joints = std::vector<std::string>{"wrist_r"};
+  sel.torso = std::vector<std::string>{};  // none
+  sel.hands = std::vector<std::string>{};
+  c.joints = intent::ResolveJointConfig({"wrist_r"}, sel);
+  c.rate = 15.0;
+  c.window = 6;
+  c.horizon = 4;
+  intent::TrainParams p;
+  p.sigma_factors = {1.0};
+  p.lambdas = {1e-3};
+  p.pseudo_inputs = 6;
+  p.gp_iterations = 15;
+  p.max_forecast_windows = 60;
+  auto model = std::make_shared<const IntentModel>(intent::TrainIntentModel(only_wrist({"s01", "s03"}), c, p));
+  IntentEstimator est(model, {});
+  ASSERT_EQ(est.joint_names(), std::vector<std::string>{"wrist_r"});
+
+  const intent::SkeletonDataset played = only_wrist({"s02"});
+  const intent::SkeletonSequence& seq = played.sequences.at(0);
+  MixturePrediction got;
+  for (Eigen::Index i = 0; i < seq.positions.rows(); ++i) {
+    SkeletonFrame f;
+    f.body_id = 4;
+    f.stamp = 100.0 + seq.time(i);
+    f.joints.push_back({"wrist_r", seq.positions.row(i).transpose()});
+    f.joints.push_back({"wrist_l", Eigen::Vector3d(0.1, 0.2, 2.0)});  // not a model joint: ignored
+    const FrameResult r = est.Update(f, &got);
+    ASSERT_TRUE(r.accepted()) << r.reason;
+    ASSERT_EQ(got.num_joints, 1);
+    ASSERT_EQ(got.horizon, 4);
+    double sum = 0;
+    for (const auto& h : got.actions) {
+      sum += h.probability;
+      ASSERT_EQ(h.joints.size(), 4u);
+      for (const auto& g : h.joints) {
+        EXPECT_TRUE(g.mean.allFinite());
+        EXPECT_TRUE(g.covariance.allFinite());
+      }
+    }
+    EXPECT_NEAR(sum, 1.0, 1e-9);
+  }
+  // Forecasts are positions in the skeletons' frame: one step (1/15 s) ahead
+  // the wrist is near where it is now.
+  const Eigen::Vector3d now = seq.positions.bottomRows(1).transpose();
+  for (int a = 0; a < static_cast<int>(got.actions.size()); ++a) EXPECT_LE((got.At(a, 0, 0).mean - now).norm(), 0.3);
+
+  // A skeleton without the model's joint is a counted rejection naming it.
+  SkeletonFrame no_wrist;
+  no_wrist.body_id = 4;
+  no_wrist.stamp = 200.0;
+  no_wrist.joints.push_back({"wrist_l", Eigen::Vector3d(0.1, 0.2, 2.0)});
+  const FrameResult r = est.Update(no_wrist, &got);
+  EXPECT_EQ(r.status, FrameStatus::kMissingJoint);
+  EXPECT_NE(r.reason.find("model joints missing from the frame: wrist_r"), std::string::npos) << r.reason;
+}
+
 TEST(IntentEstimatorParamsTest, InvalidParamsAreNamed) {
   IntentEstimatorParams p;
   EXPECT_EQ(p.Validate(), "");

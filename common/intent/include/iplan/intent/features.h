@@ -7,6 +7,7 @@
 // still before tracking started).
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,22 +16,53 @@
 namespace iplan::intent {
 
 /// Which joints the model uses and how the torso and hands are defined.
+/// Any joint set works, from one joint (a tracked wrist) to a full body; the
+/// names are those of the data and never interpreted, except by the defaults
+/// (DefaultJointConfig, ResolveJointConfig) and the optional body-size
+/// normalisation (FrameFeatureOptions::normalise_body_size).
 struct JointConfig {
-  /// Model joints, in output order (J names). Every name must exist in the data.
+  /// Model joints, in output order (J >= 1 names). Every name must exist in the data.
   std::vector<std::string> joints;
-  /// The torso reference point is the mean of these joints (names from
-  /// `joints`), e.g. {"torso"} or {"shoulder_l", "shoulder_r"}.
+  /// The torso reference point p_WT is the mean of these joints (names from
+  /// `joints`), e.g. {"torso"} or {"shoulder_l", "shoulder_r"}. "Relative to
+  /// the torso" in the features means relative to p_WT:
+  ///  - a joint of its own, e.g. {"wrist_r"} for a one-joint model: that
+  ///    joint's posture block is zero, the torso-motion block and the
+  ///    forecaster's torso velocity and displacement carry its own motion;
+  ///    the features do not depend on where the person is (translation
+  ///    invariant), only on how the joints move;
+  ///  - empty (no torso, "none"): p_WT is the origin of W, so the features
+  ///    are absolute positions in W (posture block = p_WJ, torso-motion,
+  ///    torso velocity and displacement blocks = 0); the model then depends on
+  ///    where in W the motion happens (use it when the data frame is the cell's
+  ///    world frame and the location itself is telling).
   std::vector<std::string> torso;
   /// Hand joints (names from `joints`) used for hand-object distances; may be
-  /// empty.
+  /// empty (then, or without objects, there are no hand-object features).
   std::vector<std::string> hands;
   /// Task object positions p_WO (metres, frame W). May be empty: datasets
   /// without objects simply have no hand-object features.
   std::vector<Eigen::Vector3d> objects;
 
-  /// Returns an empty string when valid, otherwise what is wrong (empty joint
-  /// list, duplicate joint, torso/hand name not among `joints`, no torso).
+  /// Returns an empty string when valid, otherwise what is wrong, naming the
+  /// joint (empty joint list, empty or duplicate joint name, torso/hand name
+  /// not among `joints`, duplicate torso/hand name, non-finite object).
   std::string Validate() const;
+};
+
+/// A joint set as configured (CLI --joints/--torso/--hands, a config file):
+/// every part that is set is used as given; only the unset parts get a
+/// default, computed from the chosen joints (not from the data's).
+struct JointSelection {
+  /// Model joints; unset: the default upper-body set found in the data.
+  std::optional<std::vector<std::string>> joints;
+  /// Torso reference joints; unset: the default among `joints` (torso or
+  /// spine, else shoulder_l and shoulder_r); set and empty: no torso (see
+  /// JointConfig::torso).
+  std::optional<std::vector<std::string>> torso;
+  /// Hand joints; unset: hand_l/hand_r, else wrist_l/wrist_r, among `joints`;
+  /// set and empty: none.
+  std::optional<std::vector<std::string>> hands;
 };
 
 /// Options of the per-frame classifier features.
@@ -49,10 +81,23 @@ struct FrameFeatureOptions {
 /// accepting the usual aliases: neck = shoulder_center, torso = spine, hand =
 /// wrist when there is no hand joint. Joints the dataset lacks are left out;
 /// when there is no torso joint the torso is the mean of the shoulders.
-/// Hands are hand_l/hand_r, else wrist_l/wrist_r, when present.
+/// Hands are hand_l/hand_r, else wrist_l/wrist_r, when present. Same as
+/// ResolveJointConfig(available, {}).
 /// Throws std::invalid_argument when fewer than two default joints or no
-/// torso reference can be found.
+/// torso reference can be found (other joint sets must be named: see
+/// ResolveJointConfig).
 JointConfig DefaultJointConfig(const std::vector<std::string>& available);
+
+/// The joint configuration for data providing the joints `available`: the
+/// parts set in `selection` as given, defaults (see JointSelection) only for
+/// the unset ones. Objects are left empty.
+/// Throws std::invalid_argument, naming the joint, when a selected joint is
+/// not in `available`, when a default is needed but cannot be found (fewer
+/// than two default joints; no torso reference among the chosen joints), or
+/// when the result is invalid (JointConfig::Validate, e.g. a torso joint that
+/// is not a model joint).
+JointConfig ResolveJointConfig(const std::vector<std::string>& available,
+                               const JointSelection& selection);
 
 /// Index helpers derived from a validated JointConfig.
 class FeatureLayout {
@@ -72,7 +117,8 @@ class FeatureLayout {
     return static_cast<int>(hand_index_.size() * objects_.size());
   }
 
-  /// Torso reference p_WT of one frame row (3 J) in metres, frame W.
+  /// Torso reference p_WT of one frame row (3 J) in metres, frame W; the
+  /// origin of W when the configuration has no torso joints.
   Eigen::Vector3d Torso(const Eigen::Ref<const Eigen::RowVectorXd>& frame) const;
 
   /// Per-frame classifier features of a padded window (T, 3 J): for each row s,

@@ -161,16 +161,18 @@ struct TrainReport {
 };
 
 /// Trains a model on `data` (its subjects are the cross-validation folds).
-/// Throws std::invalid_argument for invalid config/params, joints missing from
-/// the data, or fewer than two actions. Deterministic for a given seed.
-/// Single-threaded.
+/// Throws std::invalid_argument for invalid config/params, a model joint
+/// missing from the data (the message names it), or fewer than two actions.
+/// Any valid JointConfig works, including one joint without a torso.
+/// Deterministic for a given seed. Single-threaded.
 IntentModel TrainIntentModel(const SkeletonDataset& data,
                              const IntentModelConfig& config,
                              const TrainParams& params,
                              TrainReport* report = nullptr);
 
 /// Resamples every sequence of `data` to the model joints and rate.
-/// Throws std::invalid_argument when a model joint is missing from the data.
+/// Throws std::invalid_argument naming the first model joint missing from the
+/// data.
 std::vector<Track> MakeTracks(const SkeletonDataset& data,
                               const IntentModelConfig& config, double max_gap);
 

@@ -44,8 +44,9 @@ void SaveIntentModel(const IntentModel& model, const std::string& path);
 
 /// Reads a model file and, if `expected` is given, checks that the model's
 /// joint set and rate match it. Throws std::runtime_error naming the file and
-/// the mismatching values (e.g. "model joints [a,b] do not match the
-/// configured joints [a,c]").
+/// the mismatching values and the first mismatching joint (e.g. "model
+/// joints [a,b] do not match the configured joints [a,c]: configured joint
+/// 'c' is not a model joint").
 IntentModel LoadIntentModel(const std::string& path,
                             const ModelExpectation& expected = ModelExpectation{});
 
