@@ -69,6 +69,39 @@ INSTANTIATE_TEST_SUITE_P(
                       BadConfig{"perception:\n  replay:\n    transform:\n      matrix: [1, 0, 0]\n",
                                 "key 'perception.replay.transform.matrix': must have 16 numbers"}));
 
+// The fail-safe settings: a supervisor in deployment that watches nothing,
+// a key written twice, an empty file, a robot obeying no monitor, a permit
+// validity that one late permit would lapse.
+struct SafetyConfig {
+  std::string service;
+  std::string yaml;
+  std::string expected;
+};
+class RefusedSafetyConfig : public ::testing::TestWithParam<SafetyConfig> {};
+
+TEST_P(RefusedSafetyConfig, ExitsWithCode2NamingTheProblem) {
+  const std::string file = WriteTemp(GetParam().service + "-bad.yaml", GetParam().yaml);
+  Process p({BinPath("iplan-" + GetParam().service), "--config", file, "--check-config", "--domain",
+             std::to_string(UniqueDomain(6))});
+  const auto rc = p.Wait(20s);
+  ASSERT_TRUE(rc.has_value()) << "service did not refuse the configuration";
+  EXPECT_EQ(*rc, 2) << p.Stdout() << p.Stderr();
+  EXPECT_NE(p.Stderr().find(GetParam().expected), std::string::npos) << p.Stderr();
+  std::remove(file.c_str());
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Cases, RefusedSafetyConfig,
+    ::testing::Values(
+        SafetyConfig{"supervisor", "supervisor:\n  mode: deployment\n  watch: []\n",
+                     "key 'supervisor.watch': must name at least one topic in deployment"},
+        SafetyConfig{"supervisor", "supervisor:\n  permit_period: 0.1\n  permit_validity: 0.15\n",
+                     "key 'supervisor.permit_validity': must be at least twice permit_period"},
+        SafetyConfig{"supervisor", "supervisor:\n  alpha: 0.1\n  alpha: 0.2\n", "key 'supervisor.alpha': appears twice"},
+        SafetyConfig{"supervisor", "# nothing but a comment\n", "the file is empty"},
+        SafetyConfig{"robot-sim", "robot_sim:\n  permits:\n    monitors: []\n",
+                     "permits: no monitors configured"}));
+
 TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
   Process missing({BinPath("iplan-perception"), "--config", "/nonexistent/perception.yaml"});
   ASSERT_EQ(missing.Wait(20s), 2);
