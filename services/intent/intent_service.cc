@@ -3,6 +3,12 @@
 // mixture over actions) computed by the intent model (common/intent) through
 // the online estimator in core/. Positions stay in the skeleton's frame
 // (header.frame_id), which must be the frame the model was trained in.
+// `intent.predictor` chooses what is published as the prediction: the
+// model's mixture (default), or a kinematic baseline (constant position or
+// constant velocity, iplan/intent/baseline_predictors.h) of the model's
+// joints at the model's rate and horizon, for measuring what the model adds;
+// the action belief always comes from the model.
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <map>
@@ -10,6 +16,7 @@
 
 #include "core/intent_estimator.h"
 #include "iplan/framework/service.h"
+#include "iplan/intent/baseline_predictors.h"
 #include "iplan/intent/model_io.h"
 
 namespace iplan::intent_service {
@@ -32,6 +39,13 @@ class IntentService : public framework::Service {
     config.Read("body_timeout", &params_.body_timeout, framework::Positive<double>());
     config.Read("max_gap", &params_.max_gap, framework::Positive<double>());
     config.Read("max_bodies", &params_.max_bodies, framework::InRange(1, 1000));
+    config.Read("predictor", &predictor_, framework::OneOf({"model", "constant-position", "constant-velocity"}));
+    framework::ConfigSection bc = config.Section("baseline");
+    bc.Read("window", &baseline_.window, framework::Positive<double>());
+    bc.Read("sensor_noise_std", &baseline_.sensor_noise_std, framework::NonNegative<double>());
+    bc.Read("speed_std", &baseline_.speed_std, framework::NonNegative<double>());
+    bc.Read("acceleration_std", &baseline_.acceleration_std, framework::NonNegative<double>());
+    bc.Read("covariance", &baseline_covariance_, framework::OneOf({"model", "growth"}));
     if (!have_model || !have_joints || !have_rate) return Result::Fail("incomplete configuration");
     if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
 
@@ -45,8 +59,16 @@ class IntentService : public framework::Service {
     } catch (const std::exception& e) {
       return Result::Fail(config.file() + ": key 'intent.model': " + e.what());
     }
-    node.log().info("model {}: {} actions, {} joints, {} Hz, window {} frames, horizon {} steps", path,
-                    model_->actions.size(), joints.size(), rate, model_->config.window, model_->config.horizon);
+    node.log().info("model {}: {} actions, {} joints, {} Hz, window {} frames, horizon {} steps; predictions from {}", path,
+                    model_->actions.size(), joints.size(), rate, model_->config.window, model_->config.horizon,
+                    predictor_);
+    baseline_.kind = predictor_ == "constant-position" ? intent::BaselineKind::kConstantPosition
+                                                       : intent::BaselineKind::kConstantVelocity;
+    baseline_.rate = model_->config.rate;
+    baseline_.horizon = model_->config.horizon;
+    if (const std::string why = baseline_.Validate(); !why.empty()) {
+      return Result::Fail(config.file() + ": key 'intent.baseline': " + why);
+    }
 
     belief_writer_ = &node.Advertise(framework::topics::ActionBelief());
     prediction_writer_ = &node.Advertise(framework::topics::HumanPrediction());
@@ -58,9 +80,8 @@ class IntentService : public framework::Service {
     prediction_.time_step = 1.0 / model_->config.rate;
     prediction_.num_steps = static_cast<uint32_t>(model_->config.horizon);
     prediction_.joint_names = model_->config.joints.joints;
-    prediction_.actions.resize(model_->actions.size());
-    for (std::size_t c = 0; c < model_->actions.size(); ++c) prediction_.actions[c].action = model_->actions[c];
     node.SetDiagnosticValue("model", path);
+    node.SetDiagnosticValue("predictor", predictor_);
     UpdateDiagnostics(node);
     return Result::Ok();
   }
@@ -71,6 +92,16 @@ class IntentService : public framework::Service {
     const auto period = std::chrono::duration<double>(params_.body_timeout / 2);
     timer_ = node.AddTimer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this, &node] {
       if (estimator_->DropStale(msg::ToSeconds(msg::Now())) > 0) UpdateDiagnostics(node);
+      // Baselines of bodies not seen for body_timeout go with them.
+      const double now = msg::ToSeconds(msg::Now());
+      for (auto b = last_baseline_stamp_.begin(); b != last_baseline_stamp_.end();) {
+        if (now - b->second > params_.body_timeout) {
+          baselines_.erase(b->first);
+          b = last_baseline_stamp_.erase(b);
+        } else {
+          ++b;
+        }
+      }
     });
     return Result::Ok();
   }
@@ -97,6 +128,7 @@ class IntentService : public framework::Service {
       frame_.joints[j].position = {s.joints[j].position.x, s.joints[j].position.y, s.joints[j].position.z};
     }
     const FrameResult r = estimator_->Update(frame_, &mixture_);
+    if (r.accepted() && predictor_ != "model") PredictBaseline(s);
     if (!r.accepted()) {
       const std::string kind = ToString(r.status);
       const uint64_t n = ++rejected_[kind];
@@ -113,6 +145,40 @@ class IntentService : public framework::Service {
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
   }
 
+  // The baseline's prediction replaces the model's (the belief stays the
+  // model's). One predictor per body, forgotten with the estimator's bodies.
+  void PredictBaseline(const msg::HumanSkeleton& s) {
+    const auto& joints = model_->config.joints.joints;
+    Eigen::VectorXd p(3 * static_cast<Eigen::Index>(joints.size()));
+    for (std::size_t j = 0; j < joints.size(); ++j) {
+      // The estimator accepted the frame: every model joint is present.
+      const auto it = std::find_if(s.joints.begin(), s.joints.end(), [&](const msg::HumanJoint& h) { return h.name == joints[j]; });
+      const auto& q = it->position;
+      p.segment<3>(3 * static_cast<Eigen::Index>(j)) << q.x, q.y, q.z;
+    }
+    auto it = baselines_.find(s.body_id);
+    if (it == baselines_.end()) {
+      it = baselines_.emplace(s.body_id, intent::BaselinePredictor(baseline_, static_cast<int>(joints.size()))).first;
+    }
+    const double stamp = msg::ToSeconds(s.header.stamp);
+    if (it->second.buffered_frames() > 0 && !(stamp > last_baseline_stamp_[s.body_id])) it->second.Reset();
+    last_baseline_stamp_[s.body_id] = stamp;
+    baseline_mixture_.actions.clear();
+    it->second.Update(stamp, p, &baseline_mixture_);
+    if (baseline_covariance_ == "model") {
+      // The model's uncertainty around the baseline's mean: per step and
+      // joint the probability-weighted covariance of the model's components
+      // (without the spread of their means), so a comparison with the model
+      // differs in the mean forecast only.
+      auto& g = baseline_mixture_.actions.at(0).joints;
+      for (std::size_t k = 0; k < g.size(); ++k) {
+        Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
+        for (const auto& a : mixture_.actions) c += a.probability * a.joints.at(k).covariance;
+        g[k].covariance = c;
+      }
+    }
+  }
+
   void Publish(Node& node, const msg::HumanSkeleton& s) {
     // Our own stamp on our outputs (a consumer orders them by it); the
     // skeleton's stamp, t0 of the prediction steps, travels beside it.
@@ -126,10 +192,13 @@ class IntentService : public framework::Service {
     prediction_.header.frame_id = s.header.frame_id;
     prediction_.observation_stamp = s.header.stamp;
     prediction_.body_id = s.body_id;
-    for (std::size_t c = 0; c < mixture_.actions.size(); ++c) {
-      const intent::ActionHypothesis& h = mixture_.actions[c];
-      belief_.probabilities[c] = h.probability;
+    for (std::size_t c = 0; c < mixture_.actions.size(); ++c) belief_.probabilities[c] = mixture_.actions[c].probability;
+    const intent::MixturePrediction& predicted = predictor_ == "model" ? mixture_ : baseline_mixture_;
+    prediction_.actions.resize(predicted.actions.size());
+    for (std::size_t c = 0; c < predicted.actions.size(); ++c) {
+      const intent::ActionHypothesis& h = predicted.actions[c];
       msg::ActionPrediction& a = prediction_.actions[c];
+      a.action = predictor_ == "model" ? model_->actions[c] : h.action;
       a.probability = h.probability;
       a.joints.resize(h.joints.size());
       for (std::size_t k = 0; k < h.joints.size(); ++k) {  // both step-major
@@ -165,6 +234,12 @@ class IntentService : public framework::Service {
   dds::Writer<msg::HumanPrediction>* prediction_writer_ = nullptr;
   SkeletonFrame frame_;               // reused
   intent::MixturePrediction mixture_; // reused
+  std::string predictor_ = "model";  // model, constant-position, constant-velocity
+  intent::BaselinePredictorParams baseline_;
+  std::string baseline_covariance_ = "model";  // model: the model's covariances; growth: the baseline's own
+  std::map<std::uint32_t, intent::BaselinePredictor> baselines_;
+  std::map<std::uint32_t, double> last_baseline_stamp_;  // s, newest frame per body
+  intent::MixturePrediction baseline_mixture_;  // reused
   msg::ActionBelief belief_;          // reused
   msg::HumanPrediction prediction_;   // reused
   std::map<std::string, uint64_t> rejected_;

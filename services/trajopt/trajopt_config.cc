@@ -12,6 +12,7 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   config.Read("human_body", &body_file);
   config.Read("scene", &scene_file);
   config.Read("planner", &planner_file);
+  config.Read("use_prediction", &c.use_prediction);
   ReplannerParams& p = c.replanner;
   config.Read("planning_step", &p.planning_step, framework::InRange(0.01, 2.0));
   config.Read("frozen_waypoints", &p.frozen_waypoints, framework::InRange(2, 50));

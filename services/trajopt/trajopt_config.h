@@ -19,13 +19,16 @@ struct TrajoptConfig {
   std::string human_body_file;
   std::string scene_file;
   std::string planner_file;
+  /// false: the planner ignores the person (no prediction enters the plan;
+  /// only the collision-risk monitor protects), for ablations.
+  bool use_prediction = true;
 };
 
 /// Reads `section` (trajopt); problems with single keys are recorded in the
 /// configuration (reported by Finish()), cross-key ones are left to
 /// ReplannerParams::Validate(). Keys: robot, human_body, scene, planner,
 /// planning_step, frozen_waypoints, goal_tolerance, settle_speed,
-/// stale_after, max_tracking_error.
+/// stale_after, max_tracking_error, use_prediction.
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& section);
 
 /// Loads the robot model, static scene and planner parameters named by

@@ -23,6 +23,8 @@ class TrajoptService : public framework::Service {
   Result OnConfigure(ConfigSection& config, Node& node) override {
     const TrajoptConfig c = ReadTrajoptConfig(config);
     planning_step_ = c.replanner.planning_step;
+    use_prediction_ = c.use_prediction;
+    if (!use_prediction_) node.log().warn("trajopt.use_prediction is false: plans ignore the person (ablation)");
     try {
       planner_ = MakePlanner(c);
       body_ = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(c.human_body_file));
@@ -41,6 +43,7 @@ class TrajoptService : public framework::Service {
                    }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
+                     if (!use_prediction_) return;
                      node.CountRejection("prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
                    }));
     // The supervisor's permit tells whether the cell is stopped (its stop
@@ -179,6 +182,7 @@ class TrajoptService : public framework::Service {
   }
 
   double planning_step_ = 0.1;  // s
+  bool use_prediction_ = true;
   std::unique_ptr<planning::Planner> planner_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   std::unique_ptr<Replanner> replanner_;

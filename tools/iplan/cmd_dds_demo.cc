@@ -48,6 +48,11 @@ struct DemoOptions {
   double timeout = 170;
   std::string summary_file, config_dir, state_dir;
   bool keep_learning = false, retrain = false, prepare_only = false;
+  /// What the planner and monitor are given as the prediction: model,
+  /// constant-position, constant-velocity (intent.predictor), or none (the
+  /// planner ignores the person, trajopt.use_prediction false; collision
+  /// risk still gets the model's prediction).
+  std::string predictor = "model";
 };
 
 // The services in start order (executable suffix, config name).
@@ -252,6 +257,7 @@ int RunDemo(const DemoOptions& o) {
 
   std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain << "\n"
             << "  configuration " << config_dir << "\n  state and service logs (<service>.err) " << state_dir << "\n";
+  if (o.predictor != "model") std::cout << "  predictor: " << o.predictor << " (ablation)\n";
 
   // The intent model: trained from the synthetic person's demonstrations once.
   CellModelResult model;
@@ -286,6 +292,10 @@ int RunDemo(const DemoOptions& o) {
     std::vector<std::string> argv = {bin + "/iplan-" + exe, "--config", cfg(name), "--dds", dds::ToString(v),
                                      "--domain", std::to_string(domain)};
     if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model.path});
+    if (name == "intent" && o.predictor != "model" && o.predictor != "none") {
+      argv.insert(argv.end(), {"--set", "intent.predictor=" + o.predictor});
+    }
+    if (name == "trajopt" && o.predictor == "none") argv.insert(argv.end(), {"--set", "trajopt.use_prediction=false"});
     if (name == "perception") argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set",
                                                        "perception.publish_truth=true"});
     if (name == "supervisor") {
@@ -395,6 +405,7 @@ int RunDemo(const DemoOptions& o) {
   if (!o.summary_file.empty()) {
     nlohmann::json j;
     j["domain"] = domain;
+    j["predictor"] = o.predictor;
     j["vendors"] = nlohmann::json::object();
     for (const std::string& name : names) j["vendors"][name] = dds::ToString(vendor_of(name));
     j["monitor_vendor"] = dds::ToString(vendor_a);
@@ -456,6 +467,12 @@ void Register(CLI::App& app) {
   d->add_flag("--keep-learning", o.keep_learning,
               "use the Q-table of supervisor.yaml (learning carries over between runs) instead of a fresh one");
   d->add_flag("--retrain", o.retrain, "train the intent model again even if a cached one fits");
+  d->add_option("--predictor", o.predictor,
+                 "prediction the cell plans with: model (the trained intent model), constant-velocity or "
+                 "constant-position (kinematic baselines from the intent service), none (the planner ignores "
+                 "the person; only collision risk protects)")
+      ->check(CLI::IsMember({"model", "constant-velocity", "constant-position", "none"}))
+      ->capture_default_str();
   d->add_flag("--prepare-only", o.prepare_only,
               "train (or check) the cell's intent model, print its path ('model path: FILE') and exit without running the cell");
   d->callback([] { SetExitCode(RunDemo(o)); });
