@@ -401,6 +401,55 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
   EXPECT_EQ(count("rejected (stamp_not_increasing)"), 1) << err;
 }
 
+// intent.predictor constant-velocity: the prediction is the baseline's (one
+// component, the model's horizon and rate, a straight line continued), the
+// belief stays the model's.
+TEST_F(IntentServiceTest, ABaselinePredictorReplacesThePredictionNotTheBelief) {
+  const int domain = UniqueDomain(14);
+  TestNode cell("baseline_test", dds::Vendor::kCyclone, domain);
+  framework::Node& node = *cell.node;
+  std::optional<msg::ActionBelief> belief;
+  std::optional<msg::HumanPrediction> prediction;
+  node.Subscribe(framework::topics::ActionBelief(),
+                 std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
+                     [&](const msg::ActionBelief& b, const dds::SampleInfo&) { belief = b; }));
+  node.Subscribe(framework::topics::HumanPrediction(),
+                 std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanPrediction& p, const dds::SampleInfo&) { prediction = p; }));
+  const std::vector<std::string>& joints = model_->config.joints.joints;
+  const std::string cfg = IntentConfig("intent-cv.yaml", joints, 15.0);
+  std::ofstream(cfg, std::ios::app) << "  predictor: constant-velocity\n";
+  Process intent({BinPath("iplan-intent"), "--config", cfg, "--dds", "fastdds", "--domain", std::to_string(domain)});
+  auto& w = node.Advertise(framework::topics::HumanSkeleton());
+  ASSERT_TRUE(SpinUntil(node, 30s, [&] { return w.MatchedReaders() > 0; })) << intent.Stderr();
+  // Every joint moves at 0.3 m/s along x, at 30 Hz for 0.5 s.
+  const double t0 = msg::ToSeconds(msg::Now());
+  msg::HumanSkeleton last;
+  for (int k = 0; k < 15; ++k) {
+    const double t = t0 + k / 30.0;
+    last = Skeleton(700, joints, msg::TimeFromSeconds(t));
+    for (auto& j : last.joints) j.position.x += 0.3 * (t - t0);
+    ASSERT_TRUE(w.Write(last));
+    SpinFor(node, 33ms);
+  }
+  SpinFor(node, 300ms);
+  ASSERT_TRUE(prediction.has_value()) << intent.Stderr();
+  ASSERT_TRUE(belief.has_value());
+  EXPECT_EQ(belief->actions, model_->actions);
+  ASSERT_EQ(prediction->actions.size(), 1u);
+  EXPECT_EQ(prediction->actions[0].action, "constant_velocity");
+  EXPECT_EQ(prediction->num_steps, static_cast<uint32_t>(model_->config.horizon));
+  EXPECT_NEAR(prediction->time_step, 1.0 / model_->config.rate, 1e-12);
+  // Step k (0-based) is (k + 1) / rate after the last observation: x moved on at 0.3 m/s.
+  const std::size_t J = joints.size();
+  const int k = static_cast<int>(prediction->num_steps) - 1;
+  const double tau = (k + 1) * prediction->time_step;
+  EXPECT_NEAR(prediction->actions[0].joints[static_cast<std::size_t>(k) * J].mean.x, last.joints[0].position.x + 0.3 * tau,
+              1e-6);
+  intent.Signal(SIGTERM);
+  EXPECT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+}
+
 TEST_F(IntentServiceTest, AModelThatDoesNotMatchTheConfigurationIsRefused) {
   struct Case {
     std::string config;
