@@ -1,0 +1,116 @@
+#include "iplan/intent/baseline_predictors.h"
+
+#include <cmath>
+#include <stdexcept>
+
+#include <gtest/gtest.h>
+
+namespace iplan::intent {
+namespace {
+
+// Two joints moving on straight lines at constant velocity, 30 Hz.
+Eigen::VectorXd LinePose(double t) {
+  Eigen::VectorXd p(6);
+  p << 0.5 + 0.3 * t, -0.2 + 0.1 * t, 1.0 - 0.05 * t,  // joint 0
+      1.0, 0.4 - 0.6 * t, 0.2;                         // joint 1
+  return p;
+}
+
+TEST(BaselinePredictors, ConstantVelocityExtrapolatesAStraightLineExactly) {
+  BaselinePredictorParams params;
+  params.kind = BaselineKind::kConstantVelocity;
+  BaselinePredictor predictor(params, 2);
+  MixturePrediction out;
+  double t = 10.0;
+  for (int i = 0; i < 12; ++i, t += 1.0 / 30) predictor.Update(t, LinePose(t), &out);
+  const double t0 = t - 1.0 / 30;
+  ASSERT_EQ(out.actions.size(), 1u);
+  EXPECT_EQ(out.actions[0].action, "constant_velocity");
+  EXPECT_DOUBLE_EQ(out.actions[0].probability, 1.0);
+  EXPECT_EQ(out.horizon, 15);
+  EXPECT_EQ(out.num_joints, 2);
+  EXPECT_NEAR(out.dt, 1.0 / 15, 1e-15);
+  for (int k = 0; k < out.horizon; ++k) {
+    const Eigen::VectorXd truth = LinePose(t0 + (k + 1) * out.dt);
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_LT((out.At(0, k, j).mean - truth.segment<3>(3 * j)).norm(), 1e-9) << "step " << k << " joint " << j;
+    }
+  }
+  // Only the fit window (0.25 s at 30 Hz: 8 frames) is kept.
+  EXPECT_EQ(predictor.buffered_frames(), 8);
+}
+
+TEST(BaselinePredictors, ConstantVelocityCovarianceGrowsAsStated) {
+  BaselinePredictorParams params;
+  params.kind = BaselineKind::kConstantVelocity;
+  params.rate = 10;
+  params.horizon = 10;
+  params.window = 0.3;
+  // Four frames at -0.3, -0.2, -0.1, 0 s: tbar = -0.15, S_tt = 0.05.
+  Eigen::VectorXd stamps(4);
+  stamps << 0.7, 0.8, 0.9, 1.0;
+  Eigen::MatrixXd positions(4, 3);
+  for (int i = 0; i < 4; ++i) positions.row(i) = LinePose(stamps(i)).head<3>().transpose();
+  MixturePrediction out;
+  PredictBaseline(params, stamps, positions, &out);
+  const double sn2 = 1e-4;
+  for (int k : {0, 4, 9}) {
+    const double t = (k + 1) * 0.1;
+    const double accel = 0.5 * 1.0 * t * t;
+    const double expected = sn2 + sn2 * (0.25 + (t + 0.15) * (t + 0.15) / 0.05) + accel * accel;
+    const Eigen::Matrix3d& c = out.At(0, k, 0).covariance;
+    EXPECT_NEAR(c(0, 0), expected, 1e-12) << "step " << k;
+    EXPECT_NEAR(c(2, 2), expected, 1e-12);
+    EXPECT_DOUBLE_EQ(c(0, 1), 0.0);
+  }
+  EXPECT_GT(out.At(0, 9, 0).covariance(0, 0), out.At(0, 0, 0).covariance(0, 0));
+}
+
+TEST(BaselinePredictors, ConstantPositionHoldsTheNewestObservation) {
+  BaselinePredictorParams params;
+  params.kind = BaselineKind::kConstantPosition;
+  BaselinePredictor predictor(params, 2);
+  MixturePrediction out;
+  double t = 0.0;
+  for (int i = 0; i < 10; ++i, t += 1.0 / 30) predictor.Update(t, LinePose(t), &out);
+  const Eigen::VectorXd last = LinePose(t - 1.0 / 30);
+  EXPECT_EQ(out.actions[0].action, "constant_position");
+  for (int k = 0; k < out.horizon; ++k) {
+    for (int j = 0; j < 2; ++j) {
+      EXPECT_EQ(out.At(0, k, j).mean, Eigen::Vector3d(last.segment<3>(3 * j))) << "step " << k;
+      const double s = 0.25 * (k + 1) / 15.0;
+      EXPECT_NEAR(out.At(0, k, j).covariance(1, 1), 1e-4 + s * s, 1e-15);
+    }
+  }
+}
+
+TEST(BaselinePredictors, ConstantVelocityWithOneFrameHoldsAndIsStillUsable) {
+  BaselinePredictorParams params;
+  BaselinePredictor predictor(params, 2);
+  MixturePrediction out;
+  predictor.Update(3.0, LinePose(3.0), &out);
+  EXPECT_EQ(out.At(0, 14, 1).mean, Eigen::Vector3d(LinePose(3.0).segment<3>(3)));
+  EXPECT_GT(out.At(0, 14, 1).covariance(0, 0), 1e-4);
+}
+
+TEST(BaselinePredictors, RefusesBadInputNamingIt) {
+  BaselinePredictorParams bad;
+  bad.window = 0;
+  EXPECT_THROW(BaselinePredictor(bad, 1), std::invalid_argument);
+  BaselinePredictor predictor(BaselinePredictorParams{}, 2);
+  MixturePrediction out;
+  predictor.Update(1.0, LinePose(1.0), &out);
+  try {
+    predictor.Update(1.0, LinePose(1.0), &out);
+    FAIL() << "a repeated stamp was accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("is not after"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(predictor.buffered_frames(), 1);
+  EXPECT_THROW(predictor.Update(2.0, Eigen::VectorXd::Zero(5), &out), std::invalid_argument);
+  EXPECT_THROW(PredictBaseline(BaselinePredictorParams{}, Eigen::VectorXd(), Eigen::MatrixXd(), &out),
+               std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace iplan::intent
