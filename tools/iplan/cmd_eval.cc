@@ -238,6 +238,8 @@ int RunInteraction(const InteractionOptions& o) {
       if (!r.reason.empty()) j["reason"] = r.reason;
       j["task_time_s"] = r.task_time;
       j["protective_stops"] = r.protective_stops;
+      j["stops_by_separation"] = r.stops_separation;
+      j["stops_by_bound"] = r.stops_bound;
       j["stop_time_s"] = r.stop_time;
       j["min_separation_m"] = r.min_separation;
       j["max_bound"] = r.max_bound;
@@ -258,6 +260,8 @@ int RunInteraction(const InteractionOptions& o) {
     j["task_time_s"] = SpreadJson(s.task_time);
     Json stops = SpreadJson(s.protective_stops);
     stops["total"] = s.protective_stops_total;
+    stops["by_separation"] = s.stops_separation_total;
+    stops["by_bound"] = s.stops_bound_total;
     j["protective_stops"] = stops;
     Json stop_time = SpreadJson(s.stop_time);
     stop_time["total"] = s.stop_time_total;
@@ -292,13 +296,14 @@ int RunInteraction(const InteractionOptions& o) {
 
   // The table.
   const int w = 19;
-  std::cout << std::left << std::setw(w) << "predictor" << std::setw(24) << "task time s" << std::setw(16)
-            << "stops tot (med)" << std::setw(24) << "time in stop s" << std::setw(24) << "min separation m"
+  std::cout << std::left << std::setw(w) << "predictor" << std::setw(24) << "task time s" << std::setw(20)
+            << "stops tot sep/bnd" << std::setw(24) << "time in stop s" << std::setw(24) << "min separation m"
             << std::setw(24) << "max true bound" << std::setw(9) << "contacts" << "done\n";
   for (const auto& s : summary) {
     std::cout << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
-              << SpreadText(s.task_time, 2) << std::setw(16)
-              << (std::to_string(s.protective_stops_total) + " (" + Fixed(s.protective_stops.median, 0) + ")")
+              << SpreadText(s.task_time, 2) << std::setw(20)
+              << (std::to_string(s.protective_stops_total) + " " + std::to_string(s.stops_separation_total) + "/" +
+                  std::to_string(s.stops_bound_total))
               << std::setw(24) << SpreadText(s.stop_time, 2) << std::setw(24) << SpreadText(s.min_separation, 3)
               << std::setw(24) << SpreadText(s.max_bound, 3) << std::setw(9) << s.true_contacts << s.succeeded << "/"
               << s.scenarios << "\n";

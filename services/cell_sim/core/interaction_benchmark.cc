@@ -509,6 +509,8 @@ std::vector<PredictorSummary> Summarize(const std::vector<Predictor>& predictors
       time.push_back(r.task_time);
       stops.push_back(r.protective_stops);
       s.protective_stops_total += r.protective_stops;
+      s.stops_separation_total += r.stops_separation;
+      s.stops_bound_total += r.stops_bound;
       stop_time.push_back(r.stop_time);
       s.stop_time_total += r.stop_time;
       separation.push_back(r.min_separation);

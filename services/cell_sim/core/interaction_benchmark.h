@@ -160,6 +160,8 @@ struct PredictorSummary {
   Spread task_time;             ///< s (failed tasks count with their time when they ended)
   Spread protective_stops;
   int protective_stops_total = 0;
+  int stops_separation_total = 0;  ///< started by the ISO/TS 15066 separation layer
+  int stops_bound_total = 0;       ///< started by the collision bound
   Spread stop_time;             ///< s
   double stop_time_total = 0;   ///< s
   Spread min_separation;        ///< m

@@ -162,6 +162,12 @@ InteractionResult RunInteraction(const CellModels& models, const LoopParams& par
       stop_since = t;
       if (in_task) {
         ++result.protective_stops;
+        // Which layer (the monitor decides separation first, then the bound).
+        if (report.binding_separation < 1e6 && report.separation_margin < 0) {
+          ++result.stops_separation;
+        } else if (!report.waypoint_bounds.empty()) {
+          ++result.stops_bound;
+        }
         if (result.first_stop_reason.empty()) result.first_stop_reason = report.reason;
       }
     } else if (!stop && robot.stopped()) {

@@ -112,6 +112,8 @@ struct InteractionResult {
   double planner_delay = 0;    ///< s, the replanner's delay (waits, hold-offs, time in stop)
   uint32_t waits = 0;          ///< cycles whose plan inserted a wait
   int protective_stops = 0;    ///< times the robot was stopped (once if stopped at the command)
+  int stops_separation = 0;    ///< of which the ISO/TS 15066 separation layer started
+  int stops_bound = 0;         ///< of which the collision bound along the executing trajectory started
   double stop_time = 0;        ///< s the robot spent stopped
   double min_separation = 1e6; ///< m, smallest true robot-human surface distance (control rate)
   /// Highest true bound: at every skeleton frame, the collision bound
