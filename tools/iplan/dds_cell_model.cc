@@ -48,6 +48,10 @@ std::string ModelKey(const perception::SyntheticPersonParams& p, const std::vect
 
 }  // namespace
 
+intent::SkeletonDataset RecordCellDemonstrations(const perception::SyntheticPersonParams& person) {
+  return perception::RecordDemonstrations(person, kSubjects, kRepetitions, kSeconds, 30.0);
+}
+
 CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::string& intent_yaml,
                                 const std::string& fallback_dir, bool force) {
   // The person, as the perception service will simulate it.
@@ -84,8 +88,7 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   }
 
   const auto t0 = std::chrono::steady_clock::now();
-  const intent::SkeletonDataset data =
-      perception::RecordDemonstrations(person, kSubjects, kRepetitions, kSeconds, 30.0);
+  const intent::SkeletonDataset data = RecordCellDemonstrations(person);
   intent::IntentModelConfig config;
   // The configured joints, torso and hands defaulted among them (not among
   // the person's), so that any joint set of intent.yaml trains or is refused

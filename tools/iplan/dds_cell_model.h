@@ -5,7 +5,15 @@
 
 #include <string>
 
+#include "core/synthetic_person.h"
+#include "iplan/intent/skeleton_data.h"
+
 namespace iplan::cli {
+
+/// The demonstrations the cell's intent model is trained on: the synthetic
+/// person `person` doing every action (several simulated people, two
+/// recordings each, 30 Hz, with its sensor noise). Deterministic.
+intent::SkeletonDataset RecordCellDemonstrations(const perception::SyntheticPersonParams& person);
 
 struct CellModelResult {
   std::string path;     ///< model file to use

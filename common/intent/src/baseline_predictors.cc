@@ -1,5 +1,6 @@
 #include "iplan/intent/baseline_predictors.h"
 
+#include <algorithm>
 #include <cmath>
 #include <stdexcept>
 
@@ -20,6 +21,11 @@ std::string BaselinePredictorParams::Validate() const {
   if (!(speed_std >= 0) || !std::isfinite(speed_std)) return bad("speed_std", speed_std, ">= 0 m/s");
   if (!(acceleration_std >= 0) || !std::isfinite(acceleration_std)) {
     return bad("acceleration_std", acceleration_std, ">= 0 m/s^2");
+  }
+  for (std::size_t j = 0; j < joint_growth.size(); ++j) {
+    if (!(joint_growth[j] >= 0) || !std::isfinite(joint_growth[j])) {
+      return "joint_growth[" + std::to_string(j) + "] " + std::to_string(joint_growth[j]) + " must be >= 0";
+    }
   }
   return "";
 }
@@ -42,6 +48,10 @@ void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorX
     if (!(stamps(i) > stamps(i - 1))) throw std::invalid_argument("baseline predictor: stamps do not increase");
   }
   const int J = static_cast<int>(positions.cols() / 3);
+  if (!params.joint_growth.empty() && static_cast<int>(params.joint_growth.size()) != J) {
+    throw std::invalid_argument("baseline predictor: " + std::to_string(params.joint_growth.size()) +
+                                " joint growths for " + std::to_string(J) + " joints");
+  }
   const double t0 = stamps(n - 1);
   const double noise = params.sensor_noise_std * params.sensor_noise_std;
 
@@ -73,25 +83,94 @@ void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorX
   h.action = ToString(params.kind);
   h.probability = 1.0;
   h.joints.resize(static_cast<std::size_t>(params.horizon) * static_cast<std::size_t>(J));
+  // Constant velocity with one frame falls back to constant position, and
+  // then grows as constant position does.
+  const double scalar = fit ? params.acceleration_std : params.speed_std;
+  const bool per_joint = !params.joint_growth.empty() && (fit || params.kind == BaselineKind::kConstantPosition);
   for (int k = 0; k < params.horizon; ++k) {
     const double t = (k + 1) / params.rate;
-    double var = noise;
+    double base = noise;
     Eigen::RowVectorXd mean;
     if (fit) {
       mean = a + (t - tbar) * b;
-      const double accel = 0.5 * params.acceleration_std * t * t;
-      var += noise * (1.0 / static_cast<double>(m) + (t - tbar) * (t - tbar) / stt) + accel * accel;
+      base += noise * (1.0 / static_cast<double>(m) + (t - tbar) * (t - tbar) / stt);
     } else {
       mean = a;
-      const double spread = params.speed_std * t;
-      var += spread * spread;
     }
+    // The growth's shape: t for an unknown speed, t^2 / 2 for an unknown acceleration.
+    const double shape = fit ? 0.5 * t * t : t;
     for (int j = 0; j < J; ++j) {
+      const double spread = (per_joint ? params.joint_growth[static_cast<std::size_t>(j)] : scalar) * shape;
       JointGaussian& g = h.joints[static_cast<std::size_t>(k) * static_cast<std::size_t>(J) + static_cast<std::size_t>(j)];
       g.mean = mean.segment<3>(3 * j).transpose();
-      g.covariance = var * Eigen::Matrix3d::Identity();
+      g.covariance = (base + spread * spread) * Eigen::Matrix3d::Identity();
     }
   }
+}
+
+std::vector<double> CalibrateBaselineGrowth(const BaselinePredictorParams& params, const SkeletonDataset& data,
+                                            const std::vector<std::string>& joints) {
+  if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument("baseline predictor: " + why);
+  const std::vector<int> columns = JointIndices(data.joint_names, joints);
+  const int J = static_cast<int>(joints.size());
+  const int H = params.horizon;
+  // The base variance of each prediction (noise and fit) is its covariance
+  // without growth.
+  BaselinePredictorParams no_growth = params;
+  no_growth.joint_growth.assign(static_cast<std::size_t>(J), 0.0);
+  Eigen::MatrixXd error = Eigen::MatrixXd::Zero(J, H);  // summed squared error per coordinate
+  Eigen::VectorXd base = Eigen::VectorXd::Zero(H), count = Eigen::VectorXd::Zero(H);
+  MixturePrediction out;
+  for (const SkeletonSequence& seq : data.sequences) {
+    // The usable frames: every selected joint detected.
+    std::vector<double> stamps;
+    std::vector<Eigen::VectorXd> frames;
+    for (Eigen::Index i = 0; i < seq.positions.rows(); ++i) {
+      Eigen::VectorXd p(3 * J);
+      bool ok = true;
+      for (int j = 0; j < J && ok; ++j) {
+        const Eigen::RowVectorXd q = seq.positions.row(i).segment(3 * columns[static_cast<std::size_t>(j)], 3);
+        ok = JointDetected(q);
+        p.segment<3>(3 * j) = q.transpose();
+      }
+      if (!ok || (!stamps.empty() && !(seq.time(i) > stamps.back()))) continue;
+      stamps.push_back(seq.time(i));
+      frames.push_back(p);
+    }
+    BaselinePredictor predictor(no_growth, J);
+    for (std::size_t i = 0; i < stamps.size(); ++i) {
+      predictor.Update(stamps[i], frames[i], &out);
+      if (stamps[i] - stamps.front() < params.window) continue;  // not a full window of history yet
+      std::size_t seg = i;
+      for (int k = 0; k < H; ++k) {
+        const double t = stamps[i] + (k + 1) / params.rate;
+        if (t > stamps.back()) break;
+        while (seg + 1 < stamps.size() && stamps[seg + 1] < t) ++seg;
+        const std::size_t next = std::min(seg + 1, stamps.size() - 1);
+        const double u = next == seg ? 0.0 : (t - stamps[seg]) / (stamps[next] - stamps[seg]);
+        const Eigen::VectorXd truth = (1 - u) * frames[seg] + u * frames[next];
+        for (int j = 0; j < J; ++j) {
+          error(j, k) += (out.At(0, k, j).mean - truth.segment<3>(3 * j)).squaredNorm() / 3.0;
+        }
+        base(k) += out.At(0, k, 0).covariance(0, 0);
+        count(k) += 1;
+      }
+    }
+  }
+  if (count.sum() == 0) throw std::invalid_argument("baseline calibration: no sequence long enough to predict from");
+  std::vector<double> growth(static_cast<std::size_t>(J), 0.0);
+  for (int j = 0; j < J; ++j) {
+    double num = 0, den = 0;
+    for (int k = 0; k < H; ++k) {
+      if (count(k) == 0) continue;
+      const double t = (k + 1) / params.rate;
+      const double phi = params.kind == BaselineKind::kConstantVelocity ? 0.25 * t * t * t * t : t * t;
+      num += phi * (error(j, k) - base(k)) / count(k);
+      den += phi * phi;
+    }
+    growth[static_cast<std::size_t>(j)] = std::sqrt(std::max(0.0, num / den));
+  }
+  return growth;
 }
 
 BaselinePredictor::BaselinePredictor(BaselinePredictorParams params, int num_joints)

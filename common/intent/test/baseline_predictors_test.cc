@@ -93,6 +93,60 @@ TEST(BaselinePredictors, ConstantVelocityWithOneFrameHoldsAndIsStillUsable) {
   EXPECT_GT(out.At(0, 14, 1).covariance(0, 0), 1e-4);
 }
 
+TEST(BaselinePredictors, PerJointGrowthReplacesTheScalar) {
+  BaselinePredictorParams params;
+  params.kind = BaselineKind::kConstantPosition;
+  params.joint_growth = {0.0, 0.5};
+  Eigen::VectorXd stamps(1);
+  stamps << 2.0;
+  Eigen::MatrixXd positions = LinePose(2.0).transpose();
+  MixturePrediction out;
+  PredictBaseline(params, stamps, positions, &out);
+  const double t = 15 / 15.0;
+  EXPECT_NEAR(out.At(0, 14, 0).covariance(0, 0), 1e-4, 1e-15);
+  EXPECT_NEAR(out.At(0, 14, 1).covariance(0, 0), 1e-4 + 0.25 * t * t, 1e-15);
+  params.joint_growth = {0.1};
+  EXPECT_THROW(PredictBaseline(params, stamps, positions, &out), std::invalid_argument);
+}
+
+// One joint moving at 0.3 m/s along x, one at rest, 30 Hz for 4 s, no noise.
+SkeletonDataset MovingAndStill() {
+  SkeletonDataset d;
+  d.joint_names = {"hand", "torso"};
+  SkeletonSequence s;
+  s.id = "line";
+  const int n = 120;
+  s.time.resize(n);
+  s.positions.resize(n, 6);
+  for (int i = 0; i < n; ++i) {
+    const double t = i / 30.0;
+    s.time(i) = t;
+    s.positions.row(i) << 0.5 + 0.3 * t, 0.1, 0.2, 1.0, 0.0, 0.3;
+  }
+  d.sequences.push_back(s);
+  return d;
+}
+
+TEST(BaselinePredictors, CalibrationFitsEachPredictorsOwnErrors) {
+  const SkeletonDataset d = MovingAndStill();
+  BaselinePredictorParams cp;
+  cp.kind = BaselineKind::kConstantPosition;
+  cp.sensor_noise_std = 0;
+  // Holding a joint that moves at v errs by v t along one axis: v t / sqrt(3)
+  // per coordinate; a joint at rest not at all.
+  const std::vector<double> g_cp = CalibrateBaselineGrowth(cp, d, {"hand", "torso"});
+  ASSERT_EQ(g_cp.size(), 2u);
+  EXPECT_NEAR(g_cp[0], 0.3 / std::sqrt(3.0), 1e-9);
+  EXPECT_NEAR(g_cp[1], 0.0, 1e-12);
+  // A straight line is what constant velocity predicts exactly.
+  BaselinePredictorParams cv = cp;
+  cv.kind = BaselineKind::kConstantVelocity;
+  const std::vector<double> g_cv = CalibrateBaselineGrowth(cv, d, {"torso", "hand"});
+  EXPECT_NEAR(g_cv[0], 0.0, 1e-6);
+  EXPECT_NEAR(g_cv[1], 0.0, 1e-6);
+  EXPECT_THROW(CalibrateBaselineGrowth(cv, d, {"elbow"}), std::invalid_argument);
+}
+
 TEST(BaselinePredictors, RefusesBadInputNamingIt) {
   BaselinePredictorParams bad;
   bad.window = 0;

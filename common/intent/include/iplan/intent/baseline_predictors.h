@@ -10,15 +10,20 @@
 //     two-frame difference, so that sensor noise does not dominate).
 //
 // Covariance growth (isotropic, per coordinate, t = (k + 1) / rate the time
-// of future step k after the newest observation, sigma_n = sensor_noise_std):
-//   constant position:  var(t) = sigma_n^2 + (speed_std t)^2
+// of future step k after the newest observation, sigma_n = sensor_noise_std,
+// g_j the joint's growth: joint_growth[j], or the scalar when it is empty):
+//   constant position:  var_j(t) = sigma_n^2 + (g_j t)^2,  g = speed_std
 //     (the person's speed is unknown: the error grows linearly in time);
-//   constant velocity:  var(t) = sigma_n^2 + var_fit(t) + (acceleration_std t^2 / 2)^2
+//   constant velocity:  var_j(t) = sigma_n^2 + var_fit(t) + (g_j t^2 / 2)^2,  g = acceleration_std
 //     with var_fit(t) = sigma_n^2 (1/n + (t - tbar)^2 / S_tt) the variance of
 //     the fitted line at t (n frames at times tbar +- ..., S_tt their spread)
 //     and the acceleration term for what a constant velocity cannot follow.
 // The sigma_n^2 term is the noise of the future observation itself, as the
 // intent model adds its sensor noise to every predicted covariance.
+// CalibrateBaselineGrowth fits g_j to a predictor's own errors on recorded
+// motion (e.g. the demonstrations an intent model is trained on), so that a
+// baseline's covariances are as honest as the model's: a torso that hardly
+// moves gets a small growth, a working hand a large one.
 //
 // Frames: positions are metres in the frame of the observations (W); stamps
 // are seconds (any epoch). Free functions are thread-safe; BaselinePredictor
@@ -27,10 +32,12 @@
 
 #include <deque>
 #include <string>
+#include <vector>
 
 #include <Eigen/Core>
 
 #include "iplan/intent/intent_model.h"
+#include "iplan/intent/skeleton_data.h"
 
 namespace iplan::intent {
 
@@ -48,6 +55,10 @@ struct BaselinePredictorParams {
   double sensor_noise_std = 0.01; ///< m, per coordinate noise of an observation (>= 0)
   double speed_std = 0.25;        ///< m/s, constant position: spread of the unknown speed (>= 0)
   double acceleration_std = 1.0;  ///< m/s^2, constant velocity: unmodelled acceleration (>= 0)
+  /// Per joint (J entries, >= 0): speed_std (constant position) or
+  /// acceleration_std (constant velocity) of that joint. Empty: the scalar
+  /// for every joint.
+  std::vector<double> joint_growth;
 
   /// Empty when valid, else the offending field and value.
   std::string Validate() const;
@@ -65,6 +76,21 @@ struct BaselinePredictorParams {
 /// increase or non-finite values.
 void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorXd& stamps,
                      const Eigen::MatrixXd& positions, MixturePrediction* out);
+
+/// Fits joint_growth for `params` (kind, rate, horizon, window, noise) to the
+/// predictor's own errors on `data` (its sequences' frames in any frame,
+/// `joints` selecting and ordering the joints; frames where one is not
+/// detected are skipped): every frame with a full window of history is
+/// predicted from, each step's mean compared with the sequence's position at
+/// that time (linear between frames; steps past the end are left out), and
+/// per joint the mean squared error per coordinate e_k at step k fitted by
+/// least squares, e_k - base_k = g^2 phi_k (phi = t^2, or t^4 / 4 for
+/// constant velocity; base the noise and fit terms at the window's nominal
+/// frame count), g^2 clamped at 0. Returns g (J). Throws
+/// std::invalid_argument on invalid params, an unknown joint or no usable
+/// prediction. Thread-safe; allocates.
+std::vector<double> CalibrateBaselineGrowth(const BaselinePredictorParams& params, const SkeletonDataset& data,
+                                            const std::vector<std::string>& joints);
 
 /// Keeps one person's recent frames and predicts with every new one.
 class BaselinePredictor {

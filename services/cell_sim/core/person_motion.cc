@@ -1,0 +1,214 @@
+#include "core/person_motion.h"
+
+#include <algorithm>
+#include <cmath>
+#include <random>
+#include <stdexcept>
+
+#include <Eigen/Geometry>
+
+#include "core/skeleton_replay.h"
+
+namespace iplan::cell_sim {
+namespace {
+
+// The synthetic person's proportions (services/perception/core/synthetic_person.cc).
+constexpr double kShoulderBelowNeck = 0.05;  // m
+constexpr double kNeckToHead = 0.18;         // m
+constexpr double kTorsoToNeck = 0.30;        // m
+
+void CheckArguments(double rate_hz, double duration, double noise_std) {
+  if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw std::invalid_argument("rate_hz must be > 0");
+  if (!(duration > 0) || !std::isfinite(duration)) throw std::invalid_argument("duration must be > 0 s");
+  if (!(noise_std >= 0) || !std::isfinite(noise_std)) throw std::invalid_argument("noise_std must be >= 0 m");
+}
+
+const intent::SkeletonSequence& FindSequence(const intent::SkeletonDataset& data, const std::string& id) {
+  for (const auto& s : data.sequences) {
+    if (s.id == id) return s;
+  }
+  throw std::invalid_argument("no sequence '" + id + "' in the recordings");
+}
+
+int JointColumn(const intent::SkeletonDataset& data, const std::string& name) {
+  const auto it = std::find(data.joint_names.begin(), data.joint_names.end(), name);
+  if (it == data.joint_names.end()) throw std::invalid_argument("the recordings have no joint '" + name + "'");
+  return static_cast<int>(it - data.joint_names.begin());
+}
+
+void AddNoise(double noise_std, uint64_t seed, PersonStream* s) {
+  std::mt19937_64 rng(seed);
+  std::normal_distribution<double> n(0.0, 1.0);
+  s->observed.resize(s->truth.size());
+  for (std::size_t i = 0; i < s->truth.size(); ++i) {
+    Eigen::Matrix3Xd o = s->truth[i];
+    for (Eigen::Index j = 0; j < o.cols(); ++j) {
+      for (int a = 0; a < 3; ++a) o(a, j) += noise_std * n(rng);
+    }
+    s->observed[i] = std::move(o);
+  }
+}
+
+}  // namespace
+
+Eigen::Isometry3d RecordingPose(const intent::SkeletonDataset& data, const std::string& sequence,
+                                const RecordedPlacement& placement) {
+  const intent::SkeletonSequence& seq = FindSequence(data, sequence);
+  const int l = JointColumn(data, "shoulder_l"), r = JointColumn(data, "shoulder_r");
+  Eigen::Vector3d c_S = Eigen::Vector3d::Zero();
+  int n = 0;
+  for (Eigen::Index i = 0; i < seq.positions.rows(); ++i) {
+    const Eigen::RowVectorXd pl = seq.positions.row(i).segment(3 * l, 3), pr = seq.positions.row(i).segment(3 * r, 3);
+    if (!intent::JointDetected(pl) || !intent::JointDetected(pr)) continue;
+    c_S += 0.5 * (pl + pr).transpose();
+    ++n;
+  }
+  if (n == 0) throw std::invalid_argument("sequence '" + sequence + "' never shows both shoulders");
+  c_S /= n;
+  Eigen::Matrix3d R_WS0;
+  R_WS0 << 0, 0, 1,  //
+      -1, 0, 0,      //
+      0, -1, 0;
+  Eigen::Isometry3d X_WS = Eigen::Isometry3d::Identity();
+  X_WS.linear() = Eigen::AngleAxisd(placement.yaw, Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_WS0;
+  X_WS.translation() = placement.shoulder_centre_W - X_WS.linear() * c_S;
+  return X_WS;
+}
+
+PersonStream RecordedPersonStream(const intent::SkeletonDataset& data, const std::string& file,
+                                  const std::string& sequence, const std::map<std::string, std::string>& joint_map,
+                                  const RecordedPlacement& placement, const std::vector<std::string>& body_joints,
+                                  double rate_hz, double duration, double noise_std, uint64_t seed) {
+  CheckArguments(rate_hz, duration, noise_std);
+  if (!(placement.clip_start >= 0) || !(placement.delay >= 0)) {
+    throw std::invalid_argument("clip_start and delay must be >= 0 s");
+  }
+  // The perception service's replay of this one sequence.
+  intent::SkeletonDataset one;
+  one.joint_names = data.joint_names;
+  one.sequences.push_back(FindSequence(data, sequence));
+  perception::SkeletonReplayParams rp;
+  rp.file = file;
+  rp.sequences = {sequence};
+  rp.joint_map = joint_map;
+  rp.X_WS = RecordingPose(data, sequence, placement);
+  perception::SkeletonReplay replay(rp, std::move(one));
+  const std::vector<std::string>& names = replay.published_joint_names();
+
+  // Which body joints come from the recording, which are derived.
+  std::vector<int> column(body_joints.size(), -1);
+  int neck = -1, head = -1, torso = -1, shoulder_l = -1, shoulder_r = -1;
+  for (std::size_t b = 0; b < body_joints.size(); ++b) {
+    const auto it = std::find(names.begin(), names.end(), body_joints[b]);
+    if (it != names.end()) {
+      column[b] = static_cast<int>(it - names.begin());
+    } else if (body_joints[b] == "neck") {
+      neck = static_cast<int>(b);
+    } else if (body_joints[b] == "head") {
+      head = static_cast<int>(b);
+    } else if (body_joints[b] == "torso") {
+      torso = static_cast<int>(b);
+    } else {
+      throw std::invalid_argument("body joint '" + body_joints[b] + "' is not in " + file +
+                                  " (after joint_map) and cannot be derived (only head, neck and torso are)");
+    }
+    if (body_joints[b] == "shoulder_l") shoulder_l = static_cast<int>(b);
+    if (body_joints[b] == "shoulder_r") shoulder_r = static_cast<int>(b);
+  }
+  if ((neck >= 0 || head >= 0 || torso >= 0) && (shoulder_l < 0 || shoulder_r < 0 || column[shoulder_l] < 0 ||
+                                                 column[shoulder_r] < 0)) {
+    throw std::invalid_argument("head, neck and torso are derived from shoulder_l and shoulder_r, which " + file +
+                                " lacks");
+  }
+
+  // Recorded frames in W, undetected joints held; before every joint has
+  // been seen once, frames are skipped.
+  std::vector<double> times;
+  std::vector<Eigen::Matrix3Xd> frames;
+  std::vector<bool> seen(names.size(), false);
+  Eigen::Matrix3Xd last = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(names.size()));
+  perception::ReplayFrame f;
+  while (replay.Next(1e300, &f)) {
+    for (const auto& j : f.joints) {
+      const auto it = std::find(names.begin(), names.end(), j.name);
+      const std::size_t k = static_cast<std::size_t>(it - names.begin());
+      last.col(static_cast<Eigen::Index>(k)) = j.position_W;
+      seen[k] = true;
+    }
+    if (std::find(seen.begin(), seen.end(), false) != seen.end()) continue;
+    if (!times.empty() && !(f.play_time > times.back())) continue;
+    times.push_back(f.play_time);
+    frames.push_back(last);
+  }
+  if (frames.empty()) throw std::invalid_argument("sequence '" + sequence + "' never shows every joint of " + file);
+
+  PersonStream s;
+  s.joint_names = body_joints;
+  s.rate_hz = rate_hz;
+  const int n = static_cast<int>(std::floor(duration * rate_hz)) + 1;
+  const double t0 = times.front();
+  std::size_t seg = 0;
+  for (int i = 0; i < n; ++i) {
+    // Recording time of this frame: the first pose until the delay is over.
+    const double r = t0 + placement.clip_start + std::max(0.0, i / rate_hz - placement.delay);
+    while (seg + 1 < times.size() && times[seg + 1] <= r) ++seg;
+    Eigen::Matrix3Xd rec = frames[seg];
+    if (seg + 1 < times.size() && r > times[seg]) {
+      const double u = (r - times[seg]) / (times[seg + 1] - times[seg]);
+      rec = (1 - u) * frames[seg] + u * frames[seg + 1];
+    }
+    Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(body_joints.size()));
+    for (std::size_t b = 0; b < body_joints.size(); ++b) {
+      if (column[b] >= 0) p.col(static_cast<Eigen::Index>(b)) = rec.col(column[b]);
+    }
+    if (neck >= 0 || head >= 0 || torso >= 0) {
+      const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+      const Eigen::Vector3d n_W = 0.5 * (p.col(shoulder_l) + p.col(shoulder_r)) + kShoulderBelowNeck * up;
+      if (neck >= 0) p.col(neck) = n_W;
+      if (head >= 0) p.col(head) = n_W + kNeckToHead * up;
+      if (torso >= 0) p.col(torso) = n_W - kTorsoToNeck * up;
+    }
+    s.truth.push_back(std::move(p));
+  }
+  AddNoise(noise_std, seed, &s);
+  return s;
+}
+
+PersonStream SyntheticPersonStream(const perception::SyntheticPersonParams& person, const SyntheticPlacement& placement,
+                                   const std::vector<std::string>& body_joints, double rate_hz, double duration,
+                                   double noise_std, uint64_t seed) {
+  CheckArguments(rate_hz, duration, noise_std);
+  perception::SyntheticPersonParams p = person;
+  p.torso_W += placement.torso_offset_W;
+  p.facing_yaw += placement.yaw;
+  p.loop = false;
+  perception::SyntheticPerson sim(p);
+  // Before the script starts the person idles in the last step's action, as
+  // the synthetic person does before its first episode.
+  sim.StartScript(placement.script_start);
+
+  PersonStream s;
+  s.joint_names = body_joints;
+  s.rate_hz = rate_hz;
+  const int n = static_cast<int>(std::floor(duration * rate_hz)) + 1;
+  std::vector<int> index;
+  for (int i = 0; i < n; ++i) {
+    const std::vector<perception::JointSample> pose = sim.TruePose(i / rate_hz);
+    if (index.empty()) {
+      for (const auto& name : body_joints) {
+        const auto it = std::find_if(pose.begin(), pose.end(), [&](const auto& j) { return j.name == name; });
+        if (it == pose.end()) throw std::invalid_argument("body joint '" + name + "' is not a joint of the synthetic person");
+        index.push_back(static_cast<int>(it - pose.begin()));
+      }
+    }
+    Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(body_joints.size()));
+    for (std::size_t b = 0; b < body_joints.size(); ++b) {
+      q.col(static_cast<Eigen::Index>(b)) = pose[static_cast<std::size_t>(index[b])].position_W;
+    }
+    s.truth.push_back(std::move(q));
+  }
+  AddNoise(noise_std, seed, &s);
+  return s;
+}
+
+}  // namespace iplan::cell_sim

@@ -1,0 +1,384 @@
+// `iplan eval interaction`: the closed-loop interaction benchmark. Seeded
+// scenarios in the cell (a robot task while a recorded or the synthetic
+// person moves near or across its path), each run in one process and in
+// simulated time through the services' cores once per predictor, and the
+// figures per predictor: task time, protective stops, time in stop, minimum
+// true separation, maximum true bound, true contacts (median and [p10, p90]
+// over the scenarios, paired ratios against `none`). The work is done by
+// services/cell_sim; this file parses options, prepares the intent model as
+// `iplan demo --prepare-only` does, and prints.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <memory>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include <nlohmann/json.hpp>
+
+#include "cell_config.h"
+#include "command_registry.h"
+#include "core/interaction_benchmark.h"
+#include "dds_cell_model.h"
+#include "iplan/core/atomic_file.h"
+#include "iplan/core/stats.h"
+#include "iplan/framework/service.h"
+#include "iplan/intent/model_io.h"
+#include "iplan/intent/skeleton_data.h"
+
+namespace iplan::cli {
+namespace {
+
+namespace fs = std::filesystem;
+using cell_sim::Predictor;
+using Json = nlohmann::ordered_json;
+
+const char* kAllPredictors = "none,constant-position,constant-velocity,model,oracle";
+
+struct InteractionOptions {
+  std::string predictors = kAllPredictors;
+  int scenarios = 40;
+  uint64_t seed = 1;
+  std::string json_file, config_dir, recordings, model_dir, monitor = "same";
+  int threads = 1;
+  int trace = -1;  // scenario whose runs are traced (-1: none)
+  double time_limit = 20;
+  bool retrain = false, quiet = false;
+};
+
+std::string Fixed(double v, int digits) {
+  if (std::isinf(v)) return "inf";
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+std::string SpreadText(const cell_sim::Spread& s, int digits) {
+  return Fixed(s.median, digits) + " [" + Fixed(s.p10, digits) + ", " + Fixed(s.p90, digits) + "]";
+}
+
+Json SpreadJson(const cell_sim::Spread& s) { return Json{{"median", s.median}, {"p10", s.p10}, {"p90", s.p90}}; }
+
+// A ratio for JSON: infinity (stops where `none` had none) has no JSON number.
+Json RatioJson(double r) { return std::isfinite(r) ? Json(r) : Json(nullptr); }
+
+Json VectorJson(const Eigen::VectorXd& v) {
+  Json a = Json::array();
+  for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
+  return a;
+}
+
+int RunInteraction(const InteractionOptions& o) {
+  // Options first: a bad request is refused before anything is loaded.
+  std::vector<Predictor> predictors;
+  {
+    std::stringstream ss(o.predictors);
+    std::string name;
+    while (std::getline(ss, name, ',')) {
+      if (name.empty()) continue;
+      const auto p = cell_sim::ParsePredictor(name);
+      if (!p) {
+        std::string known;
+        for (const auto& n : cell_sim::PredictorNames()) known += (known.empty() ? "" : ", ") + n;
+        std::cerr << "iplan eval interaction: unknown predictor '" << name << "' (known: " << known << ")\n";
+        return 2;
+      }
+      if (std::find(predictors.begin(), predictors.end(), *p) != predictors.end()) {
+        std::cerr << "iplan eval interaction: predictor '" << name << "' named twice\n";
+        return 2;
+      }
+      predictors.push_back(*p);
+    }
+  }
+  if (predictors.empty()) {
+    std::cerr << "iplan eval interaction: --predictors names no predictor\n";
+    return 2;
+  }
+  if (o.scenarios < 1) {
+    std::cerr << "iplan eval interaction: --scenarios must be at least 1, got " << o.scenarios << "\n";
+    return 2;
+  }
+  if (!(o.time_limit > 0)) {
+    std::cerr << "iplan eval interaction: --time-limit must be > 0 s\n";
+    return 2;
+  }
+  if (o.monitor != "same" && o.monitor != "model") {
+    std::cerr << "iplan eval interaction: --monitor-prediction must be 'same' or 'model', got '" << o.monitor << "'\n";
+    return 2;
+  }
+  const std::string dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
+  if (dir.empty()) {
+    std::cerr << "iplan eval interaction: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+    return 2;
+  }
+  // The recorded motion sits beside the checkout (../shared, as the
+  // perception replay's example path says).
+  const std::string recordings_file =
+      o.recordings.empty() ? (fs::path(dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
+                           : o.recordings;
+
+  const auto wall0 = std::chrono::steady_clock::now();
+  cell_sim::CellConfig cell;
+  intent::SkeletonDataset recordings;
+  CellModelResult model;
+  std::shared_ptr<const intent::IntentModel> intent_model;
+  try {
+    cell = cell_sim::LoadCellConfig(dir, o.threads);
+    if (!fs::exists(recordings_file)) {
+      throw std::runtime_error("no recorded motion at " + recordings_file + " (set --recordings)");
+    }
+    recordings = intent::LoadSkeletonCsv(recordings_file);
+    // The demo cell's model, trained or taken from the cache exactly as
+    // `iplan demo --prepare-only` does.
+    const std::string fallback = o.model_dir.empty() ? (fs::temp_directory_path() / "iplan-eval-model").string() : o.model_dir;
+    model = EnsureCellModel((fs::path(dir) / "perception.yaml").string(), (fs::path(dir) / "intent.yaml").string(),
+                            fallback, o.retrain);
+    intent_model = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(model.path));
+  } catch (const std::exception& e) {
+    std::cerr << "iplan eval interaction: " << e.what() << "\n";
+    return 2;
+  }
+
+  cell_sim::BenchmarkSetup setup = cell.MakeSetup();
+  setup.intent_model = intent_model;
+  setup.recordings = &recordings;
+  setup.recordings_file = recordings_file;
+  // As perception.replay.joint_map would rename them for this body model.
+  setup.joint_map = {{"wrist_l", "hand_l"}, {"wrist_r", "hand_r"}};
+  setup.time_limit = o.time_limit;
+  setup.loop.max_duration = o.time_limit + 1.0;
+  setup.monitor_input = o.monitor == "same" ? cell_sim::MonitorInput::kSame : cell_sim::MonitorInput::kModel;
+  try {
+    cell_sim::CalibrateBaselines(RecordCellDemonstrations(cell.person), &setup);
+  } catch (const std::exception& e) {
+    std::cerr << "iplan eval interaction: baseline calibration: " << e.what() << "\n";
+    return 2;
+  }
+
+  std::vector<cell_sim::ScenarioSpec> specs;
+  try {
+    specs = cell_sim::MakeScenarios(setup, o.scenarios, o.seed);
+  } catch (const std::exception& e) {
+    std::cerr << "iplan eval interaction: " << e.what() << "\n";
+    return 2;
+  }
+
+  std::cout << "iplan eval interaction: " << specs.size() << " scenarios, seed " << o.seed << ", predictors";
+  for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
+  std::cout << "\n  configuration " << dir << "\n  recorded motion " << recordings_file << "\n  " << model.summary
+            << "\n  monitor prediction: "
+            << (setup.monitor_input == cell_sim::MonitorInput::kModel ? "the model's, for every predictor"
+                                                                        : "the planner's (with none: the model's)")
+            << "; planner threads " << (o.threads > 0 ? std::to_string(o.threads) : std::string("as configured"))
+            << "\n  baseline covariance growth per joint, fitted on the model's training demonstrations:";
+  const auto& body_joints = cell.body->params().joints;
+  for (const auto* b : {&setup.constant_position, &setup.constant_velocity}) {
+    std::cout << "\n    " << (b == &setup.constant_position ? "constant-position speed_std m/s:       "
+                                                             : "constant-velocity acceleration_std m/s^2:");
+    for (std::size_t j = 0; j < b->joint_growth.size(); ++j) {
+      std::cout << " " << body_joints[j] << " " << Fixed(b->joint_growth[j], 3);
+    }
+  }
+  std::cout << "\n\n";
+
+  std::vector<std::vector<cell_sim::InteractionResult>> results;
+  std::vector<double> cycle_times;
+  Json scenarios = Json::array();
+  for (const auto& s : specs) {
+    if (o.trace >= 0 && s.index != o.trace) continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (o.trace >= 0) {
+      setup.loop.trace = [](double t, const std::string& event) {
+        std::cerr << "    " << std::fixed << std::setprecision(2) << std::setw(6) << t << " " << event << "\n";
+      };
+    }
+    try {
+      results.push_back(cell_sim::RunScenario(setup, s, predictors));
+    } catch (const std::exception& e) {
+      std::cerr << "iplan eval interaction: scenario " << s.index << ": " << e.what() << "\n";
+      return 1;
+    }
+    const auto& row = results.back();
+    if (!o.quiet) {
+      std::cerr << "  scenario " << std::setw(3) << s.index + 1 << "/" << specs.size() << " " << s.source << " "
+                << s.sequence.substr(0, 24) << ", " << s.task << " from " << s.start << ":";
+      for (std::size_t p = 0; p < predictors.size(); ++p) {
+        std::cerr << " " << cell_sim::ToString(predictors[p]) << " " << Fixed(row[p].task_time, 1) << " s/"
+                  << row[p].protective_stops << "st";
+      }
+      std::cerr << " (" << Fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1)
+                << " s)\n";
+    }
+    for (std::size_t p = 0; p < predictors.size(); ++p) {
+      const cell_sim::InteractionResult& r = row[p];
+      cycle_times.insert(cycle_times.end(), r.planning_times.begin(), r.planning_times.end());
+      Json j;
+      j["scenario"] = s.index;
+      j["predictor"] = cell_sim::ToString(predictors[p]);
+      j["source"] = s.source;
+      j["subject"] = s.subject;
+      j["sequence"] = s.sequence;
+      j["placement_m"] = VectorJson(s.placement_W);
+      j["yaw_rad"] = s.yaw;
+      if (s.source == "recorded") j["clip_start_s"] = s.clip_start;
+      j["delay_s"] = s.delay;
+      j["task"] = s.task;
+      j["start"] = s.start;
+      j["start_q"] = VectorJson(s.start_q);
+      j["goal_q"] = VectorJson(s.goal_q);
+      if (s.retreat_q.size() > 0) j["retreat_q"] = VectorJson(s.retreat_q);
+      if (s.task == "reach") j["reach_p_m"] = VectorJson(s.reach_p_WE);
+      j["noise_seed"] = s.seed;
+      j["succeeded"] = r.finished && r.status == trajopt::TaskStatus::kSucceeded;
+      if (!r.reason.empty()) j["reason"] = r.reason;
+      j["task_time_s"] = r.task_time;
+      j["protective_stops"] = r.protective_stops;
+      j["stops_by_separation"] = r.stops_separation;
+      j["stops_by_bound"] = r.stops_bound;
+      j["stop_time_s"] = r.stop_time;
+      j["min_separation_m"] = r.min_separation;
+      j["max_bound"] = r.max_bound;
+      j["true_contacts"] = r.true_contacts;
+      j["waits"] = r.waits;
+      j["planner_delay_s"] = r.planner_delay;
+      if (!r.first_stop_reason.empty()) j["first_stop"] = r.first_stop_reason;
+      scenarios.push_back(std::move(j));
+    }
+  }
+
+  const std::vector<cell_sim::PredictorSummary> summary = cell_sim::Summarize(predictors, results);
+  Json per = Json::object();
+  for (const auto& s : summary) {
+    Json j;
+    j["scenarios"] = s.scenarios;
+    j["succeeded"] = s.succeeded;
+    j["task_time_s"] = SpreadJson(s.task_time);
+    Json stops = SpreadJson(s.protective_stops);
+    stops["total"] = s.protective_stops_total;
+    stops["by_separation"] = s.stops_separation_total;
+    stops["by_bound"] = s.stops_bound_total;
+    j["protective_stops"] = stops;
+    Json stop_time = SpreadJson(s.stop_time);
+    stop_time["total"] = s.stop_time_total;
+    j["stop_time_s"] = stop_time;
+    j["min_separation_m"] = SpreadJson(s.min_separation);
+    j["max_bound"] = SpreadJson(s.max_bound);
+    j["true_contacts"] = s.true_contacts;
+    if (s.has_reference) {
+      j["vs_none"] = Json{{"task_time_median_ratio", RatioJson(s.task_time_median_ratio)},
+                          {"task_time_paired_ratio", SpreadJson(s.task_time_ratio)},
+                          {"protective_stops_ratio", RatioJson(s.protective_stops_ratio)},
+                          {"stop_time_ratio", RatioJson(s.stop_time_ratio)}};
+    }
+    per[cell_sim::ToString(s.predictor)] = std::move(j);
+  }
+  Json doc;
+  doc["command"] = "iplan eval interaction";
+  doc["seed"] = o.seed;
+  doc["num_scenarios"] = specs.size();
+  doc["monitor_prediction"] = o.monitor;
+  doc["time_limit_s"] = o.time_limit;
+  doc["recordings"] = fs::path(recordings_file).filename().string();
+  Json growth = Json::object();
+  for (const auto* b : {&setup.constant_position, &setup.constant_velocity}) {
+    Json g = Json::object();
+    for (std::size_t j = 0; j < b->joint_growth.size(); ++j) g[body_joints[j]] = b->joint_growth[j];
+    growth[b == &setup.constant_position ? "constant-position_speed_std_m_s" : "constant-velocity_acceleration_std_m_s2"] = g;
+  }
+  doc["baseline_growth"] = std::move(growth);
+  doc["predictors"] = std::move(per);
+  doc["scenarios"] = std::move(scenarios);
+
+  // The table.
+  const int w = 19;
+  std::cout << std::left << std::setw(w) << "predictor" << std::setw(24) << "task time s" << std::setw(20)
+            << "stops tot sep/bnd" << std::setw(24) << "time in stop s" << std::setw(24) << "min separation m"
+            << std::setw(24) << "max true bound" << std::setw(9) << "contacts" << "done\n";
+  for (const auto& s : summary) {
+    std::cout << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
+              << SpreadText(s.task_time, 2) << std::setw(20)
+              << (std::to_string(s.protective_stops_total) + " " + std::to_string(s.stops_separation_total) + "/" +
+                  std::to_string(s.stops_bound_total))
+              << std::setw(24) << SpreadText(s.stop_time, 2) << std::setw(24) << SpreadText(s.min_separation, 3)
+              << std::setw(24) << SpreadText(s.max_bound, 3) << std::setw(9) << s.true_contacts << s.succeeded << "/"
+              << s.scenarios << "\n";
+  }
+  if (!summary.empty() && summary.front().has_reference) {
+    std::cout << "\npaired against none: task time (median of per-scenario ratios [p10, p90]; ratio of medians),\n"
+              << "protective stops and time in stop (ratio of totals)\n";
+    for (const auto& s : summary) {
+      std::cout << "  " << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
+                << SpreadText(s.task_time_ratio, 2) << std::setw(8) << Fixed(s.task_time_median_ratio, 2)
+                << " stops " << std::setw(8) << Fixed(s.protective_stops_ratio, 2) << " stop time "
+                << Fixed(s.stop_time_ratio, 2) << "\n";
+    }
+  }
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+  std::sort(cycle_times.begin(), cycle_times.end());
+  std::cout << "\nwall time " << Fixed(wall, 1) << " s; planning cycles " << cycle_times.size() << ", p50 "
+            << Fixed(1e3 * core::QuantileSorted(cycle_times, 0.5), 1) << " ms, p99 "
+            << Fixed(1e3 * core::QuantileSorted(cycle_times, 0.99), 1) << " ms (wall time, not in the JSON)\n";
+
+  if (!o.json_file.empty()) {
+    try {
+      core::WriteFileAtomically(o.json_file, doc.dump(2) + "\n");
+    } catch (const std::exception& e) {
+      std::cerr << "iplan eval interaction: cannot write " << o.json_file << ": " << e.what() << "\n";
+      return 1;
+    }
+    std::cout << "JSON written to " << o.json_file << "\n";
+  }
+  return 0;
+}
+
+const bool kRegistered = RegisterCommand("eval", [](CLI::App& app) {
+  CLI::App* eval = app.add_subcommand("eval", "Benchmarks of the whole cell, in one process and in simulated time");
+  eval->require_subcommand(1);
+  auto o = std::make_shared<InteractionOptions>();
+  CLI::App* c = eval->add_subcommand(
+      "interaction",
+      "Closed-loop interaction benchmark: seeded scenarios in the cell (a robot task from the task graph or a\n"
+      "table-top reach while a person moves near or across its path: recorded arm motion of assembly.csv, both\n"
+      "people, placed across the table, or the synthetic person of perception.yaml), each run through the\n"
+      "services' own cores at the cell's rates (skeletons with sensor noise -> prediction -> replanner every\n"
+      "planning step -> collision-risk monitor, whose PROTECTIVE_STOP stops the simulated robot, resuming after\n"
+      "the supervisor's resume_delay -> robot), once per predictor. The true body decides contacts, separation\n"
+      "and the true bound. Deterministic for a seed. Prints a table (median [p10, p90] over the scenarios and\n"
+      "ratios against 'none'); --json writes every figure and every scenario. Exit code 2 on bad input.\n"
+      "Predictors: none (the planner gets no prediction; only the monitor protects, with the model's), constant-position,\n"
+      "constant-velocity (least-squares velocity over 0.25 s), model (the cell's trained intent model, trained\n"
+      "or cached as `iplan demo --prepare-only` does), oracle (the true future with the model's covariances).");
+  c->add_option("--predictors", o->predictors, "comma-separated predictors to compare")->capture_default_str();
+  c->add_option("--scenarios", o->scenarios, "number of scenarios (>= 1)")->capture_default_str();
+  c->add_option("--seed", o->seed, "seed of the scenarios and the sensor noise")->capture_default_str();
+  c->add_option("--json", o->json_file, "write the figures and every scenario's run as JSON to this file");
+  c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
+  c->add_option("--recordings", o->recordings,
+                "skeleton CSV of recorded motion (default: CONFIG/../../shared/data/assembly.csv)");
+  c->add_option("--monitor-prediction", o->monitor,
+                "what the collision-risk monitor predicts with: 'same' (the planner's prediction, as the cell's one "
+                "prediction topic carries it; with none the model's) or 'model' (the model's for every predictor: "
+                "only planning differs)")
+      ->capture_default_str();
+  c->add_option("--time-limit", o->time_limit, "s a task may take before it counts as failed")->capture_default_str();
+  c->add_option("--threads", o->threads,
+                "planner threads (0: as planner_replanning.yaml; results do not depend on it)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 64));
+  c->add_option("--model-dir", o->model_dir,
+                "folder for the intent model when config/models is not writable (default: a temporary folder)");
+  c->add_flag("--retrain", o->retrain, "train the intent model again even if a cached one fits");
+  c->add_flag("--quiet", o->quiet, "no progress line per scenario on stderr");
+  c->add_option("--trace", o->trace,
+                "run only scenario N (0-based) and print every planning cycle, stop and resume of each predictor's run "
+                "to stderr, to see why it went as it did");
+  c->callback([o] { SetExitCode(RunInteraction(*o)); });
+});
+
+}  // namespace
+}  // namespace iplan::cli
