@@ -185,9 +185,46 @@ TEST_F(IntentModelTest, EvalJsonHasTheDocumentedKeys) {
   const EvalReport r = EvaluateIntentModel(*model_, MakeDataset(3), EvalParams{});
   const std::string json = EvalReportToJson(r);
   for (const char* key : {"\"accuracy\"", "\"0.2\"", "\"1.0\"", "\"error_m\"", "\"0.333\"",
-                          "\"const_velocity\"", "\"coverage95\"", "\"inference_ms\"", "\"p99\""}) {
+                          "\"const_velocity\"", "\"const_velocity_frames\"", "\"smoothed_position\"",
+                          "\"const_velocity_by_frames\"", "\"coverage95\"", "\"inference_ms\"",
+                          "\"p99\""}) {
     EXPECT_NE(json.find(key), std::string::npos) << key << " missing in\n" << json;
   }
+}
+
+// The evaluation's constant-velocity baseline fits a least-squares line
+// through the last L frames: on noise-free motion at constant velocity it
+// is exact for every L >= 2 once two frames are recorded, while holding the
+// pose is not. (The first window of a track has one frame and no velocity.)
+TEST_F(IntentModelTest, ConstantVelocityBaselineIsExactOnALine) {
+  SkeletonDataset d = MakeDataset(5);
+  for (SkeletonSequence& s : d.sequences) {
+    for (Eigen::Index i = 0; i < s.positions.rows(); ++i) {
+      for (Eigen::Index c = 0; c < s.positions.cols(); ++c) {
+        s.positions(i, c) = 0.1 * c + (0.2 + 0.01 * c) * s.time(i);
+      }
+    }
+  }
+  EvalParams params;
+  params.velocity_frames = {2, 4, 7};
+  const EvalReport r = EvaluateIntentModel(*model_, d, params);
+  ASSERT_GT(r.num_forecast_windows, 0);
+  ASSERT_EQ(r.error_const_velocity_by_frames.rows(), 3);
+  // Equal-length tracks, same velocity everywhere: only the first window of
+  // each track errs, by the constant-position error.
+  ASSERT_EQ(r.num_forecast_windows % r.num_sequences, 0);
+  const double first_share = static_cast<double>(r.num_sequences) / r.num_forecast_windows;
+  for (size_t k = 0; k < r.horizon_s.size(); ++k) {
+    EXPECT_GT(r.error_const_position[k], 0.01 * r.horizon_s[k]);
+    for (int v = 0; v < 3; ++v) {
+      EXPECT_NEAR(r.error_const_velocity_by_frames(v, k), first_share * r.error_const_position[k], 1e-12);
+    }
+    EXPECT_NEAR(r.error_const_velocity[k], first_share * r.error_const_position[k], 1e-12);
+    // The line passes through the newest frame: holding its value is holding the pose.
+    EXPECT_NEAR(r.error_smoothed_position[k], r.error_const_position[k], 1e-12);
+  }
+  params.velocity_frames = {};
+  EXPECT_THROW(EvaluateIntentModel(*model_, d, params), std::invalid_argument);
 }
 
 // Recorded Florence 3D sequences of `subjects` as a tracker that gives only
