@@ -81,4 +81,18 @@ void ExtrapolateKinematic(const Eigen::Ref<const Eigen::MatrixXd>& window,
   }
 }
 
+void MeanJointSpeeds(const Eigen::Ref<const Eigen::MatrixXd>& window, double rate,
+                     Eigen::VectorXd* speeds) {
+  const Eigen::Index n = window.rows(), J = window.cols() / 3;
+  speeds->setZero(J);
+  if (n < 2) return;
+  for (Eigen::Index j = 0; j < J; ++j) {
+    double path = 0.0;
+    for (Eigen::Index r = 1; r < n; ++r) {
+      path += (window.block<1, 3>(r, 3 * j) - window.block<1, 3>(r - 1, 3 * j)).norm();
+    }
+    (*speeds)(j) = path * rate / static_cast<double>(n - 1);
+  }
+}
+
 }  // namespace iplan::intent

@@ -1,5 +1,6 @@
 #include "iplan/intent/kinematic_baseline.h"
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <random>
@@ -95,6 +96,19 @@ TEST(KinematicBaselineTest, LongerFitsAverageOutWhiteNoise) {
     err8 += p.squaredNorm();
   }
   EXPECT_LT(err8, 0.6 * err1);
+}
+
+TEST(KinematicBaselineTest, MeanJointSpeedsArePathLengthPerSecond) {
+  // Joint 0 moves 3 cm per frame along x then stops; joint 1 is still.
+  Eigen::MatrixXd rows = Eigen::MatrixXd::Zero(5, 6);
+  for (int i = 0; i < 5; ++i) rows(i, 0) = 0.03 * std::min(i, 3);
+  Eigen::VectorXd u;
+  MeanJointSpeeds(rows, 10.0, &u);
+  ASSERT_EQ(u.size(), 2);
+  EXPECT_NEAR(u(0), 0.09 * 10.0 / 4.0, 1e-12);
+  EXPECT_EQ(u(1), 0.0);
+  MeanJointSpeeds(rows.topRows(1), 10.0, &u);
+  EXPECT_EQ(u, Eigen::VectorXd::Zero(2));
 }
 
 TEST(KinematicBaselineTest, InvalidParametersAreNamed) {

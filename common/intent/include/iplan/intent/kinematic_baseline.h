@@ -57,4 +57,12 @@ void ExtrapolateKinematic(const Eigen::Ref<const Eigen::MatrixXd>& window,
                           const KinematicBaseline& baseline, double rate, int horizon,
                           Eigen::MatrixXd* out);
 
+/// Mean speed of each joint over a window (n rows of 3 J columns, newest
+/// last, `rate` Hz): for joint j (columns 3j..3j+2) the path length
+/// sum_r |x_j(r + 1) - x_j(r)| times rate / (n - 1), m/s. Repeated (padding)
+/// rows add nothing; zero for n < 2. Resizes `speeds` to J; does not allocate
+/// when it already has that size. Thread-safe.
+void MeanJointSpeeds(const Eigen::Ref<const Eigen::MatrixXd>& window, double rate,
+                     Eigen::VectorXd* speeds);
+
 }  // namespace iplan::intent
