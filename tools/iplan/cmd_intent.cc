@@ -3,8 +3,11 @@
 // data and evaluate it. The work is done by iplan::intent; this file only
 // parses options and prints.
 #include <algorithm>
+#include <array>
 #include <chrono>
+#include <cmath>
 #include <iostream>
+#include <map>
 #include <memory>
 #include <sstream>
 #include <stdexcept>
@@ -65,11 +68,14 @@ struct TrainOptions {
   // the torso weight and the lambda grid differ from the library's
   // (FrameFeatureOptions, TrainParams), see docs/intent.md "Known limits".
   std::string sigma_factors, prefixes, belief_taus;
+  std::string baseline_frames, baseline_taus, residual_weights;
+  bool no_calibration = false;
+  int forecast_cv_folds = 5;
   std::string lambdas = "1e-5,1e-4,1e-3";
   double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 3.0;
   bool normalise_size = false;
   double ivm_tolerance = 1e-3;
-  int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80;
+  int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80, velocity_frames = 2;
   int gp_iterations = 150, max_forecast_windows = 600, forecast_stride = 2;
   std::uint64_t seed = 1;
 };
@@ -108,6 +114,7 @@ void RunTrain(const TrainOptions& o) {
   config.rate = o.rate;
   config.window = o.window;
   config.horizon = o.horizon;
+  config.velocity_frames = o.velocity_frames;
   config.dtw_band = o.band;
   config.sensor_noise_std = o.noise;
   config.features.torso_motion_weight = o.torso_weight;
@@ -118,6 +125,17 @@ void RunTrain(const TrainOptions& o) {
   if (!o.lambdas.empty()) params.lambdas = ParseDoubles(o.lambdas, "--lambdas");
   if (!o.belief_taus.empty()) params.belief_time_constants = ParseDoubles(o.belief_taus, "--belief-taus");
   if (!o.prefixes.empty()) params.prefix_fractions = ParseDoubles(o.prefixes, "--prefixes");
+  if (!o.baseline_frames.empty()) {
+    params.baseline_smoothing_frames.clear();
+    for (double L : ParseDoubles(o.baseline_frames, "--baseline-frames")) {
+      if (L != std::floor(L)) throw std::invalid_argument("--baseline-frames: " + std::to_string(L) + " is not an integer");
+      params.baseline_smoothing_frames.push_back(static_cast<int>(L));
+    }
+  }
+  if (!o.baseline_taus.empty()) params.baseline_damping_time_constants = ParseDoubles(o.baseline_taus, "--baseline-taus");
+  if (!o.residual_weights.empty()) params.residual_weights = ParseDoubles(o.residual_weights, "--residual-weights");
+  params.calibrate_covariance = !o.no_calibration;
+  params.forecast_cv_folds = o.forecast_cv_folds;
   params.ivm.max_import = o.max_import;
   params.ivm.stop_tolerance = o.ivm_tolerance;
   params.pseudo_inputs = o.pseudo_inputs;
@@ -170,7 +188,44 @@ void RunTrain(const TrainOptions& o) {
                         rep.forecast_padded.end()
                     ? "  (* short clips: futures past the recording end hold the last pose)"
                     : "")
-            << "\n  " << rep.seconds_forecaster << " s\ntraining time: " << seconds
+            << "\n  kinematic baseline (least-squares line over L frames, velocity decaying with tau),\n"
+            << "  mean joint error over all steps on the training windows; best tau per L:\n"
+            << "    L  tau_s  error_m\n";
+  std::map<int, std::array<double, 3>> best_per_frames;
+  for (const auto& row : rep.baseline_table) {
+    auto [it, fresh] = best_per_frames.emplace(static_cast<int>(row[0]), row);
+    if (!fresh && row[2] < it->second[2]) it->second = row;
+  }
+  for (const auto& [L, row] : best_per_frames) {
+    std::cout << "    " << L << "  " << (L == 1 ? 0.0 : row[1]) << "  " << row[2] << "\n";
+  }
+  std::cout << "  (holding the last pose: " << rep.error_const_position << " m)\n  chosen L "
+            << rep.baseline.smoothing_frames << ", tau " << rep.baseline.damping_time_constant << " s\n";
+  if (rep.forecast_cv_folds > 0) {
+    std::cout << "  residual weight, cross-validation (" << rep.forecast_cv_folds
+              << " folds: the training subjects, or with one subject its sequences; "
+              << rep.forecast_cv_windows << " held-out windows), held-out mean joint error [m]:\n"
+              << "    w  step~0.5s  last_step  all_steps\n";
+    for (const auto& row : rep.residual_cv_table) {
+      std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
+    }
+    std::cout << "  chosen w " << rep.residual_weight << "\n";
+    if (!rep.motion_cv_table.empty()) {
+      std::cout << "  covariance activity offset m0, held-out (after calibration):\n"
+                << "    m0_m_per_s  nll  coverage\n";
+      for (const auto& row : rep.motion_cv_table) {
+        std::cout << "    " << row[0] << "  " << row[1] << "  " << 100.0 * row[2] << " %\n";
+      }
+      std::cout << "  chosen m0 " << rep.motion_offset << " m/s\n";
+    }
+    std::cout << "  held-out 95 % coverage " << 100.0 * rep.cv_coverage_raw
+              << " % raw, " << 100.0 * rep.cv_coverage_calibrated << " % calibrated (variance scales min "
+              << rep.variance_scale_min << ", median " << rep.variance_scale_median << ", max "
+              << rep.variance_scale_max << ")\n";
+  } else {
+    std::cout << "  no forecaster cross-validation (fewer than two training groups): w = 1, uncalibrated\n";
+  }
+  std::cout << "  " << rep.seconds_forecaster << " s\ntraining time: " << seconds
             << " s\nmodel written to " << o.out << "\n";
 }
 
@@ -226,6 +281,8 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--rate", t.rate, "Model rate, Hz")->capture_default_str();
   train->add_option("--window,-T", t.window, "Window length T, frames")->capture_default_str();
   train->add_option("--horizon", t.horizon, "Forecast horizon, frames")->capture_default_str();
+  train->add_option("--velocity-frames", t.velocity_frames,
+                    "Forecaster input velocities: finite differences over this many frames")->capture_default_str();
   train->add_option("--pseudo-inputs,-M", t.pseudo_inputs, "SPGP pseudo-inputs per action")->capture_default_str();
   train->add_option("--band", t.band, "DTW Sakoe-Chiba band, frames")->capture_default_str();
   train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
@@ -235,6 +292,16 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--belief-taus", t.belief_taus,
                     "CV belief-filter time constants, s; inf allowed (default 0,0.25,0.5,1,2,4,inf)");
   train->add_option("--prefixes", t.prefixes, "Training prefix fractions (default 0.2,...,1.0)");
+  train->add_option("--baseline-frames", t.baseline_frames,
+                    "Kinematic baseline: least-squares frames L tried (default 1,2,3,4,5,6,8,10)");
+  train->add_option("--baseline-taus", t.baseline_taus,
+                    "Kinematic baseline: velocity decay time constants tried, s; inf allowed "
+                    "(default 0,0.1,0.2,0.3,0.5,0.75,1,1.5,2,inf)");
+  train->add_option("--residual-weights", t.residual_weights,
+                    "CV weights of the SPGP residual over the baseline (default 0,0.25,0.5,0.75,1)");
+  train->add_flag("--no-calibration", t.no_calibration, "Do not calibrate the forecast covariances");
+  train->add_option("--forecast-cv-folds", t.forecast_cv_folds,
+                    "Forecaster CV folds (training subjects, or one subject's sequences)")->capture_default_str();
   train->add_option("--gp-iterations", t.gp_iterations, "L-BFGS iterations per action")->capture_default_str();
   train->add_option("--max-forecast-windows", t.max_forecast_windows, "Forecaster windows per action")->capture_default_str();
   train->add_option("--forecast-stride", t.forecast_stride, "Frames between forecaster windows")->capture_default_str();

@@ -30,11 +30,13 @@ std::string ReadFile(const fs::path& p) {
 }
 
 // Everything the trained model depends on, as text: a changed person, joint
-// set or rate makes the cached model stale.
+// set or rate makes the cached model stale, and so does a model file format
+// written by another build (an older file may still load, but it lacks what
+// the newer training chooses, e.g. the calibrated forecast covariances).
 std::string ModelKey(const perception::SyntheticPersonParams& p, const std::vector<std::string>& joints, double rate) {
   std::ostringstream k;
   k.precision(17);
-  k << "iplan cell intent model v1\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
+  k << "iplan cell intent model v1\nformat " << intent::kIntentModelFormatVersion << "\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
     << kSeconds << "\nrate " << rate << "\njoints";
   for (const auto& j : joints) k << " " << j;
   k << "\ntorso " << p.torso_W.transpose() << " rest " << p.rest_left_P.transpose() << " yaw " << p.facing_yaw << " noise " << p.noise_stddev << " variation "

@@ -13,6 +13,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iplan/intent/belief_filter.h"
+#include "iplan/intent/kinematic_baseline.h"
 
 namespace iplan::intent {
 namespace {
@@ -43,6 +44,10 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
                                const EvalParams& params) {
   if (params.fractions.empty() || params.forecast_stride < 1) {
     throw std::invalid_argument("EvalParams: need fractions and forecast_stride >= 1");
+  }
+  if (params.velocity_frames.empty() ||
+      *std::min_element(params.velocity_frames.begin(), params.velocity_frames.end()) < 1) {
+    throw std::invalid_argument("EvalParams: velocity_frames must be non-empty with entries >= 1");
   }
   const std::vector<Track> tracks = MakeTracks(data, model.config, params.max_gap);
   std::map<std::string, int> action_id;
@@ -116,7 +121,10 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
   // Forecasts.
   r.horizon_s.resize(H);
   for (int k = 0; k < H; ++k) r.horizon_s[k] = (k + 1) / rate;
-  std::vector<double> em(H, 0.0), ep(H, 0.0), ev(H, 0.0);
+  const int V = static_cast<int>(params.velocity_frames.size());
+  std::vector<double> em(H, 0.0), ep(H, 0.0);
+  Eigen::MatrixXd ev = Eigen::MatrixXd::Zero(V, H), es = Eigen::MatrixXd::Zero(V, H);
+  Eigen::VectorXd line_p, line_v;
   long inside = 0, total = 0;
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
@@ -125,9 +133,6 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
       timed_predict(window);
       ++r.num_forecast_windows;
       const Eigen::RowVectorXd now = t.positions.row(e);
-      const Eigen::RowVectorXd vel =
-          e > 0 ? Eigen::RowVectorXd((t.positions.row(e) - t.positions.row(e - 1)) * rate)
-                : Eigen::RowVectorXd::Zero(3 * J);
       for (int k = 0; k < H; ++k) {
         const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
         for (int j = 0; j < J; ++j) {
@@ -136,20 +141,38 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
           const Eigen::Vector3d err = p_true - g.mean;
           em[k] += err.norm();
           ep[k] += (p_true - now.segment<3>(3 * j).transpose()).norm();
-          ev[k] += (p_true - (now.segment<3>(3 * j) + vel.segment<3>(3 * j) * (k + 1) / rate)
-                                 .transpose()).norm();
           const double d2 = err.dot(g.covariance.ldlt().solve(err));
           if (d2 <= kChi2Dof3P95) ++inside;
           ++total;
         }
       }
+      // Least-squares baselines over the recorded frames up to e.
+      for (int v = 0; v < V; ++v) {
+        FitLine(t.positions.topRows(e + 1), params.velocity_frames[v], rate, &line_p, &line_v);
+        for (int k = 0; k < H; ++k) {
+          const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
+          const double ahead = (k + 1) / rate;
+          for (int j = 0; j < J; ++j) {
+            const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
+            ev(v, k) += (p_true - line_p.segment<3>(3 * j) - ahead * line_v.segment<3>(3 * j)).norm();
+            es(v, k) += (p_true - line_p.segment<3>(3 * j)).norm();
+          }
+        }
+      }
     }
   }
   const double denom = std::max(1.0, static_cast<double>(r.num_forecast_windows) * J);
+  r.velocity_frames = params.velocity_frames;
+  r.error_const_velocity_by_frames = ev / denom;
+  r.error_smoothed_position_by_frames = es / denom;
   for (int k = 0; k < H; ++k) {
     r.error_model.push_back(em[k] / denom);
     r.error_const_position.push_back(ep[k] / denom);
-    r.error_const_velocity.push_back(ev[k] / denom);
+    Eigen::Index best_v = 0, best_s = 0;
+    r.error_const_velocity.push_back(r.error_const_velocity_by_frames.col(k).minCoeff(&best_v));
+    r.const_velocity_frames.push_back(params.velocity_frames[best_v]);
+    r.error_smoothed_position.push_back(r.error_smoothed_position_by_frames.col(k).minCoeff(&best_s));
+    r.smoothed_position_frames.push_back(params.velocity_frames[best_s]);
   }
   r.coverage95 = total > 0 ? static_cast<double>(inside) / total : 0.0;
   r.inference_p50_ms = Percentile(times_ms, 0.5);
@@ -167,9 +190,21 @@ std::string EvalReportToJson(const EvalReport& r) {
   j["error_m"] = nlohmann::ordered_json::object();
   if (r.num_forecast_windows > 0) {
     for (size_t k = 0; k < r.horizon_s.size(); ++k) {
-      j["error_m"][FormatKey(r.horizon_s[k])] = {{"model", r.error_model[k]},
-                                                 {"const_position", r.error_const_position[k]},
-                                                 {"const_velocity", r.error_const_velocity[k]}};
+      j["error_m"][FormatKey(r.horizon_s[k])] = {
+          {"model", r.error_model[k]},
+          {"const_position", r.error_const_position[k]},
+          {"const_velocity", r.error_const_velocity[k]},
+          {"const_velocity_frames", r.const_velocity_frames[k]},
+          {"smoothed_position", r.error_smoothed_position[k]},
+          {"smoothed_position_frames", r.smoothed_position_frames[k]}};
+    }
+    for (size_t v = 0; v < r.velocity_frames.size(); ++v) {
+      const std::string key = std::to_string(r.velocity_frames[v]);
+      for (size_t k = 0; k < r.horizon_s.size(); ++k) {
+        const std::string h = FormatKey(r.horizon_s[k]);
+        j["const_velocity_by_frames"][key][h] = r.error_const_velocity_by_frames(v, k);
+        j["smoothed_position_by_frames"][key][h] = r.error_smoothed_position_by_frames(v, k);
+      }
     }
     j["coverage95"] = r.coverage95;
   } else {
@@ -210,12 +245,17 @@ std::string EvalReportToText(const EvalReport& r) {
   if (r.num_forecast_windows > 0) {
     os << "forecast windows: " << r.num_forecast_windows << "\n";
     os << "mean joint position error [m] by horizon:\n";
-    os << "  horizon_s   model  const_pos  const_vel  model/const_vel\n";
+    os << "  (const_vel: least-squares line through the last L frames, the best L per horizon;\n"
+          "   smoothed_pos: hold that line's current value, a diagnostic)\n";
+    os << "  horizon_s   model  const_pos  const_vel (L)  smoothed_pos (L)  model/best_baseline\n";
     for (size_t k = 0; k < r.horizon_s.size(); ++k) {
+      const double best = std::min(r.error_const_position[k], r.error_const_velocity[k]);
       os << "  " << std::setprecision(3) << std::setw(9) << r.horizon_s[k] << std::setw(8)
          << r.error_model[k] << std::setw(11) << r.error_const_position[k] << std::setw(11)
-         << r.error_const_velocity[k] << std::setw(12) << std::setprecision(2)
-         << r.error_model[k] / std::max(r.error_const_velocity[k], 1e-12) << "\n";
+         << r.error_const_velocity[k] << " (" << std::setw(2) << r.const_velocity_frames[k] << ")"
+         << std::setw(14) << r.error_smoothed_position[k] << " (" << std::setw(2)
+         << r.smoothed_position_frames[k] << ")" << std::setw(12) << std::setprecision(2)
+         << r.error_model[k] / std::max(best, 1e-12) << "\n";
     }
     os << "95 % ellipsoid coverage: " << std::setprecision(1) << 100.0 * r.coverage95 << " %\n";
   } else {

@@ -11,6 +11,7 @@
 #include <stdexcept>
 
 #include "iplan/intent/dtw.h"
+#include "iplan/intent/forecast_calibration.h"
 
 namespace iplan::intent {
 namespace {
@@ -85,6 +86,228 @@ Eigen::MatrixXd PredictRows(const IvmModel& ivm, const Eigen::MatrixXd& K,
   return P;
 }
 
+constexpr double kTwoPi = 6.283185307179586;
+// Bounds of the calibrated covariance scale s: at least a tenth of the
+// uncalibrated standard deviation is kept, e.g. for a joint that never moved
+// in the training data (assembly.csv's shoulders are constant).
+constexpr double kMinVarianceScale = 1e-2;
+constexpr double kMaxVarianceScale = 1e4;
+
+// The q-quantile (q in [0, 1]) of `v` by linear interpolation; `v` non-empty.
+double Quantile(std::vector<double> v, double q) {
+  std::sort(v.begin(), v.end());
+  const double pos = q * static_cast<double>(v.size() - 1);
+  const size_t lo = static_cast<size_t>(std::floor(pos));
+  const size_t hi = std::min(lo + 1, v.size() - 1);
+  return v[lo] + (pos - lo) * (v[hi] - v[lo]);
+}
+
+// A forecaster training window: the one ending at row `end` of `track`.
+struct ForecastSample {
+  const Track* track;
+  int end;
+  int fold;  // forecaster cross-validation fold
+};
+
+// The recorded future (horizon, 3 J) after `end`; past the end of the track
+// the last pose is held (short clips, TrainParams::min_forecast_windows).
+Eigen::MatrixXd Future(const Track& t, int end, int horizon) {
+  const int n = static_cast<int>(t.positions.rows());
+  Eigen::MatrixXd f(horizon, t.positions.cols());
+  for (int k = 0; k < horizon; ++k) f.row(k) = t.positions.row(std::min(end + k + 1, n - 1));
+  return f;
+}
+
+// SPGP inputs X (N, D_in) and residual targets Y (N, horizon * 3 J) of the
+// samples about the kinematic extrapolation `baseline`.
+void ForecastData(const std::vector<ForecastSample>& samples, const FeatureLayout& layout,
+                  const IntentModelConfig& config, const KinematicBaseline& baseline,
+                  Eigen::MatrixXd* X, Eigen::MatrixXd* Y, Eigen::MatrixXd* speeds = nullptr) {
+  const int N = static_cast<int>(samples.size());
+  const int J = layout.num_joints();
+  const int H = config.horizon;
+  X->resize(N, layout.forecast_input_size());
+  Y->resize(N, H * 3 * J);
+  if (speeds != nullptr) speeds->resize(N, J);
+  Eigen::MatrixXd base;
+  Eigen::VectorXd u;
+  for (int i = 0; i < N; ++i) {
+    const Track& t = *samples[i].track;
+    const Eigen::MatrixXd window = WindowEndingAt(t.positions, samples[i].end, config.window);
+    X->row(i) = layout.ForecastInput(window, config.rate, config.velocity_frames).transpose();
+    ExtrapolateKinematic(window, baseline, config.rate, H, &base);
+    const Eigen::MatrixXd future = Future(t, samples[i].end, H);
+    for (int k = 0; k < H; ++k) Y->block(i, k * 3 * J, 1, 3 * J) = future.row(k) - base.row(k);
+    if (speeds != nullptr) {
+      MeanJointSpeeds(window, config.rate, &u);
+      speeds->row(i) = u.transpose();
+    }
+  }
+}
+
+// rho_j^2 of ForecastSettings for window speeds `u` (J).
+double ActivityFactor(const ForecastSettings& f, const Eigen::VectorXd& u, int j) {
+  if (!std::isfinite(f.motion_offset)) return 1.0;
+  const double rho = (u(j) + f.motion_offset) / (f.reference_speed(j) + f.motion_offset);
+  return rho * rho;
+}
+
+// Standardises X and Y and fits the SPGP of one action.
+ActionForecaster FitForecaster(const Eigen::MatrixXd& X, const Eigen::MatrixXd& Y,
+                               const TrainParams& params, std::uint64_t seed) {
+  const Eigen::Index Ns = X.rows();
+  ActionForecaster fc;
+  fc.input_mean = X.colwise().mean().transpose();
+  fc.input_scale = ((X.rowwise() - fc.input_mean.transpose()).colwise().squaredNorm() / Ns)
+                       .cwiseSqrt().transpose();
+  fc.output_mean = Y.colwise().mean().transpose();
+  fc.output_scale = ((Y.rowwise() - fc.output_mean.transpose()).colwise().squaredNorm() / Ns)
+                        .cwiseSqrt().transpose();
+  for (Eigen::Index d = 0; d < fc.input_scale.size(); ++d) {
+    if (!(fc.input_scale(d) > 1e-9)) fc.input_scale(d) = 1.0;
+  }
+  for (Eigen::Index d = 0; d < fc.output_scale.size(); ++d) {
+    if (!(fc.output_scale(d) > 1e-9)) fc.output_scale(d) = 1e-9;
+  }
+  const Eigen::MatrixXd Xs = (X.rowwise() - fc.input_mean.transpose()) *
+                             fc.input_scale.cwiseInverse().asDiagonal();
+  const Eigen::MatrixXd Ys = (Y.rowwise() - fc.output_mean.transpose()) *
+                             fc.output_scale.cwiseInverse().asDiagonal();
+  SparseGpParams gp;
+  gp.num_pseudo_inputs = params.pseudo_inputs;
+  gp.max_iterations = params.gp_iterations;
+  gp.seed = seed;
+  fc.gp = SparseGp::Fit(Xs, Ys, gp);
+  fc.num_training_windows = static_cast<int>(Ns);
+  return fc;
+}
+
+// Predicted residual (P, m) and its variance (P, m^2, without sensor noise)
+// for the unstandardised input `x`.
+void PredictResidual(const ActionForecaster& fc, const Eigen::VectorXd& x, Eigen::VectorXd* mean,
+                     Eigen::VectorXd* var) {
+  const Eigen::VectorXd xs = (x - fc.input_mean).cwiseQuotient(fc.input_scale);
+  double v = 0.0;
+  fc.gp.Predict(xs, mean, &v);
+  *mean = fc.output_mean + fc.output_scale.cwiseProduct(*mean);
+  *var = v * fc.output_scale.cwiseAbs2();
+}
+
+// Chooses the motion offset m0 and the per-(step, joint) variance scales on
+// the held-out residuals (true r_true, predicted r_pred with variances r_var,
+// window speeds r_speed) at the chosen residual weight; fills the report.
+void CalibrateForecast(const std::vector<Eigen::RowVectorXd>& r_true,
+                       const std::vector<Eigen::RowVectorXd>& r_pred,
+                       const std::vector<Eigen::RowVectorXd>& r_var,
+                       const std::vector<Eigen::RowVectorXd>& r_speed, const IntentModelConfig& config,
+                       const TrainParams& params, ForecastSettings* f, TrainReport* rep) {
+  const int H = config.horizon;
+  const int J = static_cast<int>(config.joints.joints.size());
+  const Eigen::Index N = static_cast<Eigen::Index>(r_true.size());
+  const double w = f->residual_weight;
+  const double noise = config.sensor_noise_std * config.sensor_noise_std;
+  Eigen::MatrixXd err(N, 3), var(N, 3);
+  Eigen::VectorXd scales(static_cast<Eigen::Index>(H) * J);
+  double best_nll = std::numeric_limits<double>::infinity();
+  for (double m0 : params.motion_offsets) {
+    ForecastSettings trial = *f;
+    trial.motion_offset = m0;
+    double nll = 0.0, raw = 0.0, calibrated = 0.0;
+    for (int k = 0; k < H; ++k) {
+      for (int j = 0; j < J; ++j) {
+        const int o = (k * J + j) * 3;
+        for (Eigen::Index i = 0; i < N; ++i) {
+          err.row(i) = r_true[i].segment<3>(o) - w * r_pred[i].segment<3>(o);
+          var.row(i) = ActivityFactor(trial, r_speed[i].transpose(), j) *
+                       (r_var[i].segment<3>(o).array() + noise).matrix();
+        }
+        raw += EllipsoidCoverage(err, var, 0.0, 1.0);
+        const double s = CalibrateVarianceScale(err, var, 0.0, 0.95, kMinVarianceScale, kMaxVarianceScale);
+        scales(static_cast<Eigen::Index>(k) * J + j) = s;
+        calibrated += EllipsoidCoverage(err, var, 0.0, s);
+        const Eigen::ArrayXXd total = s * var.array();
+        nll += 0.5 * ((kTwoPi * total).log() + err.array().square() / total).sum() / static_cast<double>(N);
+      }
+    }
+    nll /= static_cast<double>(H) * J;
+    rep->motion_cv_table.push_back({m0, nll, calibrated / (H * J)});
+    if (nll < best_nll) {
+      best_nll = nll;
+      f->motion_offset = m0;
+      f->variance_scale = scales;
+      rep->cv_coverage_raw = raw / (H * J);
+      rep->cv_coverage_calibrated = calibrated / (H * J);
+    }
+  }
+  if (!std::isfinite(f->motion_offset)) f->reference_speed.resize(0);
+  rep->motion_offset = f->motion_offset;
+  std::vector<double> sv(f->variance_scale.data(), f->variance_scale.data() + f->variance_scale.size());
+  rep->variance_scale_min = *std::min_element(sv.begin(), sv.end());
+  rep->variance_scale_max = *std::max_element(sv.begin(), sv.end());
+  rep->variance_scale_median = Quantile(sv, 0.5);
+}
+
+// The (L, tau) of the grids with the lowest mean joint error of the
+// extrapolation alone over all samples; fills the report's table.
+KinematicBaseline ChooseBaseline(const std::vector<std::vector<ForecastSample>>& samples,
+                                 const IntentModelConfig& config, const TrainParams& params,
+                                 TrainReport* rep) {
+  const int H = config.horizon;
+  const int J = static_cast<int>(config.joints.joints.size());
+  std::vector<int> frames;
+  for (int L : params.baseline_smoothing_frames) {
+    if (L <= config.window) frames.push_back(L);
+  }
+  if (frames.empty()) frames.push_back(1);
+  const std::vector<double>& taus = params.baseline_damping_time_constants;
+  Eigen::MatrixXd error = Eigen::MatrixXd::Zero(frames.size(), taus.size());
+  Eigen::VectorXd g(H), p, v;
+  long count = 0;
+  double hold = 0.0;
+  for (const std::vector<ForecastSample>& action : samples) {
+    for (const ForecastSample& smp : action) {
+      const Eigen::MatrixXd window = WindowEndingAt(smp.track->positions, smp.end, config.window);
+      const Eigen::MatrixXd future = Future(*smp.track, smp.end, H);
+      for (int k = 0; k < H; ++k) {
+        for (int j = 0; j < J; ++j) {
+          hold += (future.block<1, 3>(k, 3 * j) - window.block<1, 3>(window.rows() - 1, 3 * j)).norm();
+        }
+      }
+      for (size_t l = 0; l < frames.size(); ++l) {
+        FitLine(window, frames[l], config.rate, &p, &v);
+        for (size_t ti = 0; ti < taus.size(); ++ti) {
+          for (int k = 0; k < H; ++k) g(k) = DampedDisplacement((k + 1) / config.rate, taus[ti]);
+          double sum = 0.0;
+          for (int k = 0; k < H; ++k) {
+            for (int j = 0; j < J; ++j) {
+              sum += (future.row(k).segment<3>(3 * j).transpose() - p.segment<3>(3 * j) -
+                      g(k) * v.segment<3>(3 * j)).norm();
+            }
+          }
+          error(l, ti) += sum;
+        }
+      }
+      ++count;
+    }
+  }
+  const double denom = static_cast<double>(std::max<long>(1, count)) * H * J;
+  error /= denom;
+  rep->error_const_position = hold / denom;
+  Eigen::Index bl = 0, bt = 0;
+  error.minCoeff(&bl, &bt);
+  for (size_t l = 0; l < frames.size(); ++l) {
+    for (size_t ti = 0; ti < taus.size(); ++ti) {
+      rep->baseline_table.push_back({static_cast<double>(frames[l]), taus[ti], error(l, ti)});
+    }
+  }
+  KinematicBaseline b;
+  b.smoothing_frames = frames[bl];
+  // L = 1 has no velocity: any tau is the same; store 0.
+  b.damping_time_constant = frames[bl] == 1 ? 0.0 : taus[bt];
+  rep->baseline = b;
+  return b;
+}
+
 }  // namespace
 
 std::string IntentModelConfig::Validate() const {
@@ -123,6 +346,52 @@ std::string TrainParams::Validate() const {
   if (forecast_stride < 1) return "forecast_stride must be >= 1";
   if (max_forecast_windows < 2) return "max_forecast_windows must be >= 2";
   if (gp_iterations < 0) return "gp_iterations must be >= 0";
+  if (baseline_smoothing_frames.empty() || baseline_damping_time_constants.empty() ||
+      residual_weights.empty()) {
+    return "baseline_smoothing_frames, baseline_damping_time_constants and residual_weights "
+           "must not be empty";
+  }
+  for (int L : baseline_smoothing_frames) {
+    if (L < 1) return "baseline smoothing frames " + std::to_string(L) + " must be >= 1";
+  }
+  for (double tau : baseline_damping_time_constants) {
+    if (!(tau >= 0.0)) return "baseline damping time constant " + std::to_string(tau) + " must be >= 0";
+  }
+  for (double w : residual_weights) {
+    if (!(w >= 0.0 && w <= 1.0)) return "residual weight " + std::to_string(w) + " outside [0, 1]";
+  }
+  if (forecast_cv_folds < 2) return "forecast_cv_folds " + std::to_string(forecast_cv_folds) + " must be >= 2";
+  if (motion_offsets.empty()) return "motion_offsets must not be empty";
+  for (double m0 : motion_offsets) {
+    if (!(m0 > 0.0)) return "motion offset " + std::to_string(m0) + " must be > 0 m/s";
+  }
+  return "";
+}
+
+std::string ForecastSettings::Validate(int horizon, int num_joints) const {
+  if (const std::string why = baseline.Validate(); !why.empty()) return "baseline: " + why;
+  if (!(residual_weight >= 0.0 && residual_weight <= 1.0)) {
+    return "residual_weight " + std::to_string(residual_weight) + " outside [0, 1]";
+  }
+  if (variance_scale.size() != 0) {
+    if (variance_scale.size() != static_cast<Eigen::Index>(horizon) * num_joints) {
+      return "variance_scale has " + std::to_string(variance_scale.size()) + " entries, expected " +
+             std::to_string(horizon * num_joints) + " (horizon x joints)";
+    }
+    if (!variance_scale.allFinite() || !(variance_scale.array() > 0.0).all()) {
+      return "variance_scale entries must be finite and > 0";
+    }
+  }
+  if (!(motion_offset > 0.0)) return "motion_offset " + std::to_string(motion_offset) + " must be > 0 m/s";
+  if (std::isfinite(motion_offset) || reference_speed.size() != 0) {
+    if (reference_speed.size() != num_joints) {
+      return "reference_speed has " + std::to_string(reference_speed.size()) + " entries, expected " +
+             std::to_string(num_joints) + " (joints)";
+    }
+    if (!reference_speed.allFinite() || (reference_speed.array() < 0.0).any()) {
+      return "reference_speed entries must be finite and >= 0";
+    }
+  }
   return "";
 }
 
@@ -361,72 +630,115 @@ IntentModel TrainIntentModel(const SkeletonDataset& data, const IntentModelConfi
   rep.num_import_vectors = static_cast<int>(model.classifier.import_windows.size());
   rep.seconds_classifier = Seconds(t0);
 
-  // ---- Forecasters, one per action. ----
+  // ---- Forecasters, one per action (see ForecastSettings). ----
   t0 = std::chrono::steady_clock::now();
   const int J = layout.num_joints();
   const int H = config.horizon;
   std::mt19937_64 rng(params.seed);
+  // CV folds: subjects, or the sequences of a single subject, round-robin.
+  std::map<std::string, int> group_id;
+  for (const Track& t : tracks) {
+    group_id.emplace(num_subjects >= 2 ? t.subject : t.sequence_id, static_cast<int>(group_id.size()));
+  }
+  const int num_folds = std::min(static_cast<int>(group_id.size()), params.forecast_cv_folds);
+  std::vector<std::vector<ForecastSample>> samples(C);
   for (int c = 0; c < C; ++c) {
-    struct Sample { const Track* track; int end; };
-    std::vector<Sample> full, padded;
+    std::vector<ForecastSample> full, padded;
     for (const Track& t : tracks) {
       if (action_id.at(t.action) != c) continue;
       const int n = static_cast<int>(t.positions.rows());
+      const int fold = group_id.at(num_subjects >= 2 ? t.subject : t.sequence_id) % std::max(1, num_folds);
       for (int e = 0; e < n; e += params.forecast_stride) {
-        (e + H <= n - 1 ? full : padded).push_back({&t, e});
+        (e + H <= n - 1 ? full : padded).push_back({&t, e, fold});
       }
     }
-    bool use_padded = static_cast<int>(full.size()) < params.min_forecast_windows;
-    std::vector<Sample> samples = full;
-    if (use_padded) samples.insert(samples.end(), padded.begin(), padded.end());
-    if (samples.size() < 2) {
+    const bool use_padded = static_cast<int>(full.size()) < params.min_forecast_windows;
+    samples[c] = full;
+    if (use_padded) samples[c].insert(samples[c].end(), padded.begin(), padded.end());
+    if (samples[c].size() < 2) {
       throw std::invalid_argument("TrainIntentModel: action '" + model.actions[c] +
                                   "' has fewer than two forecaster windows");
     }
-    if (static_cast<int>(samples.size()) > params.max_forecast_windows) {
-      std::shuffle(samples.begin(), samples.end(), rng);
-      samples.resize(params.max_forecast_windows);
+    if (static_cast<int>(samples[c].size()) > params.max_forecast_windows) {
+      std::shuffle(samples[c].begin(), samples[c].end(), rng);
+      samples[c].resize(params.max_forecast_windows);
     }
-    const int Ns = static_cast<int>(samples.size());
-    Eigen::MatrixXd X(Ns, layout.forecast_input_size());
-    Eigen::MatrixXd Y(Ns, H * 3 * J);
-    for (int i = 0; i < Ns; ++i) {
-      const Track& t = *samples[i].track;
-      const int e = samples[i].end;
-      const int n = static_cast<int>(t.positions.rows());
-      X.row(i) = layout.ForecastInput(WindowEndingAt(t.positions, e, config.window),
-                                      config.rate, config.velocity_frames).transpose();
-      for (int k = 0; k < H; ++k) {
-        const int f = std::min(e + k + 1, n - 1);
-        Y.block(i, k * 3 * J, 1, 3 * J) = t.positions.row(f) - t.positions.row(e);
+    rep.forecast_windows.push_back(static_cast<int>(samples[c].size()));
+    rep.forecast_padded.push_back(use_padded);
+  }
+  model.forecast.baseline = ChooseBaseline(samples, config, params, &rep);
+  {
+    // ubar_j: mean window speed of each joint over all forecaster windows.
+    Eigen::VectorXd u, sum = Eigen::VectorXd::Zero(J);
+    long count = 0;
+    for (const std::vector<ForecastSample>& action : samples) {
+      for (const ForecastSample& smp : action) {
+        MeanJointSpeeds(WindowEndingAt(smp.track->positions, smp.end, config.window), config.rate, &u);
+        sum += u;
+        ++count;
       }
     }
-    ActionForecaster fc;
-    fc.input_mean = X.colwise().mean().transpose();
-    fc.input_scale = ((X.rowwise() - fc.input_mean.transpose()).colwise().squaredNorm() / Ns)
-                         .cwiseSqrt().transpose();
-    fc.output_mean = Y.colwise().mean().transpose();
-    fc.output_scale = ((Y.rowwise() - fc.output_mean.transpose()).colwise().squaredNorm() / Ns)
-                          .cwiseSqrt().transpose();
-    for (Eigen::Index d = 0; d < fc.input_scale.size(); ++d) {
-      if (!(fc.input_scale(d) > 1e-9)) fc.input_scale(d) = 1.0;
+    model.forecast.reference_speed = sum / static_cast<double>(std::max<long>(1, count));
+  }
+
+  // Cross-validated residual predictions: held-out true residuals, predicted
+  // residual means and variances (m, m^2), one row per held-out window.
+  model.forecast.residual_weight = 1.0;
+  rep.forecast_cv_folds = num_folds >= 2 ? num_folds : 0;
+  if (num_folds >= 2) {
+    std::vector<Eigen::RowVectorXd> r_true, r_pred, r_var, r_speed;
+    Eigen::VectorXd mean, var;
+    for (int c = 0; c < C; ++c) {
+      for (int f = 0; f < num_folds; ++f) {
+        std::vector<ForecastSample> train, test;
+        for (const ForecastSample& smp : samples[c]) (smp.fold == f ? test : train).push_back(smp);
+        if (test.empty() || train.size() < 2) continue;
+        Eigen::MatrixXd X, Y, Xt, Yt, Ut;
+        ForecastData(train, layout, config, model.forecast.baseline, &X, &Y);
+        ForecastData(test, layout, config, model.forecast.baseline, &Xt, &Yt, &Ut);
+        const ActionForecaster fc =
+            FitForecaster(X, Y, params, params.seed + static_cast<std::uint64_t>(c));
+        for (Eigen::Index i = 0; i < Xt.rows(); ++i) {
+          PredictResidual(fc, Xt.row(i).transpose(), &mean, &var);
+          r_true.push_back(Yt.row(i));
+          r_pred.push_back(mean.transpose());
+          r_var.push_back(var.transpose());
+          r_speed.push_back(Ut.row(i));
+        }
+      }
     }
-    for (Eigen::Index d = 0; d < fc.output_scale.size(); ++d) {
-      if (!(fc.output_scale(d) > 1e-9)) fc.output_scale(d) = 1e-9;
+    const Eigen::Index Nh = static_cast<Eigen::Index>(r_true.size());
+    rep.forecast_cv_windows = static_cast<int>(Nh);
+    if (Nh > 0) {
+      const int k_half = std::clamp(static_cast<int>(std::lround(0.5 * config.rate)) - 1, 0, H - 1);
+      double best_error = std::numeric_limits<double>::infinity();
+      for (double w : params.residual_weights) {
+        Eigen::VectorXd per_step = Eigen::VectorXd::Zero(H);
+        for (Eigen::Index i = 0; i < Nh; ++i) {
+          for (int k = 0; k < H; ++k) {
+            for (int j = 0; j < J; ++j) {
+              const int o = (k * J + j) * 3;
+              per_step(k) += (r_true[i].segment<3>(o) - w * r_pred[i].segment<3>(o)).norm();
+            }
+          }
+        }
+        per_step /= static_cast<double>(Nh * J);
+        rep.residual_cv_table.push_back({w, per_step(k_half), per_step(H - 1), per_step.mean()});
+        if (per_step.mean() < best_error) {
+          best_error = per_step.mean();
+          model.forecast.residual_weight = w;
+        }
+      }
+      if (params.calibrate_covariance) CalibrateForecast(r_true, r_pred, r_var, r_speed, config, params, &model.forecast, &rep);
     }
-    const Eigen::MatrixXd Xs = (X.rowwise() - fc.input_mean.transpose()) *
-                               fc.input_scale.cwiseInverse().asDiagonal();
-    const Eigen::MatrixXd Ys = (Y.rowwise() - fc.output_mean.transpose()) *
-                               fc.output_scale.cwiseInverse().asDiagonal();
-    SparseGpParams gp;
-    gp.num_pseudo_inputs = params.pseudo_inputs;
-    gp.max_iterations = params.gp_iterations;
-    gp.seed = params.seed + static_cast<std::uint64_t>(c);
-    fc.gp = SparseGp::Fit(Xs, Ys, gp);
-    fc.num_training_windows = Ns;
-    model.forecasters.push_back(std::move(fc));
-    rep.forecast_windows.push_back(Ns);
-    rep.forecast_padded.push_back(use_padded);
+  }
+  rep.residual_weight = model.forecast.residual_weight;
+  if (!std::isfinite(model.forecast.motion_offset)) model.forecast.reference_speed.resize(0);
+
+  for (int c = 0; c < C; ++c) {
+    Eigen::MatrixXd X, Y;
+    ForecastData(samples[c], layout, config, model.forecast.baseline, &X, &Y);
+    model.forecasters.push_back(FitForecaster(X, Y, params, params.seed + static_cast<std::uint64_t>(c)));
   }
   rep.seconds_forecaster = Seconds(t0);
   if (report != nullptr) *report = rep;
@@ -452,26 +764,29 @@ void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
   out->actions.resize(C);
   const Eigen::VectorXd x = layout.ForecastInput(padded, model.config.rate,
                                                  model.config.velocity_frames);
-  const Eigen::RowVectorXd now = padded.row(padded.rows() - 1);
+  Eigen::MatrixXd base;
+  ExtrapolateKinematic(padded, model.forecast.baseline, model.config.rate, H, &base);
   const double noise = model.config.sensor_noise_std * model.config.sensor_noise_std;
-  Eigen::VectorXd xs, mean;
+  const double w = model.forecast.residual_weight;
+  const Eigen::VectorXd& scale = model.forecast.variance_scale;
+  Eigen::VectorXd mean, var, speeds;
+  if (std::isfinite(model.forecast.motion_offset)) MeanJointSpeeds(padded, model.config.rate, &speeds);
   for (int c = 0; c < C; ++c) {
-    const ActionForecaster& fc = model.forecasters[c];
     ActionHypothesis& hyp = out->actions[c];
     hyp.action = model.actions[c];
     hyp.probability = p(c);
     hyp.joints.resize(static_cast<size_t>(H) * J);
-    xs = (x - fc.input_mean).cwiseQuotient(fc.input_scale);
-    double var = 0.0;
-    fc.gp.Predict(xs, &mean, &var);
+    PredictResidual(model.forecasters[c], x, &mean, &var);
     for (int k = 0; k < H; ++k) {
       for (int j = 0; j < J; ++j) {
         JointGaussian& g = hyp.joints[static_cast<size_t>(k) * J + j];
         const int o = (k * J + j) * 3;
+        const double s = (scale.size() == 0 ? 1.0 : scale(k * J + j)) *
+                         ActivityFactor(model.forecast, speeds, j);
         g.covariance.setZero();
         for (int a = 0; a < 3; ++a) {
-          g.mean(a) = now(3 * j + a) + fc.output_mean(o + a) + fc.output_scale(o + a) * mean(o + a);
-          g.covariance(a, a) = var * fc.output_scale(o + a) * fc.output_scale(o + a) + noise;
+          g.mean(a) = base(k, 3 * j + a) + w * mean(o + a);
+          g.covariance(a, a) = s * (var(o + a) + noise);
         }
       }
     }

@@ -193,6 +193,13 @@ std::string SerializeIntentModel(const IntentModel& m) {
     w.Mat(f.gp.alpha());
     w.Mat(f.gp.cov_correction());
   }
+  // Version 3: the forecast settings, last.
+  w.I64(m.forecast.baseline.smoothing_frames);
+  w.F64(m.forecast.baseline.damping_time_constant);
+  w.F64(m.forecast.residual_weight);
+  w.Vec(m.forecast.variance_scale);
+  w.F64(m.forecast.motion_offset);
+  w.Vec(m.forecast.reference_speed);
   const std::string payload = std::move(w.bytes());
   Writer file;
   file.bytes().append(kMagic, sizeof(kMagic));
@@ -210,9 +217,10 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
   }
   Reader head(bytes.data() + sizeof(kMagic), 12, source);
   const std::uint32_t version = head.Pod<std::uint32_t>();
-  if (version != kIntentModelFormatVersion) {
+  if (version < kOldestReadableIntentModelFormatVersion || version > kIntentModelFormatVersion) {
     throw std::runtime_error(source + ": intent model format version " + std::to_string(version) +
-                             ", but this build reads version " +
+                             ", but this build reads versions " +
+                             std::to_string(kOldestReadableIntentModelFormatVersion) + " to " +
                              std::to_string(kIntentModelFormatVersion) + "; retrain the model");
   }
   const std::uint64_t size = head.U64();
@@ -303,7 +311,25 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
     }
     m.forecasters.push_back(std::move(f));
   }
-  if (!r.AtEnd()) r.Fail("trailing bytes after the last forecaster");
+  if (version >= 3) {
+    m.forecast.baseline.smoothing_frames = static_cast<int>(r.I64());
+    m.forecast.baseline.damping_time_constant = r.F64();
+    m.forecast.residual_weight = r.F64();
+    m.forecast.variance_scale = r.Vec();
+    m.forecast.motion_offset = r.F64();
+    m.forecast.reference_speed = r.Vec();
+  } else {
+    // Version 2 forecasters predict the displacement from the current pose,
+    // uncalibrated: exactly L = 1 (the newest frame, no velocity), w = 1,
+    // s = 1, no activity scaling.
+    m.forecast = ForecastSettings{};
+    m.forecast.baseline = KinematicBaseline{1, 0.0};
+    m.forecast.residual_weight = 1.0;
+  }
+  if (const std::string why = m.forecast.Validate(c.horizon, layout.num_joints()); !why.empty()) {
+    r.Fail("forecast settings: " + why);
+  }
+  if (!r.AtEnd()) r.Fail("trailing bytes after the forecast settings");
   return m;
 }
 

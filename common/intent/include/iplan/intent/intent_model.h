@@ -19,6 +19,7 @@
 #include "iplan/intent/belief_filter.h"
 #include "iplan/intent/features.h"
 #include "iplan/intent/ivm.h"
+#include "iplan/intent/kinematic_baseline.h"
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/intent/sparse_gp.h"
 
@@ -65,6 +66,33 @@ struct TrainParams {
   /// cross-validation the first entry is used.
   std::vector<bool> belief_motion_weighting{false, true};
   int pseudo_inputs = 20;          ///< M per action.
+  /// Forecaster design (see ForecastSettings), chosen on the training data
+  /// only. The kinematic baseline (L, tau) minimises the mean joint error of
+  /// the extrapolation alone over the forecaster training windows of all
+  /// actions (nothing is fitted, so no hold-out is needed); these are the
+  /// grids. L values above the window length T are skipped.
+  std::vector<int> baseline_smoothing_frames{1, 2, 3, 4, 5, 6, 8, 10};
+  std::vector<double> baseline_damping_time_constants{
+      0.0, 0.1, 0.2, 0.3, 0.5, 0.75, 1.0, 1.5, 2.0, std::numeric_limits<double>::infinity()};
+  /// Residual weights w in [0, 1] tried in cross-validation (0: the
+  /// kinematic baseline alone, 1: baseline + the full SPGP residual).
+  std::vector<double> residual_weights{0.0, 0.25, 0.5, 0.75, 1.0};
+  /// Scale the predicted covariances (SPGP variance plus sensor noise) so
+  /// that 95 % of the held-out training futures fall inside the 95 %
+  /// ellipsoid, per future step and joint (CalibrateVarianceScale, scales in
+  /// [1e-2, 1e4]: at least a tenth of the uncalibrated standard deviation).
+  bool calibrate_covariance = true;
+  /// ForecastSettings::motion_offset values tried (m/s, > 0, may be
+  /// +infinity = no activity scaling), each with its own calibration; the one
+  /// with the lowest held-out Gaussian negative log-likelihood is kept.
+  std::vector<double> motion_offsets{0.01, 0.02, 0.05, 0.1, 0.2,
+                                     std::numeric_limits<double>::infinity()};
+  /// Folds of the forecaster cross-validation: the training subjects, or with
+  /// one subject its sequences (trials), dealt round-robin into at most this
+  /// many folds (>= 2). With fewer than two groups there is no
+  /// cross-validation: w = 1 and no
+  /// calibration.
+  int forecast_cv_folds = 5;
   int forecast_stride = 2;         ///< Frames between forecaster training windows.
   int max_forecast_windows = 600;  ///< Per action, seeded random subset beyond this.
   /// Actions with fewer full-horizon windows than this also use windows whose
@@ -89,13 +117,43 @@ struct ActionClassifier {
 };
 
 /// Forecaster of one action: standardisation plus the SPGP.
-/// Outputs p = (k * J + j) * 3 + axis: displacement of joint j at future step
-/// k + 1 from its current position, m, frame W.
+/// Outputs p = (k * J + j) * 3 + axis: residual of joint j at future step
+/// k + 1 about the kinematic extrapolation (ForecastSettings::baseline) of
+/// the window, m, frame W. (With the baseline L = 1, tau = 0 of format-2
+/// files this is the displacement from the current position.)
 struct ActionForecaster {
   Eigen::VectorXd input_mean, input_scale;    ///< (D_in)
   Eigen::VectorXd output_mean, output_scale;  ///< (horizon * 3 J)
   SparseGp gp;
   int num_training_windows = 0;
+};
+
+/// How the per-action SPGPs become forecasts (one setting for the model).
+/// For joint j at future step k (k = 0: one frame ahead) of action c:
+///   mean       = b_kj + w (output_mean + output_scale * SPGP mean)_ckj,
+///   covariance = s_kj rho_j^2 (SPGP variance * output_scale^2 + sensor_noise_std^2)
+///                (diagonal, per axis; forecast_calibration.h),
+/// with b the kinematic extrapolation of the window and rho_j the joint's
+/// activity: rho_j = (u_j + m0) / (ubar_j + m0), u_j its mean speed over the
+/// window (MeanJointSpeeds), ubar_j the mean of u_j over the training windows
+/// and m0 the motion offset (rho = 1 when m0 is infinite). A person who moves
+/// more than the training person gets wider ellipsoids. Chosen at training
+/// time on the training data only (TrainParams); a format-2 model file is
+/// read as L = 1, tau = 0, w = 1, s = 1, m0 = infinity (its forecasters
+/// predicted the displacement from the current pose, uncalibrated).
+struct ForecastSettings {
+  KinematicBaseline baseline;     ///< b: the extrapolation the SPGPs correct.
+  double residual_weight = 1.0;   ///< w in [0, 1].
+  /// (horizon * J) s_kj > 0 at index k * J + j; empty means all 1.
+  Eigen::VectorXd variance_scale;
+  /// m0, m/s (> 0, may be +infinity: no activity scaling).
+  double motion_offset = std::numeric_limits<double>::infinity();
+  /// (J) ubar_j, m/s (>= 0); may be empty when motion_offset is infinite.
+  Eigen::VectorXd reference_speed;
+
+  /// Empty string when valid for `horizon` steps of `num_joints` joints,
+  /// else the offending field and value.
+  std::string Validate(int horizon, int num_joints) const;
 };
 
 /// A trained model. Plain data, immutable once trained or loaded; const use
@@ -105,6 +163,7 @@ struct IntentModel {
   std::vector<std::string> actions;            ///< (C) action labels.
   ActionClassifier classifier;
   std::vector<ActionForecaster> forecasters;   ///< (C), same order as actions.
+  ForecastSettings forecast;
 };
 
 /// A Gaussian for one joint at one future step: mean p_WJ (m) and covariance
@@ -156,6 +215,27 @@ struct TrainReport {
   std::vector<std::array<double, 4>> belief_cv_table;
   std::vector<int> forecast_windows;  ///< Per action.
   std::vector<bool> forecast_padded;  ///< Per action: held-last-pose futures used.
+  /// Kinematic baseline choice: one row per (L, tau) tried: L, tau (s), mean
+  /// joint error over all steps on the training windows (m).
+  std::vector<std::array<double, 3>> baseline_table;
+  KinematicBaseline baseline;        ///< The chosen one.
+  double error_const_position = 0.0; ///< m, same windows, holding the last pose.
+  int forecast_cv_folds = 0;         ///< 0: no forecaster cross-validation.
+  int forecast_cv_windows = 0;       ///< Held-out windows scored.
+  /// One row per residual weight tried: w, held-out mean joint error (m) at
+  /// the step nearest 0.5 s, at the last step, over all steps.
+  std::vector<std::array<double, 4>> residual_cv_table;
+  double residual_weight = 1.0;      ///< The chosen w.
+  /// Held-out 95 % coverage of the chosen w before and after calibration
+  /// (after: on the same held-out windows, so 0.95 by construction up to ties).
+  double cv_coverage_raw = 0.0;
+  double cv_coverage_calibrated = 0.0;
+  double variance_scale_min = 1.0, variance_scale_median = 1.0, variance_scale_max = 1.0;
+  /// One row per motion offset tried: m0 (m/s), held-out mean Gaussian
+  /// negative log-likelihood per joint and step after calibration, held-out
+  /// coverage after calibration.
+  std::vector<std::array<double, 3>> motion_cv_table;
+  double motion_offset = std::numeric_limits<double>::infinity();  ///< The chosen m0.
   double seconds_classifier = 0.0;
   double seconds_forecaster = 0.0;
 };

@@ -16,9 +16,15 @@
 
 namespace iplan::intent {
 
-/// The format version this build writes and reads.
+/// The format version this build writes.
 /// 2: the classifier stores its belief-filter parameters.
-inline constexpr std::uint32_t kIntentModelFormatVersion = 2;
+/// 3: the forecast settings (kinematic baseline, residual weight, covariance
+///    calibration and activity scaling) follow the forecasters at the end of
+///    the payload.
+inline constexpr std::uint32_t kIntentModelFormatVersion = 3;
+/// The oldest version this build still reads: a version-2 file is read with
+/// the forecast settings that reproduce its predictions (ForecastSettings).
+inline constexpr std::uint32_t kOldestReadableIntentModelFormatVersion = 2;
 
 /// What the user of a model (a service, the CLI) is configured for. Empty /
 /// unset fields are not checked.
@@ -31,7 +37,8 @@ struct ModelExpectation {
 std::string SerializeIntentModel(const IntentModel& model);
 
 /// Parses file contents. Throws std::runtime_error with a clear message for a
-/// wrong magic, another format version, a checksum mismatch (corrupt or
+/// wrong magic, a format version outside
+/// [kOldestReadableIntentModelFormatVersion, kIntentModelFormatVersion], a checksum mismatch (corrupt or
 /// truncated file), or an inconsistent payload. `source` names the file in
 /// messages.
 IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& source);
