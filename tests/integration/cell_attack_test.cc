@@ -121,6 +121,7 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
   // the robot: permits claiming to be the supervisor at 100 Hz, "OK" verdicts
   // at 500 Hz, and a trajectory to somewhere else.
   cell[std::string("perception")].Signal(SIGSTOP);
+  cell.SpinFor(1s);  // the stop (0.15 s deadline + 0.3 s stopping), not a pause of the plan
   ASSERT_TRUE(cell.SpinUntil([&] { return cell.AtRest() && cell.RestSince(Clock::now() - 1s); }, 5s));
   const auto attack = Clock::now();
   msg::JointTrajectory away;
