@@ -76,8 +76,8 @@ class SupervisorService : public framework::Service {
     command_writer_ = &node.Advertise(framework::topics::TaskCommand());
     permit_writer_ = &node.Advertise(framework::topics::SafetyPermit());
     using SI = const dds::SampleInfo&;
-    // Watched topics: any sample is a sign of life; deadline and liveliness
-    // events come through OnReaderEvent.
+    // Watched topics: any accepted sample is a sign of life; deadline and
+    // liveliness events come through OnReaderEvent.
     std::vector<std::string> names;
     for (const std::string& w : watched) {
       if (w == "human_skeleton") Watch(node, framework::topics::HumanSkeleton(), &names);

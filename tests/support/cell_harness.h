@@ -119,7 +119,6 @@ class CellHarness {
   bool ready() const { return observer_ != nullptr; }
   framework::Node& node() { return *observer_->node; }
   int domain() const { return domain_; }
-  const std::filesystem::path& dir() const { return dir_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
 
   /// Starts (or restarts) `svc` with the shipped configuration.
@@ -197,7 +196,6 @@ class CellHarness {
     }
     return v;
   }
-  std::size_t num_joint_states() const { return joints_.size(); }
   const std::vector<double>& positions() const { return positions_; }
   const std::vector<PermitSample>& permits() const { return permits_; }
   const std::vector<msg::TaskOutcome>& outcomes() const { return outcomes_; }
@@ -225,7 +223,6 @@ class CellHarness {
     const std::string v = Diag(service, key);
     return v.empty() ? otherwise : std::stod(v);
   }
-  void ForgetDiagnostics() { diag_.clear(); }
 
  private:
   dds::Vendor vendor_;

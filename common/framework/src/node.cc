@@ -3,9 +3,7 @@
 #include <unistd.h>
 
 #include <algorithm>
-#include <cmath>
 #include <cstdio>
-#include <limits>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
@@ -197,15 +195,6 @@ std::vector<std::string> Node::EntitledWriters(const std::string& topic, const s
     if (auto it = options_.entitled_writers.find(key); it != options_.entitled_writers.end()) return it->second;
   }
   return catalogue;
-}
-
-double Node::SecondsSinceAccepted(const std::string& topic) const {
-  for (const auto& s : subscriptions_) {
-    if (s->reader->topic() == topic && s->stats.last_accepted) {
-      return std::chrono::duration<double>(std::chrono::steady_clock::now() - *s->stats.last_accepted).count();
-    }
-  }
-  return std::numeric_limits<double>::infinity();
 }
 
 bool Node::CountRejection(const std::string& input, const std::optional<std::string>& rejection) {

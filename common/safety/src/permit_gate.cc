@@ -3,7 +3,6 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
 #include <stdexcept>
 
 namespace iplan::safety {
@@ -35,6 +34,8 @@ std::string PermitGateParams::Validate() const {
 
 PermitGate::PermitGate(PermitGateParams params) : params_(std::move(params)) {
   if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
+  permitted_reason_ = "permitted by";
+  for (std::size_t i = 0; i < params_.monitors.size(); ++i) permitted_reason_ += (i ? ", " : " ") + params_.monitors[i];
 }
 
 std::optional<std::string> PermitGate::OnPermit(const std::string& monitor, bool permit, double validity_s,
@@ -76,11 +77,7 @@ PermitDecision PermitGate::Evaluate(int64_t now_ns) const {
     }
   }
   d.permitted = why.empty();
-  d.reason = d.permitted ? "permitted by " + [&] {
-    std::string s;
-    for (const auto& m : params_.monitors) s += (s.empty() ? "" : ", ") + m;
-    return s;
-  }() : why;
+  d.reason = d.permitted ? permitted_reason_ : why;
   return d;
 }
 

@@ -71,8 +71,6 @@ struct TopicStats {
   int alive_writers = 0;
   std::string last_rejection;
   std::string last_ignored_writer;  ///< name of the last writer ignored ("(unnamed)" when none)
-  /// When a sample was last accepted (steady clock); nullopt: never.
-  std::optional<std::chrono::steady_clock::time_point> last_accepted;
 };
 
 struct SubscribeOptions {
@@ -139,9 +137,6 @@ class Node {
 
   /// Counters of a subscribed topic (zeros when not subscribed).
   TopicStats stats(const std::string& topic) const;
-  /// Seconds since a sample of `topic` was last accepted (passed every
-  /// check); +infinity when none ever was or the topic is not subscribed.
-  double SecondsSinceAccepted(const std::string& topic) const;
   /// Entitled writers of `topic` after the configuration (empty: anyone).
   std::vector<std::string> EntitledWriters(const std::string& topic,
                                            const std::vector<std::string>& catalogue) const;
@@ -181,10 +176,7 @@ class Node {
   bool AcceptFrame(SubscriptionBase& sub, const std::string& frame_id);
   /// True when the stamp is acceptable for this writer (and records it).
   bool AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns);
-  void Accepted(SubscriptionBase& sub) {
-    ++sub.stats.received;
-    sub.stats.last_accepted = std::chrono::steady_clock::now();
-  }
+
   template <class F>
   void RunGuarded(SubscriptionBase* sub, const char* what, F&& f);
   void RunTimers();
@@ -248,7 +240,7 @@ struct Node::Subscription : Node::SubscriptionBase {
           continue;
         }
       }
-      node.Accepted(*this);
+      ++stats.received;
       node.RunGuarded(this, "callback", [&] { on_message(msg, info); });
     }
   }

@@ -76,6 +76,7 @@ class PermitGate {
     int64_t expires_ns = 0;
   };
   PermitGateParams params_;
+  std::string permitted_reason_;  // "permitted by <monitors>", built once (Evaluate runs every control step)
   std::map<std::string, Held> held_;
 };
 
