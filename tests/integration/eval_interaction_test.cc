@@ -4,12 +4,11 @@
 // scenario and predictor, the same seed gives the same JSON byte for byte,
 // and bad requests are refused with exit code 2 naming the problem.
 #include <filesystem>
-#include <fstream>
-#include <sstream>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
+#include "iplan/core/atomic_file.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -17,13 +16,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using namespace std::chrono_literals;
-
-std::string Read(const fs::path& p) {
-  std::ifstream in(p);
-  std::stringstream s;
-  s << in.rdbuf();
-  return s.str();
-}
 
 class EvalInteraction : public ::testing::Test {
  protected:
@@ -67,8 +59,8 @@ TEST_F(EvalInteraction, TwoScenariosWriteEveryFieldAndRepeatForASeed) {
   EXPECT_NE(out.find("paired against none"), std::string::npos) << out;
   ASSERT_EQ(Run({"--scenarios", "2", "--seed", "3", "--time-limit", "6", "--json", b}, &out), 0) << out;
   EXPECT_NE(out.find("(cached; trained for this person)"), std::string::npos) << out;
-  const std::string text = Read(a);
-  EXPECT_EQ(text, Read(b)) << "the same seed gave different results";
+  const std::string text = core::ReadFile(a);
+  EXPECT_EQ(text, core::ReadFile(b)) << "the same seed gave different results";
 
   const nlohmann::json j = nlohmann::json::parse(text);
   const std::vector<std::string> predictors = {"none", "constant-position", "constant-velocity", "model", "oracle"};

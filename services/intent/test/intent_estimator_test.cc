@@ -9,6 +9,17 @@
 namespace iplan::intent_service {
 namespace {
 
+// Small, fast training settings shared by the tests that train a model.
+intent::TrainParams SmallTrainParams() {
+  intent::TrainParams p;
+  p.sigma_factors = {1.0};
+  p.lambdas = {1e-3};
+  p.pseudo_inputs = 6;
+  p.gp_iterations = 15;
+  p.max_forecast_windows = 60;
+  return p;
+}
+
 using intent::IntentModel;
 using intent::MixturePrediction;
 
@@ -77,12 +88,7 @@ class IntentEstimatorTest : public ::testing::Test {
     c.rate = 15.0;
     c.window = 6;
     c.horizon = 4;
-    intent::TrainParams p;
-    p.sigma_factors = {1.0};
-    p.lambdas = {1e-3};
-    p.pseudo_inputs = 6;
-    p.gp_iterations = 15;
-    p.max_forecast_windows = 60;
+    const intent::TrainParams p = SmallTrainParams();
     IntentModel m = intent::TrainIntentModel(ToyData(), c, p);
     // A fixed accumulating belief filter, so that the tests exercise it
     // whatever the cross-validation picks on the toy data.
@@ -294,12 +300,7 @@ TEST(OneJointEstimatorTest, AcceptsOneJointSkeletonsAndRejectsFramesWithoutIt) {
   c.rate = 15.0;
   c.window = 6;
   c.horizon = 4;
-  intent::TrainParams p;
-  p.sigma_factors = {1.0};
-  p.lambdas = {1e-3};
-  p.pseudo_inputs = 6;
-  p.gp_iterations = 15;
-  p.max_forecast_windows = 60;
+  const intent::TrainParams p = SmallTrainParams();
   auto model = std::make_shared<const IntentModel>(intent::TrainIntentModel(only_wrist({"s01", "s03"}), c, p));
   IntentEstimator est(model, {});
   ASSERT_EQ(est.joint_names(), std::vector<std::string>{"wrist_r"});
