@@ -107,12 +107,12 @@ class CollisionRiskService : public framework::Service {
     m.max_robot_link = r.max_robot_link;
     m.max_human_segment = r.max_human_segment;
     m.max_action = r.max_action;
-    m.min_separation = r.min_separation;
+    m.min_separation = services::ToWire(r.min_separation);
     m.protective_separation = r.protective_separation;
     m.human_speed = r.human_speed;
     m.robot_speed = r.robot_speed;
-    m.separation_margin = r.separation_margin;
-    m.verdict = static_cast<uint8_t>(r.verdict);
+    m.separation_margin = services::ToWire(r.separation_margin);
+    m.verdict = services::ToWire(r.verdict);
     m.reason = r.reason;
     writer_->Write(m);
     msg::SafetyPermit p;
@@ -126,8 +126,7 @@ class CollisionRiskService : public framework::Service {
     last_publish_ns_ = now_ns;
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
     if (r.verdict != last_verdict_) {
-      static const char* kNames[] = {"OK", "SLOW_DOWN", "PROTECTIVE_STOP"};
-      node.log().info("verdict {}: {}", kNames[static_cast<int>(r.verdict)], r.reason);
+      node.log().info("verdict {}: {}", ToString(r.verdict), r.reason);
       last_verdict_ = r.verdict;
     }
   }

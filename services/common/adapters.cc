@@ -52,4 +52,42 @@ msg::JointTrajectory ToTrajectory(const msg::Time& start, const std::vector<std:
   return t;
 }
 
+double ToWire(const cell::Separation& s) { return s.value_or(kWireNoPerson); }
+
+uint8_t ToWire(cell::Verdict v) {
+  switch (v) {
+    case cell::Verdict::kOk: return msg::CollisionRisk::OK;
+    case cell::Verdict::kSlowDown: return msg::CollisionRisk::SLOW_DOWN;
+    case cell::Verdict::kProtectiveStop: return msg::CollisionRisk::PROTECTIVE_STOP;
+  }
+  return msg::CollisionRisk::PROTECTIVE_STOP;
+}
+
+std::optional<cell::Verdict> VerdictFromWire(uint8_t octet) {
+  switch (octet) {
+    case msg::CollisionRisk::OK: return cell::Verdict::kOk;
+    case msg::CollisionRisk::SLOW_DOWN: return cell::Verdict::kSlowDown;
+    case msg::CollisionRisk::PROTECTIVE_STOP: return cell::Verdict::kProtectiveStop;
+    default: return std::nullopt;
+  }
+}
+
+uint8_t ToWire(cell::TaskStatus s) {
+  switch (s) {
+    case cell::TaskStatus::kSucceeded: return msg::TaskOutcome::SUCCEEDED;
+    case cell::TaskStatus::kFailed: return msg::TaskOutcome::FAILED;
+    case cell::TaskStatus::kCancelled: return msg::TaskOutcome::CANCELLED;
+  }
+  return msg::TaskOutcome::FAILED;
+}
+
+std::optional<cell::TaskStatus> TaskStatusFromWire(uint8_t octet) {
+  switch (octet) {
+    case msg::TaskOutcome::SUCCEEDED: return cell::TaskStatus::kSucceeded;
+    case msg::TaskOutcome::FAILED: return cell::TaskStatus::kFailed;
+    case msg::TaskOutcome::CANCELLED: return cell::TaskStatus::kCancelled;
+    default: return std::nullopt;
+  }
+}
+
 }  // namespace iplan::services

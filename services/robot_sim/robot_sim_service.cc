@@ -104,7 +104,9 @@ class RobotSimService : public framework::Service {
         js.velocity.assign(sim_->qd().data(), sim_->qd().data() + sim_->qd().size());
         joint_writer_->Write(js);
         node.SetDiagnosticValue("true_contacts", std::to_string(sim_->contacts()));
-        node.SetDiagnosticValue("min_true_separation_m", std::to_string(sim_->min_separation_seen()));
+        // Absent until the true person has been seen.
+        if (const auto& sep = sim_->min_separation_seen())
+          node.SetDiagnosticValue("min_true_separation_m", std::to_string(*sep));
         node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
         node.SetDiagnosticValue("stopped", sim_->stopped() ? "true" : "false");
         node.SetDiagnosticValue("permit", permit_reason_);
@@ -117,8 +119,9 @@ class RobotSimService : public framework::Service {
 
   Result OnDeactivate(Node& node) override {
     node.CancelTimer(timer_);
-    node.log().info("true contacts {}, minimum true separation {:.3f} m, protective stops {}", sim_->contacts(),
-                    sim_->min_separation_seen(), stops_);
+    const auto& sep = sim_->min_separation_seen();
+    node.log().info("true contacts {}, minimum true separation {}, protective stops {}", sim_->contacts(),
+                    sep ? std::to_string(*sep) + " m" : std::string("none (no person seen)"), stops_);
     return Result::Ok();
   }
 

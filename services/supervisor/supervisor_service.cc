@@ -10,6 +10,7 @@
 #include <chrono>
 #include <filesystem>
 
+#include "common/adapters.h"
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
 #include "iplan/framework/service.h"
@@ -128,7 +129,11 @@ class SupervisorService : public framework::Service {
     // signs of life (rejected samples still meet the DDS deadline).
     node.Subscribe(topic, std::function<void(const T&, const dds::SampleInfo&)>([this, name](const T& m, const dds::SampleInfo&) {
                      monitor_->OnData(name, msg::ToNanoseconds(msg::Now()));
-                     if constexpr (std::is_same_v<T, msg::CollisionRisk>) monitor_->OnRiskVerdict(m.verdict, m.reason);
+                     if constexpr (std::is_same_v<T, msg::CollisionRisk>) {
+                       // The boundary refuses octets the IDL does not define; an unknown one would stop.
+                       monitor_->OnRiskVerdict(services::VerdictFromWire(m.verdict).value_or(cell::Verdict::kProtectiveStop),
+                                               m.reason);
+                     }
                      if constexpr (std::is_same_v<T, msg::ActionBelief>) Belief(m);
                    }));
   }
@@ -212,7 +217,7 @@ class SupervisorService : public framework::Service {
 
   void OnOutcome(Node& node, const msg::TaskOutcome& o) {
     if (current_task_ < 0 || o.task_id != task_id_) return;  // not ours / stale
-    const bool ok = o.status == msg::TaskOutcome::SUCCEEDED;
+    const bool ok = services::TaskStatusFromWire(o.status) == cell::TaskStatus::kSucceeded;
     const double reward = planner_->Complete(current_task_, ok, o.delay, belief_);
     ++completed_;
     node.log().info("task {} '{}' {} in {:.2f} s, delay {:.2f} s, reward {:.3f}", o.task_id, o.task_name,

@@ -132,7 +132,7 @@ class TrajoptService : public framework::Service {
     m.header.stamp = msg::Now();
     m.task_id = o.id;
     m.task_name = o.name;
-    m.status = static_cast<uint8_t>(o.status);
+    m.status = services::ToWire(o.status);
     m.reason = o.reason;
     m.duration = o.duration;
     m.delay = o.delay;
@@ -141,9 +141,8 @@ class TrajoptService : public framework::Service {
     m.planning_time_p99 = o.planning_time_p99;
     m.max_collision_bound = o.max_collision_bound;
     outcome_writer_->Write(m);
-    static const char* kStatus[] = {"SUCCEEDED", "FAILED", "CANCELLED"};
     node.log().info("task {} '{}' {} after {:.2f} s (delay {:.2f} s, {} waits){}{}", o.id, o.name,
-                    kStatus[static_cast<int>(o.status)], o.duration, o.delay, o.num_waits,
+                    cell::ToString(o.status), o.duration, o.delay, o.num_waits,
                     o.reason.empty() ? "" : ": ", o.reason);
   }
 

@@ -69,8 +69,7 @@ PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_ri
   p.loop = false;
   perception::SyntheticPerson person(p);
   collision_risk::RiskMonitor monitor = fresh;
-  std::vector<std::string> robot_joints;
-  for (int j : monitor.robot().q_joints) robot_joints.push_back(monitor.robot().joints[static_cast<std::size_t>(j)].name);
+  const std::vector<std::string> robot_joints = monitor.robot().JointNames();
   if (goal.size() != robot_joints.size()) {
     throw std::runtime_error("goal has " + std::to_string(goal.size()) + " joints, the robot " +
                              std::to_string(robot_joints.size()));
@@ -96,10 +95,11 @@ PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_ri
       if (auto why = monitor.UpdateSkeleton(stamp, names, pos)) throw std::runtime_error(*why);
       if (t < start + settle) continue;
       const collision_risk::RiskReport r = monitor.Evaluate(stamp);
-      const double m = r.separation_margin;
+      if (!r.separation_margin) throw std::runtime_error("the monitor saw no person while checking " + action);
+      const double m = *r.separation_margin;
       if (m < worst.margin) {
         worst.margin = m;
-        worst.separation = r.binding_separation;
+        worst.separation = *r.binding_separation;
         worst.protective = r.protective_separation;
         worst.human_speed = r.human_speed;
         worst.time = t - start;

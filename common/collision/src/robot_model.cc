@@ -96,6 +96,12 @@ int RobotModel::FindJoint(const std::string& n) const {
   return -1;
 }
 
+std::vector<std::string> RobotModel::JointNames() const {
+  std::vector<std::string> names;
+  for (int j : q_joints) names.push_back(joints[static_cast<std::size_t>(j)].name);
+  return names;
+}
+
 Eigen::VectorXd RobotModel::LowerLimits() const {
   Eigen::VectorXd v(nq);
   for (int i = 0; i < nq; ++i) v[i] = joints[q_joints[i]].limits.lower;

@@ -148,7 +148,7 @@ InteractionResult RunInteraction(const CellModels& models, const LoopParams& par
     const collision_risk::RiskReport report = monitor.Evaluate(kEpochNs + t);
     last_evaluation = t;
     const bool risk_stop = report.verdict == collision_risk::Verdict::kProtectiveStop;
-    supervisor.OnRiskVerdict(static_cast<uint8_t>(report.verdict), report.reason);
+    supervisor.OnRiskVerdict(report.verdict, report.reason);
     // Both permits: the monitor's own (a stop at once) and the supervisor's
     // (which holds a stop until every cause has been clear for the delay).
     const bool held = supervisor.Evaluate(nullptr, kEpochNs + t).stop;
@@ -163,7 +163,7 @@ InteractionResult RunInteraction(const CellModels& models, const LoopParams& par
       if (in_task) {
         ++result.protective_stops;
         // Which layer (the monitor decides separation first, then the bound).
-        if (report.binding_separation < 1e6 && report.separation_margin < 0) {
+        if (report.separation_margin && *report.separation_margin < 0) {
           ++result.stops_separation;
         } else if (!report.waypoint_bounds.empty()) {
           ++result.stops_bound;

@@ -9,31 +9,10 @@
 namespace iplan::collision_risk {
 namespace {
 
-constexpr double kNoPerson = 1e6;  // m, reported separation when nobody is seen
-
 std::string Fmt(double v, const char* f = "%.3g") {
   char buf[64];
   std::snprintf(buf, sizeof(buf), f, v);
   return buf;
-}
-
-// Index of each name in `wanted` within `names`, or an error naming the first missing one.
-std::optional<std::string> MapNames(const std::vector<std::string>& names, const std::vector<std::string>& wanted,
-                                    std::vector<int>* index) {
-  index->assign(wanted.size(), -1);
-  for (std::size_t w = 0; w < wanted.size(); ++w) {
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      if (names[i] == wanted[w]) (*index)[w] = static_cast<int>(i);
-    }
-    if ((*index)[w] < 0) return "missing joint '" + wanted[w] + "'";
-  }
-  return std::nullopt;
-}
-
-std::vector<std::string> RobotJointNames(const collision::RobotModel& m) {
-  std::vector<std::string> names;
-  for (int j : m.q_joints) names.push_back(m.joints[j].name);
-  return names;
 }
 
 }  // namespace
@@ -57,6 +36,7 @@ std::string RiskParams::Validate() const {
 
 RiskMonitor::RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params)
     : robot_(std::move(robot)),
+      robot_joints_(robot_.JointNames()),
       body_(std::move(body)),
       params_(params),
       data_(robot_),
@@ -70,7 +50,7 @@ std::optional<std::string> RiskMonitor::UpdateRobotState(int64_t stamp_ns, const
                                                          const std::vector<double>& positions) {
   if (names.size() != positions.size()) return std::string("names and positions differ in size");
   std::vector<int> idx;
-  if (auto e = MapNames(names, RobotJointNames(robot_), &idx)) return "joint state: " + *e;
+  if (auto e = cell::MapJointNames(names, robot_joints_, &idx)) return "joint state: " + *e;
   Eigen::VectorXd q(robot_.nq);
   for (int i = 0; i < robot_.nq; ++i) q[i] = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
   // A state the arm cannot be in is a wrong or corrupted measurement: the
@@ -85,27 +65,19 @@ std::optional<std::string> RiskMonitor::UpdateRobotState(int64_t stamp_ns, const
 std::optional<std::string> RiskMonitor::UpdateTrajectory(int64_t start_ns, const std::vector<std::string>& names,
                                                          const std::vector<double>& times,
                                                          const std::vector<std::vector<double>>& positions) {
-  if (times.size() != positions.size()) return std::string("times and points differ in size");
-  std::vector<int> idx;
-  if (auto e = MapNames(names, RobotJointNames(robot_), &idx)) return "trajectory: " + *e;
-  std::vector<Eigen::VectorXd> pts;
-  for (std::size_t p = 0; p < positions.size(); ++p) {
-    if (positions[p].size() != names.size()) return "trajectory point " + std::to_string(p) + " has the wrong size";
-    if (p > 0 && !(times[p] > times[p - 1])) return std::string("trajectory times do not increase");
-    Eigen::VectorXd q(robot_.nq);
-    for (int i = 0; i < robot_.nq; ++i) q[i] = positions[p][static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
-    pts.push_back(q);
+  if (times.empty() && positions.empty()) {  // no trajectory: the robot holds its state
+    trajectory_ = cell::JointTrajectory{};
+    return std::nullopt;
   }
-  trajectory_start_ns_ = start_ns;
-  trajectory_times_ = times;
-  trajectory_positions_ = std::move(pts);
+  if (auto e = cell::JointTrajectory::FromPoints(start_ns, names, times, positions, robot_joints_, &trajectory_))
+    return "trajectory: " + *e;
   return std::nullopt;
 }
 
 std::optional<std::string> RiskMonitor::UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
                                                        const std::vector<Eigen::Vector3d>& positions) {
   std::vector<int> idx;
-  if (auto e = MapNames(names, body_.params().joints, &idx)) return "skeleton: " + *e;
+  if (auto e = cell::MapJointNames(names, body_.params().joints, &idx)) return "skeleton: " + *e;
   Eigen::Matrix3Xd p(3, body_.num_joints());
   for (int j = 0; j < body_.num_joints(); ++j) p.col(j) = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(j)])];
   skeletons_.emplace_back(stamp_ns, p);
@@ -115,24 +87,14 @@ std::optional<std::string> RiskMonitor::UpdateSkeleton(int64_t stamp_ns, const s
 }
 
 std::optional<std::string> RiskMonitor::UpdatePrediction(const PredictionInput& in) {
-  collision::HumanPrediction pred(1, 1, {0.1});
-  if (auto why = collision::BuildSpherePrediction(body_, in, &pred)) return why;
-  prediction_ = std::move(pred);
-  prediction_meta_ = in;
-  prediction_meta_.means.clear();
-  prediction_meta_.covariances.clear();
+  cell::TimedPrediction p;
+  if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
+  prediction_ = std::move(p);
   return std::nullopt;
 }
 
 Eigen::VectorXd RiskMonitor::RobotConfigurationAt(int64_t t_ns) const {
-  if (trajectory_positions_.empty()) return state_->second;
-  const double t = (t_ns - trajectory_start_ns_) * 1e-9;
-  if (t <= trajectory_times_.front()) return trajectory_positions_.front();
-  if (t >= trajectory_times_.back()) return trajectory_positions_.back();
-  const auto it = std::upper_bound(trajectory_times_.begin(), trajectory_times_.end(), t);
-  const std::size_t i = static_cast<std::size_t>(it - trajectory_times_.begin());
-  const double u = (t - trajectory_times_[i - 1]) / (trajectory_times_[i] - trajectory_times_[i - 1]);
-  return (1 - u) * trajectory_positions_[i - 1] + u * trajectory_positions_[i];
+  return trajectory_.empty() ? state_->second : trajectory_.PositionAt(t_ns);
 }
 
 bool RiskMonitor::MeasuredJointVelocities(Eigen::Matrix3Xd* v) const {
@@ -153,7 +115,7 @@ bool RiskMonitor::MeasuredJointVelocities(Eigen::Matrix3Xd* v) const {
 void RiskMonitor::RobotSphereVelocities(int64_t now_ns, Eigen::Matrix3Xd* v) {
   Eigen::VectorXd q0, q1;
   double dt = 0;
-  if (!trajectory_positions_.empty()) {
+  if (!trajectory_.empty()) {
     dt = 0.02;
     q0 = RobotConfigurationAt(now_ns);
     q1 = RobotConfigurationAt(now_ns + static_cast<int64_t>(dt * 1e9));
@@ -179,124 +141,126 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
     r.reason = state_ ? "robot state is stale" : "no robot state yet";
     return r;
   }
-  const bool person = !skeletons_.empty() && now_ns - skeletons_.back().first <= stale;
-  const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
-  r.trajectory_stamp_ns = trajectory_positions_.empty() ? 0 : trajectory_start_ns_;
+  Inputs in;
+  in.person = !skeletons_.empty() && now_ns - skeletons_.back().first <= stale;
+  in.predicted = prediction_ && prediction_->FreshAt(now_ns, stale);
+  in.degraded = in.person && !in.predicted && params_.ssm.degrade_without_prediction;
+  r.trajectory_stamp_ns = trajectory_.empty() ? 0 : trajectory_.start_ns;
+  EvaluateSeparation(now_ns, in, &r);
+  if (in.predicted) EvaluateBound(now_ns, &r);
+  DecideVerdict(now_ns, in, &r);
+  return r;
+}
 
-  // ISO/TS 15066 layer: current separation against S_p, per sphere pair
-  // when directed (see the header), else one S_p from the fastest joint and
-  // the fastest robot sphere.
+// ISO/TS 15066 layer: current separation against S_p, per sphere pair when
+// directed (see the header), else one S_p from the fastest joint and the
+// fastest robot sphere.
+void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* out) {
+  RiskReport& r = *out;
   const SsmParams& s = params_.ssm;
   const auto& robot_spheres = robot_.spheres;
   Eigen::Matrix3Xd v_robot;
   RobotSphereVelocities(now_ns, &v_robot);
   Eigen::Matrix3Xd v_joints;
-  const bool degraded = person && !predicted && s.degrade_without_prediction;
-  const bool measured = person && !degraded && MeasuredJointVelocities(&v_joints);
-  const double fixed = s.intrusion_distance + s.sensing_uncertainty + s.robot_uncertainty;
-  auto protective = [&](double v_h, double v_r) {
-    const double s_s = s.directed ? s.stopping_distance * std::min(1.0, v_r / s.stopping_speed) : s.stopping_distance;
-    return v_h * (s.reaction_time + s.stopping_time) + v_r * s.reaction_time + s_s + fixed;
-  };
+  const bool measured = in.person && !in.degraded && MeasuredJointVelocities(&v_joints);
   // Undirected speeds (also what is reported when nobody is seen).
   const double v_h_max = measured ? v_joints.colwise().norm().maxCoeff() : s.default_human_speed;
   const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
   r.human_speed = v_h_max;
   r.robot_speed = v_r_max;
-  r.protective_separation = protective(v_h_max, v_r_max);
-  if (person) {
-    collision::CalcForwardKinematics(robot_, state_->second, &data_);
-    const Eigen::Matrix3Xd& joints = skeletons_.back().second;
-    double best = kNoPerson, best_margin = kNoPerson;
-    std::size_t closest_k = 0, binding_k = 0;
-    int closest_h = 0, binding_h = 0;
-    for (int h = 0; h < body_.num_spheres(); ++h) {
-      const auto& def = body_.spheres()[static_cast<std::size_t>(h)];
-      const Eigen::Vector3d c = (1 - def.u) * joints.col(def.joint_a) + def.u * joints.col(def.joint_b);
-      Eigen::Vector3d v_c = Eigen::Vector3d::Zero();
-      if (measured) v_c = (1 - def.u) * v_joints.col(def.joint_a) + def.u * v_joints.col(def.joint_b);
-      for (std::size_t k = 0; k < robot_spheres.size(); ++k) {
-        const Eigen::Index ki = static_cast<Eigen::Index>(k);
-        const Eigen::Vector3d delta = data_.p_WS.col(ki) - c;  // human -> robot
-        const double centres = delta.norm();
-        const double d = centres - robot_spheres[k].radius - def.radius;
-        double v_h = v_h_max, v_r = v_r_max, sp = r.protective_separation;
-        if (s.directed) {
-          // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
-          const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
-          v_h = measured ? std::max(0.0, v_c.dot(u)) : s.default_human_speed;
-          v_r = std::max(0.0, -v_robot.col(ki).dot(u));
-          sp = protective(v_h, v_r);
-        }
-        if (d < best) {
-          best = d;
-          closest_k = k;
-          closest_h = h;
-        }
-        if (d - sp < best_margin) {
-          best_margin = d - sp;
-          binding_k = k;
-          binding_h = h;
-          r.binding_separation = d;
-          r.protective_separation = sp;
-          r.human_speed = v_h;
-          r.robot_speed = v_r;
-        }
+  r.protective_separation = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+  if (!in.person) return;
+  collision::CalcForwardKinematics(robot_, state_->second, &data_);
+  const Eigen::Matrix3Xd& joints = skeletons_.back().second;
+  double best = std::numeric_limits<double>::infinity(), best_margin = best;
+  std::size_t closest_k = 0, binding_k = 0;
+  int closest_h = 0, binding_h = 0;
+  for (int h = 0; h < body_.num_spheres(); ++h) {
+    const double human_radius = body_.spheres()[static_cast<std::size_t>(h)].radius;
+    const Eigen::Vector3d c = body_.SphereCentre(h, joints);
+    const Eigen::Vector3d v_c = measured ? body_.SphereCentre(h, v_joints) : Eigen::Vector3d::Zero();
+    for (std::size_t k = 0; k < robot_spheres.size(); ++k) {
+      const Eigen::Index ki = static_cast<Eigen::Index>(k);
+      const Eigen::Vector3d delta = data_.p_WS.col(ki) - c;  // human -> robot
+      const double centres = delta.norm();
+      const double d = centres - robot_spheres[k].radius - human_radius;
+      double v_h = v_h_max, v_r = v_r_max, sp = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+      if (s.directed) {
+        // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
+        const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
+        v_h = measured ? std::max(0.0, v_c.dot(u)) : s.default_human_speed;
+        v_r = std::max(0.0, -v_robot.col(ki).dot(u));
+        sp = cell::ProtectiveSeparationDistance(s, v_h, v_r);
       }
-    }
-    auto link = [&](std::size_t k) { return robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)]; };
-    auto segment = [&](int h) {
-      return body_.params().segments[static_cast<std::size_t>(body_.spheres()[static_cast<std::size_t>(h)].segment)].name;
-    };
-    r.min_separation = best;
-    r.separation_robot_link = link(closest_k);
-    r.separation_human_segment = segment(closest_h);
-    r.separation_margin = best_margin;
-    r.binding_robot_link = link(binding_k);
-    r.binding_human_segment = segment(binding_h);
-  }
-
-  // Prediction layer: bound along the executing trajectory.
-  if (predicted) {
-    const PredictionInput& m = prediction_meta_;
-    r.prediction_stamp_ns = m.t0_ns;
-    r.time_step = m.time_step;
-    collision::RobotSpheresTrajectory traj;
-    const int S = static_cast<int>(robot_spheres.size());
-    for (const auto& sp : robot_spheres) {
-      traj.radii.push_back(sp.radius);
-      traj.links.push_back(sp.link);
-    }
-    std::vector<int> steps;
-    for (int k = 0; k < m.num_steps; ++k) {
-      const int64_t t_k = m.t0_ns + static_cast<int64_t>((k + 1) * m.time_step * 1e9);
-      if (t_k >= now_ns) steps.push_back(k);
-    }
-    traj.steps = steps;
-    traj.centres.resize(3, static_cast<Eigen::Index>(steps.size()) * S);
-    for (std::size_t w = 0; w < steps.size(); ++w) {
-      const int64_t t_k = m.t0_ns + static_cast<int64_t>((steps[w] + 1) * m.time_step * 1e9);
-      collision::CalcForwardKinematics(robot_, RobotConfigurationAt(t_k), &data_);
-      traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data_.p_WS;
-      r.waypoint_times.push_back((t_k - now_ns) * 1e-9);
-    }
-    collision::EvaluateTrajectoryBound(*prediction_, traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
-    for (std::size_t w = 0; w < bounds_.size(); ++w) {
-      const auto& b = bounds_[w];
-      r.waypoint_bounds.push_back(std::clamp(b.bound, 0.0, 1.0));
-      if (w == 0 || b.bound > r.max_bound) {
-        r.max_bound = std::clamp(b.bound, 0.0, 1.0);
-        r.max_waypoint = static_cast<int>(w);
-        r.max_time = r.waypoint_times[w];
-        r.max_robot_link = b.robot_link >= 0 ? robot_.link_names[static_cast<std::size_t>(b.robot_link)] : "";
-        r.max_human_segment =
-            b.human_segment >= 0 ? body_.params().segments[static_cast<std::size_t>(b.human_segment)].name : "";
-        r.max_action = b.action >= 0 ? m.actions[static_cast<std::size_t>(b.action)] : "";
+      if (d < best) {
+        best = d;
+        closest_k = k;
+        closest_h = h;
+      }
+      if (d - sp < best_margin) {
+        best_margin = d - sp;
+        binding_k = k;
+        binding_h = h;
+        r.binding_separation = d;
+        r.protective_separation = sp;
+        r.human_speed = v_h;
+        r.robot_speed = v_r;
       }
     }
   }
+  auto link = [&](std::size_t k) { return robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)]; };
+  auto segment = [&](int h) {
+    return body_.params().segments[static_cast<std::size_t>(body_.spheres()[static_cast<std::size_t>(h)].segment)].name;
+  };
+  r.min_separation = best;
+  r.separation_robot_link = link(closest_k);
+  r.separation_human_segment = segment(closest_h);
+  r.separation_margin = best_margin;
+  r.binding_robot_link = link(binding_k);
+  r.binding_human_segment = segment(binding_h);
+}
 
-  // Verdict: the hard layer first, then the prediction.
+// Prediction layer: the bound along the executing trajectory at every
+// prediction step not yet past.
+void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
+  RiskReport& r = *out;
+  const cell::TimedPrediction& m = *prediction_;
+  r.prediction_stamp_ns = m.t0_ns();
+  r.time_step = m.time_step();
+  collision::RobotSpheresTrajectory traj;
+  const int S = static_cast<int>(robot_.spheres.size());
+  for (const auto& sp : robot_.spheres) {
+    traj.radii.push_back(sp.radius);
+    traj.links.push_back(sp.link);
+  }
+  for (int k = 0; k < m.num_steps(); ++k)
+    if (m.StepTime(k) >= now_ns) traj.steps.push_back(k);
+  traj.centres.resize(3, static_cast<Eigen::Index>(traj.steps.size()) * S);
+  for (std::size_t w = 0; w < traj.steps.size(); ++w) {
+    const int64_t t_k = m.StepTime(traj.steps[w]);
+    collision::CalcForwardKinematics(robot_, RobotConfigurationAt(t_k), &data_);
+    traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data_.p_WS;
+    r.waypoint_times.push_back((t_k - now_ns) * 1e-9);
+  }
+  collision::EvaluateTrajectoryBound(m.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
+  for (std::size_t w = 0; w < bounds_.size(); ++w) {
+    const auto& b = bounds_[w];
+    r.waypoint_bounds.push_back(std::clamp(b.bound, 0.0, 1.0));
+    if (w == 0 || b.bound > r.max_bound) {
+      r.max_bound = std::clamp(b.bound, 0.0, 1.0);
+      r.max_waypoint = static_cast<int>(w);
+      r.max_time = r.waypoint_times[w];
+      r.max_robot_link = b.robot_link >= 0 ? robot_.link_names[static_cast<std::size_t>(b.robot_link)] : "";
+      r.max_human_segment =
+          b.human_segment >= 0 ? body_.params().segments[static_cast<std::size_t>(b.human_segment)].name : "";
+      r.max_action = b.action >= 0 ? m.actions()[static_cast<std::size_t>(b.action)] : "";
+    }
+  }
+}
+
+// Verdict: the hard layer first, then the prediction.
+void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* out) const {
+  RiskReport& r = *out;
   const double threshold = 1 - params_.delta_cl;
   double first_violation = -1;
   for (std::size_t w = 0; w < r.waypoint_bounds.size(); ++w) {
@@ -305,14 +269,16 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
       break;
     }
   }
-  if (!person && params_.person_required) {
+  const double margin = r.separation_margin.value_or(std::numeric_limits<double>::infinity());
+  const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
+  if (!in.person && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = skeletons_.empty() ? "no person tracked yet (no skeleton): the person could be anywhere"
                                   : "person no longer tracked (no skeleton for " +
                                         Fmt((now_ns - skeletons_.back().first) * 1e-9) + " s): the person could be anywhere";
-  } else if (person && r.separation_margin < 0) {
+  } else if (in.person && margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
-    r.reason = "separation " + Fmt(r.binding_separation) + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
+    r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
                ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
                ", v_r " + Fmt(r.robot_speed) + " m/s)";
   } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
@@ -325,18 +291,17 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
-  } else if (person && r.separation_margin < params_.slow_down_margin) {
+  } else if (in.person && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "separation " + Fmt(r.binding_separation) + " m within " + Fmt(params_.slow_down_margin) +
+    r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
                " m of the protective separation";
   } else {
     r.verdict = Verdict::kOk;
-    r.reason = !person    ? "no person seen"
-               : predicted ? "clear"
-               : degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
-                           : "clear (separation only: no current prediction)";
+    r.reason = !in.person    ? "no person seen"
+               : in.predicted ? "clear"
+               : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
+                              : "clear (separation only: no current prediction)";
   }
-  return r;
 }
 
 }  // namespace iplan::collision_risk

@@ -37,6 +37,10 @@
 
 #include <Eigen/Core>
 
+#include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/ssm.h"
+#include "iplan/cell/status.h"
+#include "iplan/cell/timed_prediction.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/joint_mixture.h"
 #include "iplan/collision/robot_model.h"
@@ -44,24 +48,8 @@
 
 namespace iplan::collision_risk {
 
-/// ISO/TS 15066 speed and separation monitoring parameters.
-struct SsmParams {
-  bool directed = true;             ///< speeds towards each other per sphere pair; false: fastest joint / sphere, S_s always
-  bool measure_human_speed = true;  ///< from the skeleton; else v_h = default_human_speed
-  double default_human_speed = 1.6; ///< m/s, ISO value when the speed is not measured
-  /// Degraded mode: without a usable prediction the person's intent is
-  /// unknown, so v_h is default_human_speed even when the skeleton gives a
-  /// measured speed (the robot keeps working, more cautiously).
-  bool degrade_without_prediction = true;
-  double speed_window = 0.3;        ///< s, displacement window for the measured speed
-  double reaction_time = 0.1;       ///< s, T_r
-  double stopping_time = 0.3;       ///< s, T_s
-  double stopping_distance = 0.15;  ///< m, S_s (at stopping_speed when directed)
-  double stopping_speed = 1.0;      ///< m/s, robot speed at which stopping_distance was measured (directed only)
-  double intrusion_distance = 0.1;  ///< m, C
-  double sensing_uncertainty = 0.05;  ///< m, Z_d
-  double robot_uncertainty = 0.02;    ///< m, Z_r
-};
+/// ISO/TS 15066 speed and separation monitoring parameters (iplan/cell/ssm.h).
+using SsmParams = cell::SsmParams;
 
 struct RiskParams {
   double delta_cl = 0.95;          ///< a waypoint is safe when its bound < 1 - delta_cl
@@ -81,7 +69,7 @@ struct RiskParams {
   std::string Validate() const;
 };
 
-enum class Verdict { kOk = 0, kSlowDown = 1, kProtectiveStop = 2 };
+using cell::Verdict;
 
 struct RiskReport {
   int64_t stamp_ns = 0;                  ///< evaluation time
@@ -94,13 +82,13 @@ struct RiskReport {
   int max_waypoint = 0;
   double max_time = 0;                   ///< s after stamp_ns
   std::string max_robot_link, max_human_segment, max_action;
-  double min_separation = 1e6;           ///< m; 1e6 when no person is seen
+  cell::Separation min_separation;       ///< m; nullopt when no person is seen
   std::string separation_robot_link, separation_human_segment;
   double protective_separation = 0;      ///< m, S_p of the binding pair (smallest separation - S_p)
   double human_speed = 0;                ///< m/s used for that S_p (towards the robot when directed)
   double robot_speed = 0;                ///< m/s used for that S_p (towards the person when directed)
-  double binding_separation = 1e6;       ///< m, separation of the binding pair; 1e6 when no person is seen
-  double separation_margin = 1e6;        ///< m, binding_separation - protective_separation; < 0 stops
+  cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
+  cell::Separation separation_margin;    ///< m, binding_separation - protective_separation; < 0 stops
   std::string binding_robot_link, binding_human_segment;
   Verdict verdict = Verdict::kProtectiveStop;
   std::string reason;
@@ -134,6 +122,18 @@ class RiskMonitor {
   const collision::HumanBodyModel& body() const { return body_; }
 
  private:
+  /// What Evaluate knows before it looks at the layers.
+  struct Inputs {
+    bool person = false;     ///< a fresh skeleton
+    bool predicted = false;  ///< a fresh prediction
+    bool degraded = false;   ///< a person without a usable prediction (SsmParams::degrade_without_prediction)
+  };
+  /// The ISO/TS 15066 layer into r: separation and S_p per sphere pair.
+  void EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* r);
+  /// The prediction layer into r: bound along the executing trajectory.
+  void EvaluateBound(int64_t now_ns, RiskReport* r);
+  /// The verdict policy (see the file comment) from both layers.
+  void DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* r) const;
   Eigen::VectorXd RobotConfigurationAt(int64_t t_ns) const;
   /// Per-joint velocity (m/s, 3 x joints) over the speed window; false when
   /// not measured (measure_human_speed off or too little history).
@@ -143,21 +143,19 @@ class RiskMonitor {
   void RobotSphereVelocities(int64_t now_ns, Eigen::Matrix3Xd* v);
 
   collision::RobotModel robot_;
+  std::vector<std::string> robot_joints_;  // robot_.JointNames()
   collision::HumanBodyModel body_;
   RiskParams params_;
   collision::RobotData data_;
   collision::RobotData data2_;
   // Robot state (model joint order).
   std::optional<std::pair<int64_t, Eigen::VectorXd>> state_, previous_state_;
-  // Executing trajectory.
-  int64_t trajectory_start_ns_ = 0;
-  std::vector<double> trajectory_times_;
-  std::vector<Eigen::VectorXd> trajectory_positions_;
+  // Executing trajectory (empty: none).
+  cell::JointTrajectory trajectory_;
   // Skeleton history (body joint order), newest last.
   std::deque<std::pair<int64_t, Eigen::Matrix3Xd>> skeletons_;
   // Latest prediction, converted for the bound.
-  std::optional<collision::HumanPrediction> prediction_;
-  PredictionInput prediction_meta_;
+  std::optional<cell::TimedPrediction> prediction_;
   collision::TrajectoryBoundWorkspace workspace_;
   std::vector<collision::WaypointBound> bounds_;
 };

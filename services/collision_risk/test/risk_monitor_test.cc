@@ -74,6 +74,17 @@ TEST_F(RiskMonitorTest, StopsWithoutRobotState) {
   EXPECT_EQ(r.reason, "no robot state yet");
 }
 
+TEST_F(RiskMonitorTest, NoPersonSeenHasNoSeparation) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  const RiskReport r = monitor_.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.reason;  // person_required is off here
+  EXPECT_EQ(r.reason, "no person seen");
+  EXPECT_FALSE(r.min_separation.has_value());
+  EXPECT_FALSE(r.binding_separation.has_value());
+  EXPECT_FALSE(r.separation_margin.has_value());
+}
+
 TEST_F(RiskMonitorTest, OkWhenThePersonStaysAway) {
   const int64_t t = 100 * kSec;
   RobotAtReady(t);
@@ -85,14 +96,14 @@ TEST_F(RiskMonitorTest, OkWhenThePersonStaysAway) {
   EXPECT_EQ(r.reason, "clear");
   EXPECT_EQ(r.waypoint_bounds.size(), 15u);
   EXPECT_LT(r.max_bound, 1e-6);
-  EXPECT_GT(r.min_separation, 1.0);
+  EXPECT_GT(r.min_separation.value(), 1.0);
   EXPECT_NEAR(r.human_speed, 0.0, 1e-9);
   EXPECT_NEAR(r.robot_speed, 0.0, 1e-9);
   // S_p = v_h (T_r + T_s) + v_r T_r + S_s + C + Z_d + Z_r with v_h = v_r = 0;
   // a robot at rest travels nothing while it stops, so S_s does not count.
   EXPECT_NEAR(r.protective_separation, 0.1 + 0.05 + 0.02, 1e-12);
-  EXPECT_NEAR(r.separation_margin, r.binding_separation - r.protective_separation, 1e-12);
-  EXPECT_GE(r.binding_separation, r.min_separation);
+  EXPECT_NEAR(r.separation_margin.value(), r.binding_separation.value() - r.protective_separation, 1e-12);
+  EXPECT_GE(r.binding_separation.value(), r.min_separation.value());
 }
 
 TEST(RiskMonitorUndirected, StoppingDistanceAlwaysCounts) {
@@ -108,7 +119,7 @@ TEST(RiskMonitorUndirected, StoppingDistanceAlwaysCounts) {
   ASSERT_EQ(monitor.UpdateSkeleton(t, kJoints, Person({2.0, 0, 1.0})), std::nullopt);
   const RiskReport r = monitor.Evaluate(t);
   EXPECT_NEAR(r.protective_separation, 0.15 + 0.1 + 0.05 + 0.02, 1e-12);
-  EXPECT_NEAR(r.separation_margin, r.min_separation - r.protective_separation, 1e-12);
+  EXPECT_NEAR(r.separation_margin.value(), r.min_separation.value() - r.protective_separation, 1e-12);
 }
 
 TEST_F(RiskMonitorTest, MeasuredHumanSpeedEntersTheProtectiveSeparation) {
@@ -144,8 +155,8 @@ TEST_F(RiskMonitorTest, SidewaysMotionDoesNotInflateTheDirectedProtectiveSeparat
   ASSERT_EQ(undirected.UpdateSkeleton(t, kJoints, Person({1.3, 0.0, 0.6})), std::nullopt);
   const RiskReport u = undirected.Evaluate(t);
   EXPECT_NEAR(u.human_speed, 1.0, 1e-9);
-  EXPECT_NEAR(u.min_separation, r.min_separation, 1e-12);
-  EXPECT_GT(r.separation_margin - u.separation_margin, 0.4 + 0.15 - 0.3 * 0.4);
+  EXPECT_NEAR(u.min_separation.value(), r.min_separation.value(), 1e-12);
+  EXPECT_GT(r.separation_margin.value() - u.separation_margin.value(), 0.4 + 0.15 - 0.3 * 0.4);
 }
 
 TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
@@ -157,8 +168,8 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
   SeePerson(t - 2 * kSec / 10, torso, 0.3);
   SeePerson(t, torso, 0.3);
   const RiskReport still = monitor_.Evaluate(t);
-  ASSERT_GT(still.min_separation, 0.17 + 0.02);
-  ASSERT_LT(still.min_separation, 0.32 - 0.02);
+  ASSERT_GT(still.min_separation.value(), 0.17 + 0.02);
+  ASSERT_LT(still.min_separation.value(), 0.32 - 0.02);
   EXPECT_NE(still.verdict, Verdict::kProtectiveStop) << still.reason;
   // Folding the shoulder back moves every sphere away from the person.
   ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 1.0},
@@ -166,7 +177,7 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
             std::nullopt);
   const RiskReport away = monitor_.Evaluate(t);
   EXPECT_NEAR(away.robot_speed, 0.0, 1e-12) << "no sphere of the binding pair approaches";
-  EXPECT_NEAR(away.separation_margin, still.separation_margin, 1e-12);
+  EXPECT_NEAR(away.separation_margin.value(), still.separation_margin.value(), 1e-12);
   EXPECT_NE(away.verdict, Verdict::kProtectiveStop) << away.reason;
   // Leaning the shoulder forward approaches the person: v_r T_r and S_s,
   // scaled by v_r / 1 m/s, count.
@@ -189,8 +200,8 @@ TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
   SeePerson(t, {0.75, 0, 0.5}, 0.35);
   const RiskReport r = monitor_.Evaluate(t);
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
-  EXPECT_LT(r.separation_margin, 0);
-  EXPECT_LT(r.binding_separation, r.protective_separation);
+  EXPECT_LT(r.separation_margin.value(), 0);
+  EXPECT_LT(r.binding_separation.value(), r.protective_separation);
   EXPECT_NE(r.reason.find("below the protective separation"), std::string::npos) << r.reason;
 }
 
@@ -203,7 +214,7 @@ TEST_F(RiskMonitorTest, PredictionOfContactSoonStopsBeforeSeparationIsViolated) 
   SeePerson(t, torso);
   ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
   const RiskReport r = monitor_.Evaluate(t);
-  EXPECT_GT(r.separation_margin, 0) << "the separation layer alone would not stop yet";
+  EXPECT_GT(r.separation_margin.value(), 0) << "the separation layer alone would not stop yet";
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
   EXPECT_GE(r.max_bound, 0.05);
   EXPECT_NE(r.reason.find("collision bound"), std::string::npos) << r.reason;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 
 namespace iplan::robot_sim {
@@ -13,7 +14,7 @@ std::string SimulatorParams::Validate() const {
 }
 
 RobotSimulator::RobotSimulator(collision::RobotModel robot, const Eigen::VectorXd& q0, SimulatorParams params)
-    : robot_(std::move(robot)), params_(params), data_(robot_) {
+    : robot_(std::move(robot)), params_(params), data_(robot_), robot_joints_(robot_.JointNames()) {
   if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
   const int n = robot_.nq;
   if (q0.size() != n) throw std::invalid_argument("initial configuration has " + std::to_string(q0.size()) +
@@ -35,38 +36,20 @@ RobotSimulator::RobotSimulator(collision::RobotModel robot, const Eigen::VectorX
   stop_decel_ = Eigen::VectorXd::Zero(n);
 }
 
-std::vector<std::string> RobotSimulator::joint_names() const {
-  std::vector<std::string> names;
-  for (int j : robot_.q_joints) names.push_back(robot_.joints[static_cast<std::size_t>(j)].name);
-  return names;
-}
-
 std::optional<std::string> RobotSimulator::SetTrajectory(int64_t start_ns, const std::vector<std::string>& names,
                                                          const std::vector<double>& times,
                                                          const std::vector<std::vector<double>>& positions) {
-  if (times.empty() || times.size() != positions.size()) return std::string("empty or inconsistent trajectory");
-  const std::vector<std::string> model = joint_names();
-  std::vector<int> idx(model.size(), -1);
-  for (std::size_t m = 0; m < model.size(); ++m) {
-    for (std::size_t i = 0; i < names.size(); ++i) {
-      if (names[i] == model[m]) idx[m] = static_cast<int>(i);
-    }
-    if (idx[m] < 0) return "trajectory lacks joint '" + model[m] + "'";
-  }
-  Trajectory t;
-  t.start_ns = start_ns;
-  t.times = times;
-  for (std::size_t p = 0; p < positions.size(); ++p) {
-    if (positions[p].size() != names.size()) return "point " + std::to_string(p) + " has the wrong size";
-    if (p > 0 && !(times[p] > times[p - 1])) return std::string("times do not increase");
-    Eigen::VectorXd q(robot_.nq);
+  cell::JointTrajectory t;
+  if (auto e = cell::JointTrajectory::FromPoints(start_ns, names, times, positions, robot_joints_, &t))
+    return "trajectory: " + *e;
+  for (std::size_t p = 0; p < t.positions.size(); ++p) {
+    const Eigen::VectorXd& q = t.positions[p];
     for (int i = 0; i < robot_.nq; ++i) {
-      q[i] = positions[p][static_cast<std::size_t>(idx[static_cast<std::size_t>(i)])];
       if (q[i] < lower_[i] - 1e-9 || q[i] > upper_[i] + 1e-9) {
-        return "point " + std::to_string(p) + " puts " + model[static_cast<std::size_t>(i)] + " outside its limits";
+        return "trajectory: point " + std::to_string(p) + " puts " + robot_joints_[static_cast<std::size_t>(i)] +
+               " outside its limits";
       }
     }
-    t.positions.push_back(q);
   }
   trajectory_ = std::move(t);
   return std::nullopt;
@@ -85,14 +68,7 @@ void RobotSimulator::Stop() {
 void RobotSimulator::Resume() { stop_requested_ = false; }
 
 Eigen::VectorXd RobotSimulator::Desired(int64_t now_ns) const {
-  if (!trajectory_) return q_;
-  const Trajectory& t = *trajectory_;
-  const double s = (now_ns - t.start_ns) * 1e-9;
-  if (s <= t.times.front()) return t.positions.front();
-  if (s >= t.times.back()) return t.positions.back();
-  const std::size_t i = static_cast<std::size_t>(std::upper_bound(t.times.begin(), t.times.end(), s) - t.times.begin());
-  const double u = (s - t.times[i - 1]) / (t.times[i] - t.times[i - 1]);
-  return (1 - u) * t.positions[i - 1] + u * t.positions[i];
+  return trajectory_.empty() ? q_ : trajectory_.PositionAt(now_ns);
 }
 
 void RobotSimulator::Step(int64_t now_ns, double dt) {
@@ -123,15 +99,15 @@ void RobotSimulator::Step(int64_t now_ns, double dt) {
 
 double RobotSimulator::UpdateContacts(const Eigen::Matrix3Xd& joints, const collision::HumanBodyModel& body) {
   collision::CalcForwardKinematics(robot_, q_, &data_);
-  double best = 1e6;
+  double best = std::numeric_limits<double>::infinity();
   for (int h = 0; h < body.num_spheres(); ++h) {
-    const auto& def = body.spheres()[static_cast<std::size_t>(h)];
-    const Eigen::Vector3d c = (1 - def.u) * joints.col(def.joint_a) + def.u * joints.col(def.joint_b);
+    const Eigen::Vector3d c = body.SphereCentre(h, joints);
+    const double human_radius = body.spheres()[static_cast<std::size_t>(h)].radius;
     for (std::size_t k = 0; k < robot_.spheres.size(); ++k) {
-      best = std::min(best, (data_.p_WS.col(static_cast<Eigen::Index>(k)) - c).norm() - robot_.spheres[k].radius - def.radius);
+      best = std::min(best, (data_.p_WS.col(static_cast<Eigen::Index>(k)) - c).norm() - robot_.spheres[k].radius - human_radius);
     }
   }
-  min_separation_seen_ = std::min(min_separation_seen_, best);
+  min_separation_seen_ = std::min(min_separation_seen_.value_or(best), best);
   const bool touching = best < params_.contact_margin;
   if (touching && !touching_) ++contacts_;
   touching_ = touching;

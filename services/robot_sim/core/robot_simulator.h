@@ -13,6 +13,8 @@
 
 #include <Eigen/Core>
 
+#include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/ssm.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 
@@ -26,12 +28,6 @@ struct SimulatorParams {
 };
 
 /// A trajectory to follow: points at `times` (s after start_ns).
-struct Trajectory {
-  int64_t start_ns = 0;
-  std::vector<double> times;
-  std::vector<Eigen::VectorXd> positions;  ///< model joint order
-};
-
 class RobotSimulator {
  public:
   /// `q0`: initial configuration (model joint order). Throws
@@ -63,9 +59,11 @@ class RobotSimulator {
 
   const Eigen::VectorXd& q() const { return q_; }
   const Eigen::VectorXd& qd() const { return qd_; }
-  std::vector<std::string> joint_names() const;
+  /// The robot's joints in q order (what joint states and trajectories carry).
+  const std::vector<std::string>& joint_names() const { return robot_joints_; }
   int contacts() const { return contacts_; }
-  double min_separation_seen() const { return min_separation_seen_; }
+  /// Smallest separation UpdateContacts has seen (m); nullopt before the first.
+  const cell::Separation& min_separation_seen() const { return min_separation_seen_; }
   /// Max over the last stop of the end-effector (last sphere) travel after the stop command (m).
   double last_stopping_distance() const { return last_stopping_distance_; }
   const collision::RobotModel& robot() const { return robot_; }
@@ -78,14 +76,15 @@ class RobotSimulator {
   collision::RobotData data_;
   Eigen::VectorXd q_, qd_;
   Eigen::VectorXd lower_, upper_, vmax_, amax_;
-  std::optional<Trajectory> trajectory_;
+  std::vector<std::string> robot_joints_;  // robot_.JointNames()
+  cell::JointTrajectory trajectory_;      // empty: hold the current position
   bool stop_requested_ = false;
   Eigen::VectorXd stop_decel_;  // per joint deceleration of the current stop
   Eigen::Vector3d stop_start_ee_ = Eigen::Vector3d::Zero();
   double last_stopping_distance_ = 0;
   bool touching_ = false;
   int contacts_ = 0;
-  double min_separation_seen_ = 1e6;
+  cell::Separation min_separation_seen_;
 };
 
 }  // namespace iplan::robot_sim

@@ -70,9 +70,9 @@ TEST_F(RobotSimulatorTest, RefusesBadTrajectories) {
   Eigen::VectorXd far = Ready();
   far[0] = 5.0;
   EXPECT_EQ(*sim_.SetTrajectory(0, sim_.joint_names(), {0.0, 1.0}, Points(Ready(), far)),
-            "point 1 puts panda_joint1 outside its limits");
-  EXPECT_EQ(*sim_.SetTrajectory(0, {"a", "b"}, {0.0}, {{0.0, 0.0}}), "trajectory lacks joint 'panda_joint1'");
-  EXPECT_EQ(*sim_.SetTrajectory(0, sim_.joint_names(), {1.0, 1.0}, Points(Ready(), Ready())), "times do not increase");
+            "trajectory: point 1 puts panda_joint1 outside its limits");
+  EXPECT_EQ(*sim_.SetTrajectory(0, {"a", "b"}, {0.0}, {{0.0, 0.0}}), "trajectory: missing joint 'panda_joint1'");
+  EXPECT_EQ(*sim_.SetTrajectory(0, sim_.joint_names(), {1.0, 1.0}, Points(Ready(), Ready())), "trajectory: times do not increase");
 }
 
 TEST_F(RobotSimulatorTest, CountsEachTouchOnce) {
@@ -90,7 +90,8 @@ TEST_F(RobotSimulatorTest, CountsEachTouchOnce) {
   sim_.UpdateContacts(far, body);
   sim_.UpdateContacts(near, body);
   EXPECT_EQ(sim_.contacts(), 2);
-  EXPECT_LT(sim_.min_separation_seen(), 0.0);
+  ASSERT_TRUE(sim_.min_separation_seen());
+  EXPECT_LT(*sim_.min_separation_seen(), 0.0);
 }
 
 }  // namespace

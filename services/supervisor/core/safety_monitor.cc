@@ -26,8 +26,8 @@ void SafetyMonitor::OnLivelinessLost(const std::string& topic, int alive_writers
   if (causes_.count(topic) && alive_writers == 0) causes_[topic] = "publisher gone (liveliness lost)";
 }
 
-void SafetyMonitor::OnRiskVerdict(uint8_t verdict, const std::string& reason) {
-  risk_cause_ = verdict == 2 ? "collision risk: " + reason : "";
+void SafetyMonitor::OnRiskVerdict(cell::Verdict verdict, const std::string& reason) {
+  risk_cause_ = verdict == cell::Verdict::kProtectiveStop ? "collision risk: " + reason : "";
 }
 
 SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {

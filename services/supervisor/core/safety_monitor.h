@@ -16,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "iplan/cell/status.h"
+
 namespace iplan::supervisor {
 
 struct SafetyDecision {
@@ -34,8 +36,8 @@ class SafetyMonitor {
   void SetDeadline(const std::string& topic, double seconds);
   void OnDeadlineMissed(const std::string& topic);
   void OnLivelinessLost(const std::string& topic, int alive_writers);
-  /// verdict: 0 OK, 1 SLOW_DOWN, 2 PROTECTIVE_STOP (CollisionRisk constants).
-  void OnRiskVerdict(uint8_t verdict, const std::string& reason);
+  /// Collision risk's latest verdict; a protective stop is a cause.
+  void OnRiskVerdict(cell::Verdict verdict, const std::string& reason);
 
   /// The decision at `now_ns`; `changed` is set when it differs from the
   /// last call. After a stop, the cell resumes only once every cause has been

@@ -454,9 +454,9 @@ TEST(SafetyMonitor, StopsUntilEverythingIsSeenNamesCulpritsAndResumes) {
   m.OnData("rt/b");
   d = m.Evaluate(&changed);
   EXPECT_FALSE(d.stop);
-  m.OnRiskVerdict(2, "separation 0.3 m below 0.5 m");
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "separation 0.3 m below 0.5 m");
   EXPECT_EQ(m.Evaluate(&changed).reason, "collision risk: separation 0.3 m below 0.5 m");
-  m.OnRiskVerdict(1, "slow");
+  m.OnRiskVerdict(cell::Verdict::kSlowDown, "slow");
   EXPECT_FALSE(m.Evaluate(&changed).stop);
   m.Evaluate(&changed);
   EXPECT_FALSE(changed);
@@ -469,17 +469,17 @@ TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
   const int64_t s = 1'000'000'000;
   m.OnData("rt/a");
   EXPECT_FALSE(m.Evaluate(&changed, 10 * s).stop);  // a first start needs no delay
-  m.OnRiskVerdict(2, "too close");
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "too close");
   EXPECT_TRUE(m.Evaluate(&changed, 11 * s).stop);
   EXPECT_TRUE(changed);
-  m.OnRiskVerdict(0, "");
+  m.OnRiskVerdict(cell::Verdict::kOk, "");
   SafetyDecision d = m.Evaluate(&changed, 11 * s + s / 10);
   EXPECT_TRUE(d.stop);  // clear for 0 s
   EXPECT_FALSE(changed);
   EXPECT_EQ(d.reason, "collision risk: too close");
-  m.OnRiskVerdict(2, "too close again");  // chatter restarts the clock
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "too close again");  // chatter restarts the clock
   EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 3 * s / 10).stop);
-  m.OnRiskVerdict(0, "");
+  m.OnRiskVerdict(cell::Verdict::kOk, "");
   EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 4 * s / 10).stop);
   EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 8 * s / 10).stop);
   d = m.Evaluate(&changed, 11 * s + 9 * s / 10);

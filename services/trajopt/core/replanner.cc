@@ -22,28 +22,21 @@ std::string ReplannerParams::Validate() const {
 }
 
 Replanner::Replanner(const planning::Planner& planner, const collision::HumanBodyModel& body, ReplannerParams params)
-    : planner_(planner), body_(body), params_(params) {
+    : planner_(planner), body_(body), params_(params), robot_joints_(planner.robot().JointNames()) {
   if (const std::string why = params_.Validate(); !why.empty()) throw std::invalid_argument(why);
-}
-
-std::vector<std::string> Replanner::joint_names() const {
-  std::vector<std::string> names;
-  const auto& m = planner_.robot();
-  for (int j : m.q_joints) names.push_back(m.joints[static_cast<std::size_t>(j)].name);
-  return names;
 }
 
 std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                                        const std::vector<double>& q, const std::vector<double>& qd) {
-  const auto model = joint_names();
   if (names.size() != q.size()) return std::string("names and positions differ in size");
-  Eigen::VectorXd qq(static_cast<Eigen::Index>(model.size())), vv = Eigen::VectorXd::Zero(static_cast<Eigen::Index>(model.size()));
-  for (std::size_t m = 0; m < model.size(); ++m) {
-    const auto it = std::find(names.begin(), names.end(), model[m]);
-    if (it == names.end()) return "joint state lacks '" + model[m] + "'";
-    const std::size_t i = static_cast<std::size_t>(it - names.begin());
-    qq[static_cast<Eigen::Index>(m)] = q[i];
-    if (qd.size() == q.size()) vv[static_cast<Eigen::Index>(m)] = qd[i];
+  std::vector<int> idx;
+  if (auto e = cell::MapJointNames(names, robot_joints_, &idx)) return "joint state: " + *e;
+  const Eigen::Index nq = static_cast<Eigen::Index>(robot_joints_.size());
+  Eigen::VectorXd qq(nq), vv = Eigen::VectorXd::Zero(nq);
+  for (Eigen::Index m = 0; m < nq; ++m) {
+    const std::size_t i = static_cast<std::size_t>(idx[static_cast<std::size_t>(m)]);
+    qq[m] = q[i];
+    if (qd.size() == q.size()) vv[m] = qd[i];
   }
   // A state the arm cannot be in is a wrong or corrupted measurement;
   // planning from it would start every plan from a jump. Refused (and
@@ -57,12 +50,9 @@ std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const s
 }
 
 std::optional<std::string> Replanner::UpdatePrediction(const collision::JointMixture& in) {
-  collision::HumanPrediction p(1, 1, {0.1});
-  if (auto why = collision::BuildSpherePrediction(body_, in, &p)) return why;
+  cell::TimedPrediction p;
+  if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
   prediction_ = std::move(p);
-  prediction_meta_ = in;
-  prediction_meta_.means.clear();
-  prediction_meta_.covariances.clear();
   return std::nullopt;
 }
 
@@ -179,9 +169,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (previous_) {
     // Where the executing plan says the robot is at the state's stamp.
     const auto& [p_start, P] = *previous_;
-    const double s = std::clamp((q_->first - p_start) * 1e-9 / dt, 0.0, static_cast<double>(P.cols() - 1));
-    const int i = static_cast<int>(s), j = std::min(i + 1, static_cast<int>(P.cols()) - 1);
-    const Eigen::VectorXd expected = (1 - (s - i)) * P.col(i) + (s - i) * P.col(j);
+    const Eigen::VectorXd expected = cell::JointTrajectory::Uniform(p_start, dt, P).PositionAt(q_->first);
     if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
       previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
       r.status += "robot off the plan: replanning from its state; ";
@@ -202,13 +190,11 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     req.num_frozen = 1;
   }
   req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
-  const bool predicted = prediction_ && now_ns - prediction_meta_.t0_ns <= stale;
-  if (predicted) {
-    req.prediction = &*prediction_;
-    req.prediction_dt = prediction_meta_.time_step;
-    r.prediction_t0_ns = prediction_meta_.t0_ns;
-    // Step 0 of the prediction is at t0 + time_step.
-    req.prediction_start = (prediction_meta_.t0_ns - start_ns) * 1e-9 + prediction_meta_.time_step;
+  if (prediction_ && prediction_->FreshAt(now_ns, stale)) {
+    req.prediction = &prediction_->spheres();
+    req.prediction_dt = prediction_->time_step();
+    r.prediction_t0_ns = prediction_->t0_ns();
+    req.prediction_start = prediction_->StartRelativeTo(start_ns);
   }
 
   planning::PlanningResult res;

@@ -20,6 +20,9 @@
 
 #include <Eigen/Core>
 
+#include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/status.h"
+#include "iplan/cell/timed_prediction.h"
 #include "iplan/collision/joint_mixture.h"
 #include "iplan/planning/planner.h"
 
@@ -44,7 +47,7 @@ struct ReplannerParams {
   std::string Validate() const;
 };
 
-enum class TaskStatus { kSucceeded = 0, kFailed = 1, kCancelled = 2 };
+using cell::TaskStatus;
 
 struct TaskSpec {
   uint32_t id = 0;
@@ -114,7 +117,8 @@ class Replanner {
   /// One planning step at `now_ns`.
   CycleResult Cycle(int64_t now_ns);
 
-  std::vector<std::string> joint_names() const;
+  /// The robot's joints in q order (what trajectories carry).
+  const std::vector<std::string>& joint_names() const { return robot_joints_; }
 
  private:
   TaskOutcome Finish(TaskStatus status, const std::string& reason, int64_t now_ns);
@@ -126,8 +130,8 @@ class Replanner {
   std::optional<std::pair<int64_t, Eigen::VectorXd>> q_;
   Eigen::VectorXd qd_;
   bool robot_stopped_ = false;
-  std::optional<collision::HumanPrediction> prediction_;
-  collision::JointMixture prediction_meta_;
+  std::vector<std::string> robot_joints_;
+  std::optional<cell::TimedPrediction> prediction_;
   struct Active {
     TaskSpec spec;
     int64_t start_ns = 0;

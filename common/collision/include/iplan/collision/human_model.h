@@ -69,6 +69,14 @@ class HumanBodyModel {
   std::vector<double> Radii() const;
   std::vector<int> Segments() const;
 
+  /// Centre of sphere `sphere`, (1 - u) p_a + u p_b, from the joints'
+  /// positions (3 x num_joints, m, W); with joint velocities (m/s) instead
+  /// it gives the centre's velocity (the map is linear). Does not allocate.
+  Eigen::Vector3d SphereCentre(int sphere, const Eigen::Matrix3Xd& joints) const {
+    const SphereDef& d = spheres_[static_cast<std::size_t>(sphere)];
+    return (1 - d.u) * joints.col(d.joint_a) + d.u * joints.col(d.joint_b);
+  }
+
   /// Gaussian of sphere `sphere`'s centre from the joint Gaussians.
   /// joint_means: 3 x num_joints (m, W); joint_covs: num_joints matrices
   /// (m^2). Does not allocate.

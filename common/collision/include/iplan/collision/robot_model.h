@@ -85,6 +85,9 @@ struct RobotModel {
   /// search; not for hot loops).
   int FindLink(const std::string& name) const;
   int FindJoint(const std::string& name) const;
+  /// Joint names of the configuration variables, in q order (size nq):
+  /// the names joint states and trajectories carry. Allocates.
+  std::vector<std::string> JointNames() const;
   /// Lower/upper position limits of the configuration variables (size nq).
   Eigen::VectorXd LowerLimits() const;
   Eigen::VectorXd UpperLimits() const;

@@ -1,0 +1,53 @@
+// ISO/TS 15066 speed and separation monitoring (SSM), as named functions
+// with the standard's symbols (ISO/TS 15066:2016, clause 5.5.4):
+//
+//   S_p = S_h + S_r + S_s + C + Z_d + Z_r
+//   S_h = v_h (T_r + T_s)   the person's travel while the robot reacts and stops
+//   S_r = v_r T_r           the robot's travel while it reacts
+//   S_s                     the robot's stopping distance
+//   C                       intrusion distance (a body part reaching past the sensed edge)
+//   Z_d, Z_r                position uncertainty of the person (sensing) and of the robot
+//
+// v_h is the person's speed towards the robot, v_r the robot's speed towards
+// the person (m/s); T_r, T_s the robot's reaction and stopping times (s);
+// lengths in m. The robot must be stopped while the separation S (surface
+// distance between robot and person) is below S_p.
+#pragma once
+
+#include <optional>
+
+namespace iplan::cell {
+
+struct SsmParams {
+  bool directed = true;             ///< speeds towards each other per sphere pair; false: fastest joint / sphere, S_s always
+  bool measure_human_speed = true;  ///< from the skeleton; else v_h = default_human_speed
+  double default_human_speed = 1.6; ///< m/s, ISO value when the speed is not measured
+  /// Degraded mode: without a usable prediction the person's intent is
+  /// unknown, so v_h is default_human_speed even when the skeleton gives a
+  /// measured speed (the robot keeps working, more cautiously).
+  bool degrade_without_prediction = true;
+  double speed_window = 0.3;        ///< s, displacement window for the measured speed
+  double reaction_time = 0.1;       ///< s, T_r
+  double stopping_time = 0.3;       ///< s, T_s
+  double stopping_distance = 0.15;  ///< m, S_s (at stopping_speed when directed)
+  double stopping_speed = 1.0;      ///< m/s, robot speed at which stopping_distance was measured (directed only)
+  double intrusion_distance = 0.1;  ///< m, C
+  double sensing_uncertainty = 0.05;  ///< m, Z_d
+  double robot_uncertainty = 0.02;    ///< m, Z_r
+};
+
+/// S_s for a robot moving at v_r towards the person: with `directed`,
+/// stopping_distance * min(1, v_r / stopping_speed) (linear in the speed,
+/// above the v^2 of a constant deceleration below stopping_speed; a robot at
+/// rest or moving away travels nothing towards the person while it stops);
+/// otherwise stopping_distance whatever the speed.
+double StoppingDistance(const SsmParams& p, double v_r);
+
+/// S_p above for the person's speed v_h and the robot's speed v_r (m/s, >= 0).
+double ProtectiveSeparationDistance(const SsmParams& p, double v_h, double v_r);
+
+/// A robot-person separation (m): nullopt when no person is seen. Negative
+/// values are penetration depths.
+using Separation = std::optional<double>;
+
+}  // namespace iplan::cell
