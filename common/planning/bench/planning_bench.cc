@@ -210,7 +210,7 @@ int main(int argc, char** argv) {
       const PlanningResult r = planner.Plan(req, nopt, std::min(threads, nopt), 1000 + i);
       t_total.push_back(r.planning_time);
       Fingerprint(r, &fingerprint);
-      if (r.success) {
+      if (r.success()) {
         ++ok;
         if (r.planning_time <= 1.0) ++ok_1s;
         t_first.push_back(r.time_to_first_feasible);
@@ -270,7 +270,7 @@ int main(int argc, char** argv) {
         cycle.push_back(r.planning_time);
         Fingerprint(r, &fingerprint);
         total_waits += r.num_waits;
-        if (!r.success) {
+        if (!r.success()) {
           ++cycles_failed;
           task_ok = false;
           if (r.positions.cols() == 0) break;

@@ -62,7 +62,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
     const PlanningResult r = planner.Plan(req);
     if (o.json) {
       nlohmann::ordered_json j;
-      j["success"] = r.success;
+      j["success"] = r.success();
       j["planning_time_s"] = r.planning_time;
       j["max_collision_bound"] = r.max_bound;
       j["delay_s"] = r.delay;
@@ -78,7 +78,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
       j["trajectory"] = traj;
       out << j.dump() << "\n";
     } else {
-      out << "status: " << ToString(r.status) << (r.success ? "" : " (" + r.reason + ")") << "\n"
+      out << "status: " << ToString(r.status) << (r.success() ? "" : " (" + r.reason + ")") << "\n"
           << "planning time: " << r.planning_time << " s\n"
           << "waypoints: " << r.positions.cols() << " at dt " << r.dt << " s\n"
           << "waits: " << r.num_waits << ", delay " << r.delay << " s\n"
@@ -87,7 +87,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
           << "cost: " << r.cost << " (optimiser " << r.winning_optimizer << ", " << r.num_feasible
           << " feasible)\n";
     }
-    return r.success ? 0 : 1;
+    return r.success() ? 0 : 1;
   } catch (const std::exception& e) {
     err << "iplan plan: " << e.what() << "\n";
     return 2;

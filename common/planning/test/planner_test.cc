@@ -48,7 +48,7 @@ class PlannerTest : public ::testing::Test {
   }
 
   void ExpectValid(const PlanningResult& r, const Eigen::VectorXd& start) const {
-    ASSERT_TRUE(r.success) << r.reason;
+    ASSERT_TRUE(r.success()) << r.reason;
     ASSERT_EQ(r.positions.rows(), 7);
     EXPECT_EQ(r.positions.col(0), start);  // start state kept exactly
     EXPECT_EQ(CheckLimits(robot_, r.positions, r.dt, Eigen::VectorXd()), "");
@@ -90,7 +90,7 @@ TEST_F(PlannerTest, PoseGoalsBetweenTableTopPosesAreValid) {
       const PlanningResult r = planner_.Plan(req);
       SCOPED_TRACE(std::string(poses[a].name) + " -> " + poses[b].name);
       ExpectValid(r, req.start_q);
-      successes += r.success;
+      successes += r.success();
       // The goal configuration reaches the pose.
       collision::RobotData d(robot_);
       collision::CalcForwardKinematics(robot_, r.goal_q, &d);
@@ -113,12 +113,12 @@ TEST_F(PlannerTest, PersonAcrossThePathIsAvoidedOrWaitedFor) {
   req.goal = Goal::Joint(g.q);
   // Without the person, the straight path crosses the hand's region.
   const PlanningResult free_r = planner_.Plan(req);
-  ASSERT_TRUE(free_r.success);
+  ASSERT_TRUE(free_r.success());
   req.prediction = &pred;
   req.prediction_dt = 0.1;
   const PlanningResult r = planner_.Plan(req);
   const double thr = 1.0 - planner_.params().delta_cl;
-  if (r.success) {
+  if (r.success()) {
     ExpectValid(r, req.start_q);
     ASSERT_EQ(static_cast<int>(r.bounds.size()), r.positions.cols());
     for (std::size_t i = 0; i < r.bounds.size(); ++i) EXPECT_LT(r.bounds[i], thr) << "waypoint " << i;
@@ -144,7 +144,7 @@ TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
   req.goal = Goal::Joint(g.q);
   req.prediction = &pred;
   const PlanningResult r = planner_.Plan(req);
-  EXPECT_FALSE(r.success);
+  EXPECT_FALSE(r.success());
   EXPECT_EQ(r.status, PlanStatus::kNoSafeTrajectory) << r.reason;
   EXPECT_EQ(r.num_waits, planner_.params().max_waits);
   EXPECT_NEAR(r.delay, r.num_waits * 0.5, 1e-12);
@@ -205,8 +205,8 @@ TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
   EXPECT_TRUE(a.positions == c.positions);
   EXPECT_EQ(a.cost, b.cost);
   EXPECT_EQ(a.winning_optimizer, c.winning_optimizer);
-  if (a.success) ExpectValid(a, req.start_q);
-  if (b.success) ExpectValid(b, req.start_q);
+  if (a.success()) ExpectValid(a, req.start_q);
+  if (b.success()) ExpectValid(b, req.start_q);
   // A different seed perturbs optimisers 1..N-1 differently.
   const PlanningResult d = planner_.Plan(req, 6, 2, 43);
   if (d.winning_optimizer != 0 || a.winning_optimizer != 0) {
@@ -231,7 +231,7 @@ TEST_F(PlannerTest, EarlyStopIsBitIdenticalForAnyThreadCountAndValid) {
   req.goal = Goal::Joint(g.q);
   req.prediction = &pred;
   const PlanningResult a = planner.Plan(req, 6, 1, 42);
-  ASSERT_TRUE(a.success) << a.reason;
+  ASSERT_TRUE(a.success()) << a.reason;
   ExpectValid(a, req.start_q);
   for (double b : a.bounds) EXPECT_LT(b, 1.0 - p.delta_cl);
   for (int threads : {2, 3, 6}) {
@@ -258,7 +258,7 @@ TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
   req.prediction = &pred;
   const PlanningResult a = planner.Plan(req, 4, 2, 42);
   const PlanningResult b = planner_.Plan(req, 4, 2, 42);
-  ASSERT_FALSE(a.success);
+  ASSERT_FALSE(a.success());
   EXPECT_EQ(a.status, PlanStatus::kNoSafeTrajectory);
   EXPECT_TRUE(a.positions == b.positions);
   EXPECT_EQ(a.cost, b.cost);
@@ -280,7 +280,7 @@ TEST_F(PlannerTest, WarmStartKeepsTheFrozenPrefixAndStartVelocity) {
   goal << 0.8, 0.2, 0.0, -1.8, 0.0, 2.0, 0.8;
   req.goal = Goal::Joint(goal);
   const PlanningResult first = planner_.Plan(req);
-  ASSERT_TRUE(first.success);
+  ASSERT_TRUE(first.success());
   // Replanning 0.1 s later: the robot is at waypoint 1, moving.
   PlanningRequest next;
   next.warm_start = Planner::ShiftTrajectory(first.positions, first.dt, 0.1);
@@ -289,7 +289,7 @@ TEST_F(PlannerTest, WarmStartKeepsTheFrozenPrefixAndStartVelocity) {
   next.num_frozen = 3;
   next.goal = req.goal;
   const PlanningResult r = planner_.Plan(next);
-  ASSERT_TRUE(r.success) << r.reason;
+  ASSERT_TRUE(r.success()) << r.reason;
   for (int i = 0; i < 3; ++i) EXPECT_EQ(r.positions.col(i), first.positions.col(i + 1));
   EXPECT_EQ(CheckLimits(robot_, r.positions, r.dt, next.start_qdot), "");
   EXPECT_GE(FclClearance(r.positions), -1e-9);
@@ -316,7 +316,7 @@ TEST_F(PlannerTest, MotionLongerThanTheHorizonAllowsGetsTheTimeItNeeds) {
   req.start_q = Ready();
   req.start_q[0] = 0.3;
   const PlanningResult s = short_horizon.Plan(req);
-  ASSERT_TRUE(s.success) << s.reason;
+  ASSERT_TRUE(s.success()) << s.reason;
   EXPECT_EQ(s.positions.cols(), 16);
 
   // Replanning from a warm start that is too short for the rest of the
@@ -337,7 +337,7 @@ TEST_F(PlannerTest, UnreachablePoseIsReportedAsIkFailure) {
   req.start_q = Ready();
   req.goal = Goal::Pose({1.5, 0.0, 0.4}, DownOrientation(0.0));
   const PlanningResult r = planner_.Plan(req);
-  EXPECT_FALSE(r.success);
+  EXPECT_FALSE(r.success());
   EXPECT_EQ(r.status, PlanStatus::kIkFailed);
   EXPECT_NE(r.reason.find("no IK solution"), std::string::npos);
 }

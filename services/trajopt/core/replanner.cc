@@ -217,7 +217,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   r.start_ns = start_ns;
   r.dt = dt;
   const std::string prefix = r.status;
-  if (res.success) {
+  if (res.success()) {
     r.positions = res.positions;
     t.max_bound = std::max(t.max_bound, res.max_bound);
     r.max_bound = res.max_bound;

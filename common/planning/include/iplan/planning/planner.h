@@ -5,7 +5,8 @@
 //
 // Trajectory: waypoints q_0 .. q_n (columns of an nq x (n+1) matrix, rad) at
 // t_i = i dt (relative to waypoint 0). Discrete derivatives used everywhere
-// (optimiser, feasibility check, tests):
+// (optimiser, feasibility check, tests) are iplan/cell/joint_trajectory.h's
+// FiniteDifference*:
 //   v_i = (q_{i+1} - q_i) / dt,                  i = 0 .. n-1
 //   a_i = (q_{i+1} - 2 q_i + q_{i-1}) / dt^2,     i = 0 .. n,
 // with the virtual waypoints q_{-1} = q_0 - qdot_0 dt (start velocity) and
@@ -28,6 +29,9 @@
 // i.e. the step nearest to t_i. Waypoints before the prediction's first step
 // use step 0, waypoints beyond its last step use the last step (the person is
 // assumed to stay where last predicted, rather than to vanish).
+//
+// The pieces (problem, cost terms, optimiser, multi-start, waits) are
+// internal: common/planning/src/planner_model.h maps them to their files.
 #pragma once
 
 #include <limits>
@@ -90,8 +94,9 @@ const char* ToString(PlanStatus status);
 
 struct PlanningResult {
   PlanStatus status = PlanStatus::kInfeasible;
-  bool success = false;
-  std::string reason;            ///< human-readable explanation when !success
+  /// Feasible and safe (kSuccess or kSuccessAfterWait).
+  bool success() const { return status == PlanStatus::kSuccess || status == PlanStatus::kSuccessAfterWait; }
+  std::string reason;            ///< human-readable explanation when !success()
   double dt = 0.0;               ///< s
   /// nq x (n+1) waypoints (rad): the winner, or on failure the best attempt
   /// (lowest cost; may violate constraints, see `reason`). Empty on IK failure.
@@ -160,6 +165,9 @@ class Planner {
                                          double elapsed);
 
  private:
+  bool ResolveGoal(const PlanningRequest& req, std::uint64_t seed, Eigen::VectorXd* q_goal,
+                   PlanningResult* result) const;
+
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };

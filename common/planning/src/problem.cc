@@ -1,0 +1,238 @@
+// The problem of one planning attempt (METHOD.md section 5): the request's
+// checks, the horizon and initial trajectory, the smoothness metric, the
+// prediction step of each waypoint, and exact bounds of fixed waypoints.
+#include <algorithm>
+#include <cmath>
+#include <stdexcept>
+
+#include <Eigen/Cholesky>
+
+#include "iplan/cell/joint_trajectory.h"
+#include "planner_model.h"
+
+namespace iplan::planning::internal {
+namespace {
+
+[[noreturn]] void Bad(const std::string& what) { throw std::invalid_argument("Plan: " + what); }
+
+}  // namespace
+
+void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizers, int num_threads) const {
+  const int nq = robot.nq;
+  if (num_optimizers < 1) Bad("num_optimizers must be >= 1, got " + std::to_string(num_optimizers));
+  if (num_threads < 0) Bad("num_threads must be >= 0, got " + std::to_string(num_threads));
+  if (req.start_q.size() != nq)
+    Bad("start has " + std::to_string(req.start_q.size()) + " joint values, the robot has " + std::to_string(nq));
+  if (!req.start_q.allFinite()) Bad("start is not finite: " + VectorText(req.start_q));
+  const double tol = 1e-9;
+  for (int j = 0; j < nq; ++j)
+    if (req.start_q[j] < lower[j] - tol || req.start_q[j] > upper[j] + tol)
+      Bad("start joint " + std::to_string(j) + " = " + std::to_string(req.start_q[j]) + " is outside [" +
+          std::to_string(lower[j]) + ", " + std::to_string(upper[j]) + "]");
+  if (req.start_qdot.size() != 0 && (req.start_qdot.size() != nq || !req.start_qdot.allFinite()))
+    Bad("start velocity must have " + std::to_string(nq) + " finite values, got " + VectorText(req.start_qdot));
+  if (req.num_frozen < 1) Bad("num_frozen must be >= 1, got " + std::to_string(req.num_frozen));
+  if (req.warm_start.size() != 0) {
+    if (req.warm_start.rows() != nq || !req.warm_start.allFinite())
+      Bad("warm_start must be " + std::to_string(nq) + " x m and finite");
+    if ((req.warm_start.col(0) - req.start_q).cwiseAbs().maxCoeff() > 1e-9)
+      Bad("warm_start column 0 must equal the start " + VectorText(req.start_q) + ", got " +
+          VectorText(req.warm_start.col(0)));
+  }
+  if (req.num_frozen > 1 && req.warm_start.cols() < req.num_frozen)
+    Bad("num_frozen = " + std::to_string(req.num_frozen) + " needs a warm_start with as many columns");
+  if (req.prediction) {
+    if (!(req.prediction_dt > 0.0) || !std::isfinite(req.prediction_dt))
+      Bad("prediction_dt must be > 0, got " + std::to_string(req.prediction_dt));
+    if (!std::isfinite(req.prediction_start))
+      Bad("prediction_start must be finite, got " + std::to_string(req.prediction_start));
+  }
+  if (req.goal.kind == Goal::Kind::kJoint) {
+    if (req.goal.q.size() != nq)
+      Bad("goal has " + std::to_string(req.goal.q.size()) + " joint values, the robot has " + std::to_string(nq));
+    if (!req.goal.q.allFinite()) Bad("goal is not finite: " + VectorText(req.goal.q));
+    for (int j = 0; j < nq; ++j)
+      if (req.goal.q[j] < lower[j] || req.goal.q[j] > upper[j])
+        Bad("goal joint " + std::to_string(j) + " = " + std::to_string(req.goal.q[j]) + " is outside [" +
+            std::to_string(lower[j]) + ", " + std::to_string(upper[j]) + "]");
+  }
+}
+
+Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::VectorXd& q_goal) const {
+  const int nq = robot.nq;
+  const PlannerParams& P = params;
+  Problem at;
+  at.nq = nq;
+  at.dt = P.dt;
+  const int horizon_n = std::max(2, static_cast<int>(std::lround(P.horizon / P.dt)));
+  at.n = horizon_n;
+  // A warm start longer than the horizon (it contains earlier waits) keeps
+  // its length, up to twice the horizon, so its remaining motion is not cut.
+  if (req.warm_start.cols() - 1 > at.n) at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
+  // A motion longer than the horizon allows within the velocity limits gets
+  // the time it needs after the frozen prefix, up to twice the horizon, and a
+  // straight line to the goal as its start; otherwise every attempt would
+  // break a velocity limit and the robot would never leave (measured on the
+  // Panda: 2.1 rad of joint 1 plans in a 1.5 s horizon, 2.8 rad does not).
+  const bool warm = req.warm_start.cols() > 1;
+  const int keep = warm ? req.num_frozen : 1;
+  const Eigen::VectorXd from = warm ? Eigen::VectorXd(req.warm_start.col(keep - 1)) : req.start_q;
+  double t_min = 0.0;
+  for (int j = 0; j < nq; ++j) t_min = std::max(t_min, std::abs(q_goal[j] - from[j]) / vmax[j]);
+  const int need = (keep - 1) + static_cast<int>(std::ceil(kRestToRestPeakFactor * t_min / P.dt));
+  const bool stretched = need > at.n;
+  if (stretched) at.n = std::min(need, 2 * horizon_n);
+  at.k = req.num_frozen;
+  if (at.k >= at.n)
+    Bad("num_frozen = " + std::to_string(at.k) + " leaves no free waypoint in a horizon of " +
+        std::to_string(at.n) + " intervals");
+  at.qdot0 = req.start_qdot.size() != 0 ? req.start_qdot : Eigen::VectorXd::Zero(nq);
+  at.q_goal = q_goal;
+  at.prediction = req.prediction;
+  at.prediction_dt = req.prediction_dt;
+  at.prediction_start = req.prediction_start;
+  at.base.resize(nq, at.n + 1);
+  if (warm && stretched) {
+    // The frozen prefix, then straight to the goal over the stretched time.
+    const int steps = at.n - (keep - 1);
+    for (int i = 0; i < keep; ++i) at.base.col(i) = req.warm_start.col(i);
+    for (int i = 1; i <= steps; ++i) {
+      const double s = static_cast<double>(i) / steps;
+      at.base.col(keep - 1 + i) = (1.0 - s) * from + s * q_goal;
+    }
+  } else if (warm) {
+    for (int i = 0; i <= at.n; ++i)
+      at.base.col(i) = req.warm_start.col(std::min<Eigen::Index>(i, req.warm_start.cols() - 1));
+  } else {
+    at.base.col(0) = req.start_q;
+    for (int i = 1; i <= at.n; ++i) {
+      const double s = static_cast<double>(i) / at.n;
+      at.base.col(i) = (1.0 - s) * req.start_q + s * q_goal;
+    }
+  }
+  at.base.col(0) = req.start_q;
+  at.base.col(at.n) = q_goal;
+  return at;
+}
+
+void PlannerModel::PrepareAttempt(Problem* at, bool smooth_base) const {
+  at->m = at->n - at->k;
+  BuildSmoothness(at);
+  SetSteps(at);
+  if (smooth_base) {
+    // Smoothest trajectory through the frozen prefix and goal: one Newton
+    // step on the (quadratic) smoothness from the interpolated base.
+    Eigen::MatrixXd A;
+    cell::FiniteDifferenceAccelerations(at->base, at->qdot0, at->dt, &A);
+    Eigen::MatrixXd G = Eigen::MatrixXd::Zero(at->nq, at->m);
+    for (int j = at->k; j < at->n; ++j)
+      G.col(j - at->k) = (2.0 / at->dt) * (A.col(j - 1) - 2.0 * A.col(j) + A.col(j + 1));
+    at->base.middleCols(at->k, at->m) -= G * at->Hinv;
+    Project(*at, &at->base);
+  }
+  FixBounds(at);
+}
+
+void PlannerModel::BuildSmoothness(Problem* at) const {
+  const int m = at->m;
+  // K: rows a_{k-1}..a_n, columns free waypoints k..n-1 (second differences).
+  Eigen::MatrixXd H = Eigen::MatrixXd::Zero(m, m);
+  for (int i = at->k - 1; i <= at->n; ++i) {
+    // coefficients of q_{i-1}, q_i, q_{i+1} in dt^2 a_i
+    const int idx[3] = {i - 1, i, i + 1};
+    const double cf[3] = {1.0, -2.0, 1.0};
+    for (int a = 0; a < 3; ++a) {
+      const int fa = idx[a] - at->k;
+      if (fa < 0 || fa >= m) continue;
+      for (int b = 0; b < 3; ++b) {
+        const int fb = idx[b] - at->k;
+        if (fb < 0 || fb >= m) continue;
+        H(fa, fb) += cf[a] * cf[b];
+      }
+    }
+  }
+  H *= 2.0 / (at->dt * at->dt * at->dt);
+  at->Hinv = H.llt().solve(Eigen::MatrixXd::Identity(m, m));
+}
+
+void PlannerModel::SetSteps(Problem* at) const {
+  at->steps.assign(at->n + 1, 0);
+  if (!at->prediction) return;
+  const int last = at->prediction->num_steps() - 1;
+  for (int i = 0; i <= at->n; ++i) {
+    const double s = std::round((i * at->dt - at->prediction_start) / at->prediction_dt);
+    at->steps[i] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(last)));
+  }
+}
+
+void PlannerModel::PrepareWorkspace(const Problem& at, Workspace* ws) const {
+  const int W = at.n + 1;
+  while (static_cast<int>(ws->data.size()) < W) ws->data.emplace_back(robot);
+  if (at.prediction == nullptr) return;
+  // Only the free waypoints k..n-1 are evaluated: the others never change
+  // (FixBounds).
+  ws->sub.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
+  ws->sub.steps.reserve(at.n - at.k);
+  ws->sub.radii.reserve(radii.size());
+  ws->sub.links.reserve(radii.size());
+  ws->sub_spheres.reserve(radii.size());
+  ws->active.reserve(at.n - at.k);
+  ws->active_bounds.reserve(at.n - at.k);
+  if (!ws->bound_ws)
+    ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(static_cast<int>(radii.size()),
+                                                                         at.prediction->num_spheres());
+  const int H = at.prediction->num_spheres();
+  ws->group_log_volume.resize(link_groups.size() * H);
+  for (std::size_t g = 0; g < link_groups.size(); ++g) {
+    double r = 0.0;
+    for (int sp : link_groups[g]) r = std::max(r, radii[sp]);
+    for (int l = 0; l < H; ++l)
+      ws->group_log_volume[g * H + l] = std::log(collision::BallVolume(r + at.prediction->radius(l)));
+  }
+}
+
+void PlannerModel::ExactBounds(const Problem& at, const Eigen::MatrixXd& Q, int from, int to,
+                               std::vector<double>* out) const {
+  const int S = static_cast<int>(radii.size());
+  collision::RobotSpheresTrajectory rs;
+  rs.radii = radii;
+  rs.links = links;
+  rs.centres.resize(3, static_cast<Eigen::Index>(to - from + 1) * S);
+  collision::RobotData d(robot);
+  for (int i = from; i <= to; ++i) {
+    collision::CalcForwardKinematics(robot, Q.col(i), &d);
+    rs.centres.middleCols(static_cast<Eigen::Index>(i - from) * S, S) = d.p_WS;
+    rs.steps.push_back(at.steps[i]);
+  }
+  collision::TrajectoryBoundWorkspace bw(S, at.prediction->num_spheres());
+  std::vector<collision::WaypointBound> wb;
+  collision::EvaluateTrajectoryBound(*at.prediction, rs, collision::TrajectoryBoundParams{}, &bw, &wb);
+  for (int i = from; i <= to; ++i) (*out)[i] = wb[i - from].bound;
+}
+
+void PlannerModel::FixBounds(Problem* at) const {
+  at->fixed_bounds.assign(at->n + 1, 0.0);
+  if (!at->prediction) return;
+  ExactBounds(*at, at->base, 0, at->k - 1, &at->fixed_bounds);
+  ExactBounds(*at, at->base, at->n, at->n, &at->fixed_bounds);
+}
+
+double PlannerModel::HumanSeparation(const Problem& at, const Eigen::MatrixXd& Q, int from, int to) const {
+  double best = std::numeric_limits<double>::infinity();
+  const collision::HumanPrediction& hp = *at.prediction;
+  collision::RobotData d(robot);
+  for (int i = from; i <= to; ++i) {
+    collision::CalcForwardKinematics(robot, Q.col(i), &d);
+    for (int a = 0; a < hp.num_actions(); ++a) {
+      if (hp.action_probability(a) < kSeparationMinProbability) continue;
+      for (int l = 0; l < hp.num_spheres(); ++l) {
+        const Eigen::Vector3d& mu = hp.sphere(a, at.steps[i], l).mean;
+        for (int s = 0; s < static_cast<int>(radii.size()); ++s)
+          best = std::min(best, (d.p_WS.col(s) - mu).norm() - radii[s] - hp.radius(l));
+      }
+    }
+  }
+  return best;
+}
+
+}  // namespace iplan::planning::internal
