@@ -229,6 +229,101 @@ class OracleSource {
   Eigen::Matrix3Xd p_WJ_;
 };
 
+// A recorded person seated across the table: shoulders from above its far
+// edge (x = 1.05 m) to 0.2 m behind it, at the synthetic person's shoulder
+// height; the recorded hands work 0.1-0.5 m in front of them.
+void DrawRecordedPerson(const std::vector<std::string>& subjects,
+                        const std::map<std::string, std::vector<const intent::SkeletonSequence*>>& by_subject,
+                        int recorded, Draws* d, ScenarioSpec* s) {
+  s->source = "recorded";
+  s->subject = subjects[static_cast<std::size_t>(recorded) % subjects.size()];
+  const auto& list = by_subject.at(s->subject);
+  const intent::SkeletonSequence& seq = *list[static_cast<std::size_t>(d->Index(list.size()))];
+  s->sequence = seq.id;
+  s->placement_W = {d->Uniform(1.05, 1.25), d->Uniform(-0.3, 0.3), 0.5};
+  s->yaw = d->Uniform(-0.3, 0.3);
+  const double length = seq.time.size() > 0 ? seq.time(seq.time.size() - 1) - seq.time(0) : 0.0;
+  s->clip_start = d->Uniform(0.0, std::max(0.0, length - 12.0));
+  s->delay = d->Uniform(0.0, 2.0);
+}
+
+// The synthetic person near its configured place, from well into its
+// script (assembling) to not yet started (idle).
+void DrawSyntheticPerson(const perception::SyntheticPersonParams& person, const std::string& script, Draws* d,
+                         ScenarioSpec* s) {
+  s->source = "synthetic";
+  s->subject = "synthetic";
+  s->sequence = script.empty() ? person.actions.front().name : script;
+  s->placement_W = person.torso_W + Eigen::Vector3d(d->Uniform(-0.15, 0.05), d->Uniform(-0.2, 0.2), 0.0);
+  s->yaw = d->Uniform(-0.2, 0.2);
+  s->delay = d->Uniform(-9.0, 2.0);
+}
+
+// A task of the graph, started from a pose far from its goal and retreat.
+void DrawGraphTask(const std::vector<GraphTask>& tasks, const std::vector<NamedPose>& poses, Draws* d,
+                   ScenarioSpec* s) {
+  const GraphTask& t = tasks[static_cast<std::size_t>(d->Index(tasks.size()))];
+  s->task = t.name;
+  s->goal_q = t.goal;
+  s->retreat_q = t.retreat;
+  std::vector<const NamedPose*> starts;
+  for (const auto& p : poses) {
+    const bool far_from = (p.q - t.goal).cwiseAbs().maxCoeff() > 0.3 &&
+                          (t.retreat.size() == 0 || (p.q - t.retreat).cwiseAbs().maxCoeff() > 0.3);
+    if (far_from) starts.push_back(&p);
+  }
+  if (starts.empty()) starts.push_back(&poses.front());
+  const NamedPose& start = *starts[static_cast<std::size_t>(d->Index(starts.size()))];
+  s->start = start.name;
+  s->start_q = start.q;
+}
+
+// A reach: a flange pose over the table in front of the robot, towards the
+// person, reachable and clear of the scene, keeping the home orientation
+// turned about the vertical.
+void DrawReach(const planning::Planner& planner, const std::vector<NamedPose>& poses, const Eigen::VectorXd& home,
+               const Eigen::Matrix3d& R_home, Draws* d, ScenarioSpec* s) {
+  s->task = "reach";
+  const NamedPose& start = poses[static_cast<std::size_t>(d->Index(poses.size()))];
+  s->start = start.name;
+  s->start_q = start.q;
+  for (int attempt = 0; attempt < 100; ++attempt) {
+    const Eigen::Vector3d p(d->Uniform(0.40, 0.70), d->Uniform(-0.35, 0.35), d->Uniform(0.28, 0.40));
+    const Eigen::Matrix3d R = Eigen::AngleAxisd(d->Uniform(-0.5, 0.5), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_home;
+    const planning::IkResult ik = planner.SolveIk(p, Eigen::Quaterniond(R), home, d->Next());
+    if (!ik.success) continue;
+    if (planner.CalcClearance(ik.q) < planner.params().min_clearance + 0.02) continue;
+    if ((ik.q - s->start_q).cwiseAbs().maxCoeff() < 0.3) continue;
+    s->goal_q = ik.q;
+    s->reach_p_WE = p;
+    return;
+  }
+  throw std::runtime_error("scenario " + std::to_string(s->index) + ": no reachable table-top pose found");
+}
+
+// The person of a scenario as the sensor sees it and as it truly moves.
+PersonStream MakePersonStream(const BenchmarkSetup& setup, const ScenarioSpec& spec, double duration) {
+  const std::vector<std::string>& body_joints = setup.models.body->params().joints;
+  if (spec.source == "recorded") {
+    RecordedPlacement place;
+    place.shoulder_centre_W = spec.placement_W;
+    place.yaw = spec.yaw;
+    place.clip_start = spec.clip_start;
+    place.delay = spec.delay;
+    return RecordedPersonStream(*setup.recordings, setup.recordings_file, spec.sequence, setup.joint_map, place,
+                                body_joints, setup.sensor_rate_hz, duration, setup.sensor_noise_std, spec.seed);
+  }
+  if (spec.source == "synthetic") {
+    SyntheticPlacement place;
+    place.torso_offset_W = spec.placement_W - setup.person.torso_W;
+    place.yaw = spec.yaw;
+    place.script_start = spec.delay;
+    return SyntheticPersonStream(setup.person, place, body_joints, setup.sensor_rate_hz, duration,
+                                 setup.sensor_noise_std, spec.seed);
+  }
+  throw std::invalid_argument("scenario " + std::to_string(spec.index) + ": unknown source '" + spec.source + "'");
+}
+
 }  // namespace
 
 const char* ToString(Predictor p) {
@@ -325,66 +420,15 @@ std::vector<ScenarioSpec> MakeScenarios(const BenchmarkSetup& setup, int count, 
     s.seed = d.Next();
     const bool graph_task = i % 2 == 0;
     const bool from_recording = (i / 2) % 2 == 0;
-
     if (from_recording) {
-      s.source = "recorded";
-      s.subject = subjects[static_cast<std::size_t>(recorded++) % subjects.size()];
-      const auto& list = by_subject[s.subject];
-      const intent::SkeletonSequence& seq = *list[static_cast<std::size_t>(d.Index(list.size()))];
-      s.sequence = seq.id;
-      // Seated across the table: shoulders from above its far edge (x =
-      // 1.05 m) to 0.2 m behind it, at the synthetic person's shoulder
-      // height; the recorded hands work 0.1-0.5 m in front of them.
-      s.placement_W = {d.Uniform(1.05, 1.25), d.Uniform(-0.3, 0.3), 0.5};
-      s.yaw = d.Uniform(-0.3, 0.3);
-      const double length = seq.time.size() > 0 ? seq.time(seq.time.size() - 1) - seq.time(0) : 0.0;
-      s.clip_start = d.Uniform(0.0, std::max(0.0, length - 12.0));
-      s.delay = d.Uniform(0.0, 2.0);
+      DrawRecordedPerson(subjects, by_subject, recorded++, &d, &s);
     } else {
-      s.source = "synthetic";
-      s.subject = "synthetic";
-      s.sequence = script.empty() ? setup.person.actions.front().name : script;
-      s.placement_W = setup.person.torso_W + Eigen::Vector3d(d.Uniform(-0.15, 0.05), d.Uniform(-0.2, 0.2), 0.0);
-      s.yaw = d.Uniform(-0.2, 0.2);
-      // From well into the script (assembling) to not yet started (idle).
-      s.delay = d.Uniform(-9.0, 2.0);
+      DrawSyntheticPerson(setup.person, script, &d, &s);
     }
-
     if (graph_task) {
-      const GraphTask& t = setup.tasks[static_cast<std::size_t>(d.Index(setup.tasks.size()))];
-      s.task = t.name;
-      s.goal_q = t.goal;
-      s.retreat_q = t.retreat;
-      std::vector<const NamedPose*> starts;
-      for (const auto& p : poses) {
-        const bool far_from = (p.q - t.goal).cwiseAbs().maxCoeff() > 0.3 &&
-                              (t.retreat.size() == 0 || (p.q - t.retreat).cwiseAbs().maxCoeff() > 0.3);
-        if (far_from) starts.push_back(&p);
-      }
-      if (starts.empty()) starts.push_back(&poses.front());
-      const NamedPose& start = *starts[static_cast<std::size_t>(d.Index(starts.size()))];
-      s.start = start.name;
-      s.start_q = start.q;
+      DrawGraphTask(setup.tasks, poses, &d, &s);
     } else {
-      s.task = "reach";
-      const NamedPose& start = poses[static_cast<std::size_t>(d.Index(poses.size()))];
-      s.start = start.name;
-      s.start_q = start.q;
-      // A flange pose over the table in front of the robot, towards the
-      // person, reachable and clear of the scene.
-      bool found = false;
-      for (int attempt = 0; attempt < 100 && !found; ++attempt) {
-        const Eigen::Vector3d p(d.Uniform(0.40, 0.70), d.Uniform(-0.35, 0.35), d.Uniform(0.28, 0.40));
-        const Eigen::Matrix3d R = Eigen::AngleAxisd(d.Uniform(-0.5, 0.5), Eigen::Vector3d::UnitZ()).toRotationMatrix() * R_home;
-        const planning::IkResult ik = planner.SolveIk(p, Eigen::Quaterniond(R), home, d.Next());
-        if (!ik.success) continue;
-        if (planner.CalcClearance(ik.q) < planner.params().min_clearance + 0.02) continue;
-        if ((ik.q - s.start_q).cwiseAbs().maxCoeff() < 0.3) continue;
-        s.goal_q = ik.q;
-        s.reach_p_WE = p;
-        found = true;
-      }
-      if (!found) throw std::runtime_error("scenario " + std::to_string(i) + ": no reachable table-top pose found");
+      DrawReach(planner, poses, home, R_home, &d, &s);
     }
     out.push_back(std::move(s));
   }
@@ -398,25 +442,7 @@ std::vector<InteractionResult> RunScenario(const BenchmarkSetup& setup, const Sc
   const std::vector<std::string>& body_joints = setup.models.body->params().joints;
   // Long enough for the longest run and the oracle's look-ahead past it.
   const double duration = setup.loop.task_start + setup.loop.max_duration + model.config.horizon / model.config.rate + 1.0;
-  PersonStream person;
-  if (spec.source == "recorded") {
-    RecordedPlacement place;
-    place.shoulder_centre_W = spec.placement_W;
-    place.yaw = spec.yaw;
-    place.clip_start = spec.clip_start;
-    place.delay = spec.delay;
-    person = RecordedPersonStream(*setup.recordings, setup.recordings_file, spec.sequence, setup.joint_map, place,
-                                  body_joints, setup.sensor_rate_hz, duration, setup.sensor_noise_std, spec.seed);
-  } else if (spec.source == "synthetic") {
-    SyntheticPlacement place;
-    place.torso_offset_W = spec.placement_W - setup.person.torso_W;
-    place.yaw = spec.yaw;
-    place.script_start = spec.delay;
-    person = SyntheticPersonStream(setup.person, place, body_joints, setup.sensor_rate_hz, duration,
-                                   setup.sensor_noise_std, spec.seed);
-  } else {
-    throw std::invalid_argument("scenario " + std::to_string(spec.index) + ": unknown source '" + spec.source + "'");
-  }
+  const PersonStream person = MakePersonStream(setup, spec, duration);
 
   ModelTrack track(setup, person);
   const PredictionSource model_source = [&track](int f) { return track.At(f); };

@@ -102,6 +102,227 @@ std::string LoopParams::Validate() const {
   return "";
 }
 
+namespace {
+
+// One run of the loop: the cores, the event clocks and the result so far.
+// Events are taken in time order; at equal times control, then the
+// person's frame, then the monitor, then planning.
+class Interaction {
+ public:
+  Interaction(const CellModels& models, const LoopParams& params, const TaskSetup& setup, const PersonStream& person,
+              const PredictionSource& planner_prediction, const PredictionSource& monitor_prediction,
+              const CovarianceSource& true_covariance)
+      : params_(params),
+        setup_(setup),
+        person_(person),
+        planner_prediction_(planner_prediction),
+        monitor_prediction_(monitor_prediction),
+        true_covariance_(true_covariance),
+        body_(*models.body),
+        robot_(models.planner->robot(), setup.start_q, models.simulator),
+        replanner_(*models.planner, body_, models.replanner),
+        monitor_(*models.monitor),
+        supervisor_({}),
+        true_bound_(models.planner->robot(), body_),
+        robot_joints_(robot_.joint_names()),
+        isotropic_(person.joint_names.size(), params.true_bound_std * params.true_bound_std * Eigen::Matrix3d::Identity()),
+        control_period_(Ns(1.0 / params.control_rate_hz)),
+        state_every_(std::max(1, static_cast<int>(std::lround(params.control_rate_hz / params.joint_state_rate_hz)))),
+        plan_period_(Ns(models.replanner.planning_step)),
+        monitor_period_(Ns(1.0 / params.monitor_rate_hz)),
+        task_start_((Ns(params.task_start) + plan_period_ - 1) / plan_period_ * plan_period_),
+        end_(task_start_ + Ns(params.max_duration)),
+        skeleton_(person.joint_names.size()) {
+    supervisor_.SetResumeDelay(params.resume_delay);
+  }
+
+  InteractionResult Run() {
+    while (true) {
+      const int64_t t = std::min({next_control_, FrameTime(frame_), next_monitor_, next_plan_});
+      if (t >= end_) {
+        finish_ = end_;
+        result_.reason = "no outcome within " + std::to_string(params_.max_duration) + " s";
+        result_.task_time = params_.max_duration;
+        break;
+      }
+      if (t == next_control_) {
+        Control(t);
+      } else if (t == FrameTime(frame_)) {
+        Frame(t);
+      } else if (t == next_monitor_) {
+        // Between predictions the monitor keeps watching at its own rate.
+        if (t - last_evaluation_ >= monitor_period_ * 9 / 10) Evaluate(t);
+        next_monitor_ += monitor_period_;
+      } else if (Plan(t)) {
+        break;
+      }
+    }
+    if (in_task_ && robot_.stopped()) result_.stop_time += (finish_ - stop_since_) * 1e-9;
+    result_.true_contacts = robot_.contacts() - contacts_before_;
+    return result_;
+  }
+
+ private:
+  int64_t FrameTime(int i) const { return i < person_.num_frames() ? Ns(person_.stamp(i)) : INT64_MAX; }
+
+  // One monitor evaluation and what it means for the robot.
+  void Evaluate(int64_t t) {
+    const collision_risk::RiskReport report = monitor_.Evaluate(kEpochNs + t);
+    last_evaluation_ = t;
+    const bool risk_stop = report.verdict == collision_risk::Verdict::kProtectiveStop;
+    supervisor_.OnRiskVerdict(report.verdict, report.reason);
+    // Both permits: the monitor's own (a stop at once) and the supervisor's
+    // (which holds a stop until every cause has been clear for the delay).
+    const bool held = supervisor_.Evaluate(nullptr, kEpochNs + t).stop;
+    const bool stop = risk_stop || held;
+    if (params_.trace && stop != robot_.stopped()) {
+      params_.trace(t * 1e-9, stop ? "STOP: " + (risk_stop ? report.reason : std::string("held by the resume delay"))
+                                   : "resume: " + report.reason);
+    }
+    if (stop && !robot_.stopped()) {
+      robot_.Stop();
+      stop_since_ = t;
+      if (in_task_) {
+        ++result_.protective_stops;
+        // Which layer (the monitor decides separation first, then the bound).
+        if (report.separation_margin && *report.separation_margin < 0) {
+          ++result_.stops_separation;
+        } else if (!report.waypoint_bounds.empty()) {
+          ++result_.stops_bound;
+        }
+        if (result_.first_stop_reason.empty()) result_.first_stop_reason = report.reason;
+      }
+    } else if (!stop && robot_.stopped()) {
+      robot_.Resume();
+      if (in_task_) result_.stop_time += (t - stop_since_) * 1e-9;
+    }
+    replanner_.SetRobotStopped(stop);
+  }
+
+  // The robot moves, the true body decides contact, and (at its rate) the
+  // robot state goes to the planner and the monitor.
+  void Control(int64_t t) {
+    const int64_t stamp = kEpochNs + t;
+    if (control_step_ > 0) robot_.Step(stamp, control_period_ * 1e-9);
+    person_.TrueAt(t * 1e-9, &p_WJ_);
+    const double separation = robot_.UpdateContacts(p_WJ_, body_);
+    if (in_task_) result_.min_separation = std::min(result_.min_separation, separation);
+    if (control_step_ % state_every_ == 0) {
+      const std::vector<double> q = ToStd(robot_.q()), qd = ToStd(robot_.qd());
+      if (auto why = replanner_.UpdateRobotState(stamp, robot_joints_, q, qd)) throw std::runtime_error("replanner: " + *why);
+      if (auto why = monitor_.UpdateRobotState(stamp, robot_joints_, q)) throw std::runtime_error("monitor: " + *why);
+    }
+    ++control_step_;
+    next_control_ += control_period_;
+  }
+
+  // A skeleton frame: to the monitor, and the predictions made from it.
+  void Frame(int64_t t) {
+    const int64_t stamp = kEpochNs + t;
+    const Eigen::Matrix3Xd& seen = person_.observed[static_cast<std::size_t>(frame_)];
+    for (Eigen::Index j = 0; j < seen.cols(); ++j) skeleton_[static_cast<std::size_t>(j)] = seen.col(j);
+    if (auto why = monitor_.UpdateSkeleton(stamp, person_.joint_names, skeleton_)) throw std::runtime_error("monitor: " + *why);
+    if (const collision::JointMixture* p = planner_prediction_ ? planner_prediction_(frame_) : nullptr) {
+      if (auto why = replanner_.UpdatePrediction(*p)) throw std::runtime_error("replanner prediction: " + *why);
+    }
+    // The monitor evaluates with every prediction it receives.
+    if (const collision::JointMixture* p = monitor_prediction_ ? monitor_prediction_(frame_) : nullptr) {
+      if (auto why = monitor_.UpdatePrediction(*p)) throw std::runtime_error("monitor prediction: " + *why);
+      Evaluate(t);
+    }
+    if (in_task_) {
+      const std::vector<Eigen::Matrix3d>* covs = true_covariance_ ? true_covariance_(frame_) : nullptr;
+      result_.max_bound = std::max(result_.max_bound, true_bound_.Evaluate(robot_.q(), person_.truth[static_cast<std::size_t>(frame_)],
+                                                                           covs ? *covs : isotropic_));
+    }
+    ++frame_;
+  }
+
+  // A planning step (the task is commanded at its first); true when the
+  // task's outcome ends the run.
+  bool Plan(int64_t t) {
+    const int64_t stamp = kEpochNs + t;
+    next_plan_ += plan_period_;
+    if (t == task_start_) {
+      replanner_.StartTask(setup_.task, stamp);
+      in_task_ = true;
+      contacts_before_ = robot_.contacts();
+      if (robot_.stopped()) {
+        ++result_.protective_stops;
+        stop_since_ = t;
+        result_.first_stop_reason = "stopped when the task was commanded";
+      }
+    }
+    const trajopt::CycleResult r = replanner_.Cycle(stamp);
+    if (params_.trace) {
+      const Eigen::VectorXd& goal = setup_.task.goal.q;
+      const double error = goal.size() == robot_.q().size() ? (robot_.q() - goal).cwiseAbs().maxCoeff() : -1.0;
+      params_.trace(t * 1e-9, "plan: " + r.status + " (bound " + std::to_string(r.max_bound) + ", robot " +
+                                  std::to_string(error) + " rad from the goal, " +
+                                  std::to_string(robot_.qd().cwiseAbs().maxCoeff()) + " rad/s)");
+    }
+    if (r.planning_time > 0) {
+      result_.planning_times.push_back(r.planning_time);
+      ++result_.planning_cycles;
+    }
+    if (r.publish) Publish(r);
+    if (!(r.outcome && in_task_)) return false;
+    result_.finished = true;
+    result_.status = r.outcome->status;
+    result_.reason = r.outcome->reason;
+    result_.task_time = r.outcome->duration;
+    result_.planner_delay = r.outcome->delay;
+    result_.waits = r.outcome->num_waits;
+    finish_ = t;
+    return true;
+  }
+
+  // A new trajectory: to the robot and to the monitor.
+  void Publish(const trajopt::CycleResult& r) {
+    std::vector<double> times;
+    std::vector<std::vector<double>> points;
+    for (Eigen::Index i = 0; i < r.positions.cols(); ++i) {
+      times.push_back(static_cast<double>(i) * r.dt);
+      points.push_back(ToStd(r.positions.col(i)));
+    }
+    if (auto why = robot_.SetTrajectory(r.start_ns, robot_joints_, times, points)) throw std::runtime_error("robot: " + *why);
+    if (auto why = monitor_.UpdateTrajectory(r.start_ns, robot_joints_, times, points)) {
+      throw std::runtime_error("monitor trajectory: " + *why);
+    }
+  }
+
+  const LoopParams& params_;
+  const TaskSetup& setup_;
+  const PersonStream& person_;
+  const PredictionSource& planner_prediction_;
+  const PredictionSource& monitor_prediction_;
+  const CovarianceSource& true_covariance_;
+  const collision::HumanBodyModel& body_;
+  robot_sim::RobotSimulator robot_;
+  trajopt::Replanner replanner_;
+  collision_risk::RiskMonitor monitor_;
+  supervisor::SafetyMonitor supervisor_;
+  TrueBound true_bound_;
+  const std::vector<std::string> robot_joints_;
+  const std::vector<Eigen::Matrix3d> isotropic_;
+  // Event clocks: ns of scenario time; the cores get kEpochNs + t (SimTimeNs).
+  const int64_t control_period_;
+  const int state_every_;
+  const int64_t plan_period_, monitor_period_, task_start_, end_;
+  int64_t next_control_ = 0, next_plan_ = 0, next_monitor_ = 0;
+  int control_step_ = 0, frame_ = 0;
+
+  InteractionResult result_;
+  bool in_task_ = false;
+  int contacts_before_ = 0;  // contacts before the command (the robot at rest) are not the task's
+  int64_t finish_ = 0;       // scenario time the run ended
+  int64_t last_evaluation_ = INT64_MIN / 2, stop_since_ = 0;
+  std::vector<Eigen::Vector3d> skeleton_;
+  Eigen::Matrix3Xd p_WJ_;
+};
+
+}  // namespace
+
 InteractionResult RunInteraction(const CellModels& models, const LoopParams& params, const TaskSetup& setup,
                                  const PersonStream& person, const PredictionSource& planner_prediction,
                                  const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance) {
@@ -111,172 +332,7 @@ InteractionResult RunInteraction(const CellModels& models, const LoopParams& par
   if (person.joint_names != models.body->params().joints) {
     throw std::invalid_argument("RunInteraction: the person's joints are not the body model's, in its order");
   }
-  const planning::Planner& planner = *models.planner;
-  const collision::HumanBodyModel& body = *models.body;
-
-  robot_sim::RobotSimulator robot(planner.robot(), setup.start_q, models.simulator);
-  trajopt::Replanner replanner(planner, body, models.replanner);
-  collision_risk::RiskMonitor monitor = *models.monitor;
-  supervisor::SafetyMonitor supervisor({});
-  supervisor.SetResumeDelay(params.resume_delay);
-  TrueBound true_bound(planner.robot(), body);
-  const std::vector<std::string> robot_joints = robot.joint_names();
-  const std::vector<Eigen::Matrix3d> isotropic(person.joint_names.size(),
-                                               params.true_bound_std * params.true_bound_std * Eigen::Matrix3d::Identity());
-
-  // Event clocks: ns of scenario time; the cores get kEpochNs + t (SimTimeNs).
-  const int64_t control_period = Ns(1.0 / params.control_rate_hz);
-  const int state_every = std::max(1, static_cast<int>(std::lround(params.control_rate_hz / params.joint_state_rate_hz)));
-  const int64_t plan_period = Ns(models.replanner.planning_step);
-  const int64_t monitor_period = Ns(1.0 / params.monitor_rate_hz);
-  const int64_t task_start = (Ns(params.task_start) + plan_period - 1) / plan_period * plan_period;
-  const int64_t end = task_start + Ns(params.max_duration);
-  int64_t next_control = 0, next_plan = 0, next_monitor = 0;
-  int control_step = 0, frame = 0;
-  auto frame_time = [&](int i) { return i < person.num_frames() ? Ns(person.stamp(i)) : INT64_MAX; };
-
-  InteractionResult result;
-  bool in_task = false;
-  int contacts_before = 0;  // contacts before the command (the robot at rest) are not the task's
-  int64_t finish = end;     // scenario time the run ended
-  int64_t last_evaluation = INT64_MIN / 2, stop_since = 0;
-  std::vector<Eigen::Vector3d> skeleton(person.joint_names.size());
-  Eigen::Matrix3Xd p_WJ;
-
-  // One monitor evaluation and what it means for the robot.
-  auto evaluate = [&](int64_t t) {
-    const collision_risk::RiskReport report = monitor.Evaluate(kEpochNs + t);
-    last_evaluation = t;
-    const bool risk_stop = report.verdict == collision_risk::Verdict::kProtectiveStop;
-    supervisor.OnRiskVerdict(report.verdict, report.reason);
-    // Both permits: the monitor's own (a stop at once) and the supervisor's
-    // (which holds a stop until every cause has been clear for the delay).
-    const bool held = supervisor.Evaluate(nullptr, kEpochNs + t).stop;
-    const bool stop = risk_stop || held;
-    if (params.trace && stop != robot.stopped()) {
-      params.trace(t * 1e-9, stop ? "STOP: " + (risk_stop ? report.reason : std::string("held by the resume delay"))
-                                  : "resume: " + report.reason);
-    }
-    if (stop && !robot.stopped()) {
-      robot.Stop();
-      stop_since = t;
-      if (in_task) {
-        ++result.protective_stops;
-        // Which layer (the monitor decides separation first, then the bound).
-        if (report.separation_margin && *report.separation_margin < 0) {
-          ++result.stops_separation;
-        } else if (!report.waypoint_bounds.empty()) {
-          ++result.stops_bound;
-        }
-        if (result.first_stop_reason.empty()) result.first_stop_reason = report.reason;
-      }
-    } else if (!stop && robot.stopped()) {
-      robot.Resume();
-      if (in_task) result.stop_time += (t - stop_since) * 1e-9;
-    }
-    replanner.SetRobotStopped(stop);
-  };
-
-  while (true) {
-    const int64_t t = std::min({next_control, frame_time(frame), next_monitor, next_plan});
-    if (t >= end) {
-      finish = end;
-      result.reason = "no outcome within " + std::to_string(params.max_duration) + " s";
-      result.task_time = params.max_duration;
-      break;
-    }
-    const int64_t stamp = kEpochNs + t;
-    if (t == next_control) {
-      // The robot moves, the true body decides contact, and (at its rate) the
-      // robot state goes to the planner and the monitor.
-      if (control_step > 0) robot.Step(stamp, control_period * 1e-9);
-      person.TrueAt(t * 1e-9, &p_WJ);
-      const double separation = robot.UpdateContacts(p_WJ, body);
-      if (in_task) result.min_separation = std::min(result.min_separation, separation);
-      if (control_step % state_every == 0) {
-        const std::vector<double> q = ToStd(robot.q()), qd = ToStd(robot.qd());
-        if (auto why = replanner.UpdateRobotState(stamp, robot_joints, q, qd)) throw std::runtime_error("replanner: " + *why);
-        if (auto why = monitor.UpdateRobotState(stamp, robot_joints, q)) throw std::runtime_error("monitor: " + *why);
-      }
-      ++control_step;
-      next_control += control_period;
-      continue;
-    }
-    if (t == frame_time(frame)) {
-      const Eigen::Matrix3Xd& seen = person.observed[static_cast<std::size_t>(frame)];
-      for (Eigen::Index j = 0; j < seen.cols(); ++j) skeleton[static_cast<std::size_t>(j)] = seen.col(j);
-      if (auto why = monitor.UpdateSkeleton(stamp, person.joint_names, skeleton)) throw std::runtime_error("monitor: " + *why);
-      if (const collision::JointMixture* p = planner_prediction ? planner_prediction(frame) : nullptr) {
-        if (auto why = replanner.UpdatePrediction(*p)) throw std::runtime_error("replanner prediction: " + *why);
-      }
-      // The monitor evaluates with every prediction it receives.
-      if (const collision::JointMixture* p = monitor_prediction ? monitor_prediction(frame) : nullptr) {
-        if (auto why = monitor.UpdatePrediction(*p)) throw std::runtime_error("monitor prediction: " + *why);
-        evaluate(t);
-      }
-      if (in_task) {
-        const std::vector<Eigen::Matrix3d>* covs = true_covariance ? true_covariance(frame) : nullptr;
-        result.max_bound = std::max(result.max_bound, true_bound.Evaluate(robot.q(), person.truth[static_cast<std::size_t>(frame)],
-                                                                          covs ? *covs : isotropic));
-      }
-      ++frame;
-      continue;
-    }
-    if (t == next_monitor) {
-      // Between predictions the monitor keeps watching at its own rate.
-      if (t - last_evaluation >= monitor_period * 9 / 10) evaluate(t);
-      next_monitor += monitor_period;
-      continue;
-    }
-    // Planning step.
-    next_plan += plan_period;
-    if (t == task_start) {
-      replanner.StartTask(setup.task, stamp);
-      in_task = true;
-      contacts_before = robot.contacts();
-      if (robot.stopped()) {
-        ++result.protective_stops;
-        stop_since = t;
-        result.first_stop_reason = "stopped when the task was commanded";
-      }
-    }
-    const trajopt::CycleResult r = replanner.Cycle(stamp);
-    if (params.trace) {
-      const Eigen::VectorXd& goal = setup.task.goal.q;
-      const double error = goal.size() == robot.q().size() ? (robot.q() - goal).cwiseAbs().maxCoeff() : -1.0;
-      params.trace(t * 1e-9, "plan: " + r.status + " (bound " + std::to_string(r.max_bound) + ", robot " +
-                                 std::to_string(error) + " rad from the goal, " + std::to_string(robot.qd().cwiseAbs().maxCoeff()) + " rad/s)");
-    }
-    if (r.planning_time > 0) {
-      result.planning_times.push_back(r.planning_time);
-      ++result.planning_cycles;
-    }
-    if (r.publish) {
-      std::vector<double> times;
-      std::vector<std::vector<double>> points;
-      for (Eigen::Index i = 0; i < r.positions.cols(); ++i) {
-        times.push_back(static_cast<double>(i) * r.dt);
-        points.push_back(ToStd(r.positions.col(i)));
-      }
-      if (auto why = robot.SetTrajectory(r.start_ns, robot_joints, times, points)) throw std::runtime_error("robot: " + *why);
-      if (auto why = monitor.UpdateTrajectory(r.start_ns, robot_joints, times, points)) {
-        throw std::runtime_error("monitor trajectory: " + *why);
-      }
-    }
-    if (r.outcome && in_task) {
-      result.finished = true;
-      result.status = r.outcome->status;
-      result.reason = r.outcome->reason;
-      result.task_time = r.outcome->duration;
-      result.planner_delay = r.outcome->delay;
-      result.waits = r.outcome->num_waits;
-      finish = t;
-      break;
-    }
-  }
-  if (in_task && robot.stopped()) result.stop_time += (finish - stop_since) * 1e-9;
-  result.true_contacts = robot.contacts() - contacts_before;
-  return result;
+  return Interaction(models, params, setup, person, planner_prediction, monitor_prediction, true_covariance).Run();
 }
 
 }  // namespace iplan::cell_sim

@@ -137,66 +137,16 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   }
   if (!task_) return Hold(now_ns, q_->second, "idle");
   Active& t = *task_;
-  const double dt = planner_.params().dt;
   // The robot waited from the previous cycle until now (cycles can be longer
   // than the planning step while the planner inserts waits).
   if (t.waiting || t.stopped) t.delay += (now_ns - t.last_cycle_ns) * 1e-9;
   t.waiting = false;
   t.stopped = robot_stopped_;
   t.last_cycle_ns = now_ns;
+  if (std::optional<CycleResult> over = CheckProgress(now_ns, &r)) return *over;
 
-  // Arrived? At the goal of a task with a retreat, the task goes on to it.
-  if (t.goal_q && (q_->second - *t.goal_q).cwiseAbs().maxCoeff() < params_.goal_tolerance &&
-      qd_.cwiseAbs().maxCoeff() < params_.settle_speed) {
-    if (t.spec.retreat.size() > 0 && !t.retreating) {
-      t.retreating = true;
-      t.goal_q = t.spec.retreat;
-      r.status = "goal reached, retreating: ";
-    } else {
-      CycleResult done = Hold(now_ns, q_->second, t.retreating ? "retreat reached" : "goal reached");
-      done.outcome = Finish(TaskStatus::kSucceeded, "", now_ns);
-      return done;
-    }
-  }
-  if (t.spec.time_limit > 0 && (now_ns - t.start_ns) * 1e-9 > t.spec.time_limit) {
-    CycleResult late = Hold(now_ns, q_->second, "time limit");
-    late.outcome = Finish(TaskStatus::kFailed, "time limit of " + std::to_string(t.spec.time_limit) + " s exceeded", now_ns);
-    return late;
-  }
-
-  planning::PlanningRequest req;
   int64_t start_ns = now_ns;
-  if (previous_) {
-    // Where the executing plan says the robot is at the state's stamp.
-    const auto& [p_start, P] = *previous_;
-    const Eigen::VectorXd expected = cell::JointTrajectory::Uniform(p_start, dt, P).PositionAt(q_->first);
-    if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
-      previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
-      r.status += "robot off the plan: replanning from its state; ";
-    }
-  }
-  if (previous_) {
-    // Keep what executes while this cycle plans; replan the rest.
-    const int64_t steps = std::max<int64_t>(0, std::llround((now_ns - previous_->first) * 1e-9 / dt));
-    start_ns = previous_->first + static_cast<int64_t>(std::llround(steps * dt * 1e9));
-    req.warm_start = planning::Planner::ShiftTrajectory(previous_->second, dt, steps * dt);
-    req.start_q = req.warm_start.col(0);
-    req.start_qdot = req.warm_start.cols() > 1 ? Eigen::VectorXd((req.warm_start.col(1) - req.warm_start.col(0)) / dt)
-                                               : Eigen::VectorXd::Zero(req.start_q.size());
-    req.num_frozen = std::min<int>(params_.frozen_waypoints, static_cast<int>(req.warm_start.cols()));
-  } else {
-    req.start_q = q_->second;
-    req.start_qdot = Eigen::VectorXd::Zero(req.start_q.size());
-    req.num_frozen = 1;
-  }
-  req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
-  if (prediction_ && prediction_->FreshAt(now_ns, stale)) {
-    req.prediction = &prediction_->spheres();
-    req.prediction_dt = prediction_->time_step();
-    r.prediction_t0_ns = prediction_->t0_ns();
-    req.prediction_start = prediction_->StartRelativeTo(start_ns);
-  }
-
+  const planning::PlanningRequest req = MakeRequest(now_ns, &start_ns, &r);
   planning::PlanningResult res;
   try {
     res = planner_.Plan(req);
@@ -215,42 +165,113 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (!t.goal_q && res.goal_q.size() > 0) t.goal_q = res.goal_q;
   r.publish = true;
   r.start_ns = start_ns;
-  r.dt = dt;
-  const std::string prefix = r.status;
+  r.dt = planner_.params().dt;
+  ApplyPlan(req, res, &r);
+  previous_ = std::make_pair(start_ns, r.positions);
+  return r;
+}
+
+// Arrived? At the goal of a task with a retreat, the task goes on to it.
+// Returns the cycle's result when the task is over (goal reached, time limit).
+std::optional<CycleResult> Replanner::CheckProgress(int64_t now_ns, CycleResult* r) {
+  Active& t = *task_;
+  if (t.goal_q && (q_->second - *t.goal_q).cwiseAbs().maxCoeff() < params_.goal_tolerance &&
+      qd_.cwiseAbs().maxCoeff() < params_.settle_speed) {
+    if (t.spec.retreat.size() > 0 && !t.retreating) {
+      t.retreating = true;
+      t.goal_q = t.spec.retreat;
+      r->status = "goal reached, retreating: ";
+    } else {
+      CycleResult done = Hold(now_ns, q_->second, t.retreating ? "retreat reached" : "goal reached");
+      done.outcome = Finish(TaskStatus::kSucceeded, "", now_ns);
+      return done;
+    }
+  }
+  if (t.spec.time_limit > 0 && (now_ns - t.start_ns) * 1e-9 > t.spec.time_limit) {
+    CycleResult late = Hold(now_ns, q_->second, "time limit");
+    late.outcome = Finish(TaskStatus::kFailed, "time limit of " + std::to_string(t.spec.time_limit) + " s exceeded", now_ns);
+    return late;
+  }
+  return std::nullopt;
+}
+
+// The request of this cycle: from the executing plan (its frozen prefix kept)
+// when the robot follows it, else from the robot's state; the goal; the
+// prediction when it is fresh. *start_ns is the time of waypoint 0.
+planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_ns, CycleResult* r) {
+  const Active& t = *task_;
+  const double dt = planner_.params().dt;
+  planning::PlanningRequest req;
+  if (previous_) {
+    // Where the executing plan says the robot is at the state's stamp.
+    const auto& [p_start, P] = *previous_;
+    const Eigen::VectorXd expected = cell::JointTrajectory::Uniform(p_start, dt, P).PositionAt(q_->first);
+    if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
+      previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
+      r->status += "robot off the plan: replanning from its state; ";
+    }
+  }
+  if (previous_) {
+    // Keep what executes while this cycle plans; replan the rest.
+    const int64_t steps = std::max<int64_t>(0, std::llround((now_ns - previous_->first) * 1e-9 / dt));
+    *start_ns = previous_->first + static_cast<int64_t>(std::llround(steps * dt * 1e9));
+    req.warm_start = planning::Planner::ShiftTrajectory(previous_->second, dt, steps * dt);
+    req.start_q = req.warm_start.col(0);
+    req.start_qdot = req.warm_start.cols() > 1 ? Eigen::VectorXd((req.warm_start.col(1) - req.warm_start.col(0)) / dt)
+                                               : Eigen::VectorXd::Zero(req.start_q.size());
+    req.num_frozen = std::min<int>(params_.frozen_waypoints, static_cast<int>(req.warm_start.cols()));
+  } else {
+    req.start_q = q_->second;
+    req.start_qdot = Eigen::VectorXd::Zero(req.start_q.size());
+    req.num_frozen = 1;
+  }
+  req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
+  const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
+  if (prediction_ && prediction_->FreshAt(now_ns, stale)) {
+    req.prediction = &prediction_->spheres();
+    req.prediction_dt = prediction_->time_step();
+    r->prediction_t0_ns = prediction_->t0_ns();
+    req.prediction_start = prediction_->StartRelativeTo(*start_ns);
+  }
+  return req;
+}
+
+// The trajectory to publish from the plan, and what it means for the task:
+// waits and holding off count as waiting; without a safe trajectory the
+// robot keeps the frozen prefix and holds at its end.
+void Replanner::ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r) {
+  Active& t = *task_;
+  const std::string prefix = r->status;
   if (res.success()) {
-    r.positions = res.positions;
+    r->positions = res.positions;
     t.max_bound = std::max(t.max_bound, res.max_bound);
-    r.max_bound = res.max_bound;
+    r->max_bound = res.max_bound;
     if (res.num_waits > 0) {
-      r.waiting = true;
+      r->waiting = true;
       t.waiting = true;
       ++t.waits;
-      r.status = prefix + "planned with " + std::to_string(res.num_waits) + " wait(s)";
+      r->status = prefix + "planned with " + std::to_string(res.num_waits) + " wait(s)";
     } else if (res.human_separation < planner_.params().human_separation) {
       // The keep-out from the person shapes this plan: the robot goes round
       // or holds off instead of taking its free path. Counted as delay (the
       // extra time the task needs because of the person), not as a wait.
-      r.held_off = true;
+      r->held_off = true;
       t.waiting = true;
-      r.status = prefix + "planned, held off by the person (separation " + std::to_string(res.human_separation) + " m)";
+      r->status = prefix + "planned, held off by the person (separation " + std::to_string(res.human_separation) + " m)";
     } else {
-      r.status = prefix + "planned";
+      r->status = prefix + "planned";
     }
-  } else {
-    // No safe trajectory even with waits: keep the frozen prefix and hold at
-    // its end; count the step as waiting.
-    const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);
-    const int keep = std::max(1, std::min<int>(req.num_frozen, static_cast<int>(base.cols())));
-    r.positions.resize(base.rows(), keep + 1);
-    r.positions.leftCols(keep) = base.leftCols(keep);
-    r.positions.col(keep) = base.col(keep - 1);
-    r.waiting = true;
-    t.waiting = true;
-    ++t.waits;
-    r.status = prefix + "no safe trajectory: holding (" + res.reason + ")";
+    return;
   }
-  previous_ = std::make_pair(start_ns, r.positions);
-  return r;
+  const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);
+  const int keep = std::max(1, std::min<int>(req.num_frozen, static_cast<int>(base.cols())));
+  r->positions.resize(base.rows(), keep + 1);
+  r->positions.leftCols(keep) = base.leftCols(keep);
+  r->positions.col(keep) = base.col(keep - 1);
+  r->waiting = true;
+  t.waiting = true;
+  ++t.waits;
+  r->status = prefix + "no safe trajectory: holding (" + res.reason + ")";
 }
 
 }  // namespace iplan::trajopt

@@ -123,6 +123,9 @@ class Replanner {
  private:
   TaskOutcome Finish(TaskStatus status, const std::string& reason, int64_t now_ns);
   CycleResult Hold(int64_t now_ns, const Eigen::VectorXd& q, const std::string& status);
+  std::optional<CycleResult> CheckProgress(int64_t now_ns, CycleResult* r);
+  planning::PlanningRequest MakeRequest(int64_t now_ns, int64_t* start_ns, CycleResult* r);
+  void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
 
   const planning::Planner& planner_;
   const collision::HumanBodyModel& body_;
