@@ -10,6 +10,37 @@ namespace iplan::collision::internal {
 
 constexpr double kEps = std::numeric_limits<double>::epsilon();
 
+// The starting point and certified bracket [lo, hi] of every lane (see
+// SolveSecularLanes).
+template <int L>
+inline void StartSecularLanes(const double (&d)[3][L], const double (&s)[3][L], const double (&inv_s)[3][L],
+                              const double (&dist)[L], const double (&R)[L], const bool (&need)[L],
+                              double (&lambda)[L], double (&lo)[L], double (&hi)[L], double (&inv_R)[L],
+                              bool (&active)[L]) {
+  for (int l = 0; l < L; ++l) {
+    inv_R[l] = 1.0 / R[l];
+    const double excess = dist[l] * inv_R[l] - 1.0;
+    double low = excess * inv_s[2][l];
+    for (int i = 0; i < 3; ++i) {
+      low = std::max(low, (std::abs(d[i][l]) * inv_R[l] - 1.0) * inv_s[i][l]);
+    }
+    // psi is concave, so it lies below its tangent at 0: the tangent's root
+    // (a Newton step from 0) is another lower bound.
+    const double w0 = s[0][l] * d[0][l] * d[0][l] + s[1][l] * d[1][l] * d[1][l] +
+                      s[2][l] * d[2][l] * d[2][l];
+    low = std::max(low, dist[l] * dist[l] * excess / w0);
+    // The estimates above are exact bounds only in exact arithmetic (they
+    // can be tight, e.g. for isotropic Sigma, and rounding may put them on
+    // the wrong side), so the certified bracket is [0, hi] with hi padded;
+    // `low` is only the starting point.
+    lo[l] = 0.0;
+    hi[l] = (excess * (1.0 + 1e-6) + 4.0 * kEps * dist[l] * inv_R[l]) * inv_s[0][l];
+    low = std::min(low, hi[l]);
+    lambda[l] = need[l] ? low : 0.0;
+    active[l] = need[l];
+  }
+}
+
 // Solves sum_i d_i^2 / (1 + lambda s_i)^2 = R^2 for lambda > 0, given
 // ||d|| > R and s_i > 0. Newton's method on psi(lambda) = 1/||y(lambda)||:
 // y_i = (d_i/s_i) / (1/s_i + lambda) is the trust-region step of a convex
@@ -40,28 +71,7 @@ inline void SolveSecularLanes(const double (&d)[3][L], const double (&s)[3][L],
                               double (&lambda)[L], int* iterations) {
   double lo[L], hi[L], inv_R[L];
   bool active[L];
-  for (int l = 0; l < L; ++l) {
-    inv_R[l] = 1.0 / R[l];
-    const double excess = dist[l] * inv_R[l] - 1.0;
-    double low = excess * inv_s[2][l];
-    for (int i = 0; i < 3; ++i) {
-      low = std::max(low, (std::abs(d[i][l]) * inv_R[l] - 1.0) * inv_s[i][l]);
-    }
-    // psi is concave, so it lies below its tangent at 0: the tangent's root
-    // (a Newton step from 0) is another lower bound.
-    const double w0 = s[0][l] * d[0][l] * d[0][l] + s[1][l] * d[1][l] * d[1][l] +
-                      s[2][l] * d[2][l] * d[2][l];
-    low = std::max(low, dist[l] * dist[l] * excess / w0);
-    // The estimates above are exact bounds only in exact arithmetic (they
-    // can be tight, e.g. for isotropic Sigma, and rounding may put them on
-    // the wrong side), so the certified bracket is [0, hi] with hi padded;
-    // `low` is only the starting point.
-    lo[l] = 0.0;
-    hi[l] = (excess * (1.0 + 1e-6) + 4.0 * kEps * dist[l] * inv_R[l]) * inv_s[0][l];
-    low = std::min(low, hi[l]);
-    lambda[l] = need[l] ? low : 0.0;
-    active[l] = need[l];
-  }
+  StartSecularLanes(d, s, inv_s, dist, R, need, lambda, lo, hi, inv_R, active);
   int it = 0;
   for (; it < 100; ++it) {
     for (int l = 0; l < L; ++l) {

@@ -182,6 +182,118 @@ double EvaluateMixtureBound(const HumanPrediction& prediction, int step, int sph
 // U <= `negligible` is skipped too; its U is remembered, and if the waypoint's
 // exact maximum stays below `negligible` the reported bound is the largest
 // such U, which is >= the true maximum: the result is always an upper bound.
+namespace {
+
+// The search for one waypoint's maximum over its sphere pairs (see above).
+struct PairSearch {
+  const HumanPrediction& prediction;
+  const RobotSpheresTrajectory& trajectory;
+  const TrajectoryBoundParams& params;
+  const double* log_upper;
+  const double* log_volume;
+  double log_negligible;
+  int w, t, S, H, A;
+  WaypointBound* res;
+  double best = -1.0;  // best exact mixture so far (-1: none yet)
+  double log_best = -std::numeric_limits<double>::infinity();
+  double skipped_max = 0.0;  // largest U of pairs skipped as negligible
+  double log_skipped_max = -std::numeric_limits<double>::infinity();  // same, level 1 (log)
+
+  // Level 2, then the exact mixture, of one pair unless pruned.
+  void Evaluate(int pair) {
+    const int k = pair / H;
+    const int l = pair % H;
+    const double lu = log_upper[pair];
+    if (lu <= log_negligible) {
+      log_skipped_max = std::max(log_skipped_max, lu);
+      ++res->pairs_pruned;
+      return;
+    }
+    if (lu <= log_best) {
+      ++res->pairs_pruned;
+      return;
+    }
+    const Eigen::Vector3d b = trajectory.centres.col(static_cast<Eigen::Index>(w) * S + k);
+    const double r1 = trajectory.radii[k];
+    const double R = r1 + prediction.radius(l);
+    const double log_v = log_volume[pair];
+    double u2 = 0.0;
+    for (int c = 0; c < A; ++c) {
+      const double p = prediction.action_probability(c);
+      if (p <= 0.0) continue;
+      const FactorizedGaussian& g = prediction.sphere(c, t, l);
+      const double delta = std::max(0.0, (g.mean - b).norm() - R);
+      const double lu_c = log_v + g.log_peak_density - delta * delta * (0.5 * g.inverse_eigenvalues[2]);
+      u2 += p * (lu_c >= 0.0 ? 1.0 : std::exp(lu_c));
+    }
+    if (u2 <= params.negligible) {
+      skipped_max = std::max(skipped_max, u2);
+      ++res->pairs_pruned;
+      return;
+    }
+    if (u2 <= best) {
+      ++res->pairs_pruned;
+      return;
+    }
+    int action = -1;
+    const double value = MixtureBound(prediction, t, l, b, R, log_v, &action);
+    ++res->pairs_evaluated;
+    if (value > best) {
+      best = value;
+      log_best = std::log(value);
+      res->robot_sphere = k;
+      res->human_sphere = l;
+      res->action = action;
+    }
+  }
+
+  // The waypoint's bound from the search: exact when some pair reached
+  // `negligible`, else the largest skipped upper bound.
+  void Finish() {
+    skipped_max = std::max(skipped_max, std::exp(log_skipped_max));
+    if (res->robot_sphere >= 0) {
+      res->robot_link = trajectory.links[res->robot_sphere];
+      res->human_segment = prediction.segment(res->human_sphere);
+    }
+    if (best >= params.negligible && best >= 0.0) {
+      res->bound = best;
+      res->exact = true;
+    } else {
+      res->bound = std::max(std::max(best, 0.0), std::min(skipped_max, 1.0));
+      res->exact = skipped_max <= std::max(best, 0.0);
+    }
+  }
+};
+
+// Level 1 for every pair of waypoint w, in the log domain (no exp), into
+// log_upper; returns the pair with the largest (-1 when there is none).
+int LevelOneBounds(const HumanPrediction& prediction, const RobotSpheresTrajectory& trajectory, int w, int t,
+                   double log_psum, const double* log_volume, double* log_upper) {
+  const int S = trajectory.num_spheres();
+  const int H = prediction.num_spheres();
+  int first = -1;
+  double first_value = -std::numeric_limits<double>::infinity();
+  for (int k = 0; k < S; ++k) {
+    const Eigen::Vector3d b = trajectory.centres.col(static_cast<Eigen::Index>(w) * S + k);
+    const double r1 = trajectory.radii[k];
+    for (int l = 0; l < H; ++l) {
+      const HumanPrediction::Summary& sm = prediction.summary(t, l);
+      const double R = r1 + prediction.radius(l);
+      const double delta = std::max(0.0, (sm.centre - b).norm() - sm.spread - R);
+      const double lu = log_psum + std::min(0.0, log_volume[k * H + l] + sm.max_log_peak -
+                                                     delta * delta * sm.half_inverse_max_eigenvalue);
+      log_upper[k * H + l] = lu;
+      if (lu > first_value) {
+        first_value = lu;
+        first = k * H + l;
+      }
+    }
+  }
+  return first;
+}
+
+}  // namespace
+
 void EvaluateTrajectoryBound(const HumanPrediction& prediction,
                              const RobotSpheresTrajectory& trajectory,
                              const TrajectoryBoundParams& params,
@@ -216,96 +328,13 @@ void EvaluateTrajectoryBound(const HumanPrediction& prediction,
     IPLAN_COLLISION_DEMAND(t >= 0 && t < prediction.num_steps());
     WaypointBound& res = (*out)[w];
     res = WaypointBound{};
-
-    // Level 1 for every pair, in the log domain (no exp).
-    int first = -1;
-    double first_value = -std::numeric_limits<double>::infinity();
-    for (int k = 0; k < S; ++k) {
-      const Eigen::Vector3d b = trajectory.centres.col(static_cast<Eigen::Index>(w) * S + k);
-      const double r1 = trajectory.radii[k];
-      for (int l = 0; l < H; ++l) {
-        const HumanPrediction::Summary& sm = prediction.summary(t, l);
-        const double R = r1 + prediction.radius(l);
-        const double delta = std::max(0.0, (sm.centre - b).norm() - sm.spread - R);
-        const double lu = log_psum +
-                          std::min(0.0, log_volume[k * H + l] + sm.max_log_peak -
-                                            delta * delta * sm.half_inverse_max_eigenvalue);
-        log_upper[k * H + l] = lu;
-        if (lu > first_value) {
-          first_value = lu;
-          first = k * H + l;
-        }
-      }
-    }
-
-    double best = -1.0;  // best exact mixture so far (-1: none yet)
-    double log_best = -std::numeric_limits<double>::infinity();
-    double skipped_max = 0.0;      // largest U of pairs skipped as negligible
-    double log_skipped_max = -std::numeric_limits<double>::infinity();  // same, level 1 (log)
-    auto evaluate = [&](int pair) {
-      const int k = pair / H;
-      const int l = pair % H;
-      const double lu = log_upper[pair];
-      if (lu <= log_negligible) {
-        log_skipped_max = std::max(log_skipped_max, lu);
-        ++res.pairs_pruned;
-        return;
-      }
-      if (lu <= log_best) {
-        ++res.pairs_pruned;
-        return;
-      }
-      const Eigen::Vector3d b = trajectory.centres.col(static_cast<Eigen::Index>(w) * S + k);
-      const double r1 = trajectory.radii[k];
-      const double R = r1 + prediction.radius(l);
-      const double log_v = log_volume[pair];
-      // Level 2.
-      double u2 = 0.0;
-      for (int c = 0; c < A; ++c) {
-        const double p = prediction.action_probability(c);
-        if (p <= 0.0) continue;
-        const FactorizedGaussian& g = prediction.sphere(c, t, l);
-        const double delta = std::max(0.0, (g.mean - b).norm() - R);
-        const double lu_c =
-            log_v + g.log_peak_density - delta * delta * (0.5 * g.inverse_eigenvalues[2]);
-        u2 += p * (lu_c >= 0.0 ? 1.0 : std::exp(lu_c));
-      }
-      if (u2 <= params.negligible) {
-        skipped_max = std::max(skipped_max, u2);
-        ++res.pairs_pruned;
-        return;
-      }
-      if (u2 <= best) {
-        ++res.pairs_pruned;
-        return;
-      }
-      int action = -1;
-      const double value = MixtureBound(prediction, t, l, b, R, log_v, &action);
-      ++res.pairs_evaluated;
-      if (value > best) {
-        best = value;
-        log_best = std::log(value);
-        res.robot_sphere = k;
-        res.human_sphere = l;
-        res.action = action;
-      }
-    };
-    if (first >= 0) evaluate(first);
+    const int first = LevelOneBounds(prediction, trajectory, w, t, log_psum, log_volume, log_upper);
+    PairSearch search{prediction, trajectory, params, log_upper, log_volume, log_negligible, w, t, S, H, A, &res};
+    if (first >= 0) search.Evaluate(first);
     for (int pair = 0; pair < S * H; ++pair) {
-      if (pair != first) evaluate(pair);
+      if (pair != first) search.Evaluate(pair);
     }
-    skipped_max = std::max(skipped_max, std::exp(log_skipped_max));
-    if (res.robot_sphere >= 0) {
-      res.robot_link = trajectory.links[res.robot_sphere];
-      res.human_segment = prediction.segment(res.human_sphere);
-    }
-    if (best >= params.negligible && best >= 0.0) {
-      res.bound = best;
-      res.exact = true;
-    } else {
-      res.bound = std::max(std::max(best, 0.0), std::min(skipped_max, 1.0));
-      res.exact = skipped_max <= std::max(best, 0.0);
-    }
+    search.Finish();
   }
 }
 
