@@ -75,6 +75,92 @@ Eigen::Isometry3d RecordingPose(const intent::SkeletonDataset& data, const std::
   return X_WS;
 }
 
+namespace {
+
+// Which body joints come from the recording (column into the replay's
+// joints), which are derived from the shoulders (head, neck, torso).
+struct BodyFromRecording {
+  std::vector<int> column;
+  int neck = -1, head = -1, torso = -1, shoulder_l = -1, shoulder_r = -1;
+  bool derives() const { return neck >= 0 || head >= 0 || torso >= 0; }
+};
+
+BodyFromRecording MapBodyJoints(const std::vector<std::string>& body_joints, const std::vector<std::string>& names,
+                                const std::string& file) {
+  BodyFromRecording m;
+  m.column.assign(body_joints.size(), -1);
+  for (std::size_t b = 0; b < body_joints.size(); ++b) {
+    const auto it = std::find(names.begin(), names.end(), body_joints[b]);
+    if (it != names.end()) {
+      m.column[b] = static_cast<int>(it - names.begin());
+    } else if (body_joints[b] == "neck") {
+      m.neck = static_cast<int>(b);
+    } else if (body_joints[b] == "head") {
+      m.head = static_cast<int>(b);
+    } else if (body_joints[b] == "torso") {
+      m.torso = static_cast<int>(b);
+    } else {
+      throw std::invalid_argument("body joint '" + body_joints[b] + "' is not in " + file +
+                                  " (after joint_map) and cannot be derived (only head, neck and torso are)");
+    }
+    if (body_joints[b] == "shoulder_l") m.shoulder_l = static_cast<int>(b);
+    if (body_joints[b] == "shoulder_r") m.shoulder_r = static_cast<int>(b);
+  }
+  if (m.derives() && (m.shoulder_l < 0 || m.shoulder_r < 0 || m.column[m.shoulder_l] < 0 || m.column[m.shoulder_r] < 0)) {
+    throw std::invalid_argument("head, neck and torso are derived from shoulder_l and shoulder_r, which " + file +
+                                " lacks");
+  }
+  return m;
+}
+
+// Recorded frames in W, undetected joints held; before every joint has been
+// seen once, frames are skipped.
+void ReplayFrames(perception::SkeletonReplay* replay, std::vector<double>* times, std::vector<Eigen::Matrix3Xd>* frames) {
+  const std::vector<std::string>& names = replay->published_joint_names();
+  std::vector<bool> seen(names.size(), false);
+  Eigen::Matrix3Xd last = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(names.size()));
+  perception::ReplayFrame f;
+  while (replay->Next(1e300, &f)) {
+    for (const auto& j : f.joints) {
+      const auto it = std::find(names.begin(), names.end(), j.name);
+      const std::size_t k = static_cast<std::size_t>(it - names.begin());
+      last.col(static_cast<Eigen::Index>(k)) = j.position_W;
+      seen[k] = true;
+    }
+    if (std::find(seen.begin(), seen.end(), false) != seen.end()) continue;
+    if (!times->empty() && !(f.play_time > times->back())) continue;
+    times->push_back(f.play_time);
+    frames->push_back(last);
+  }
+}
+
+// The body at recording time r: the recorded joints interpolated, the
+// derived ones placed from the shoulders.
+Eigen::Matrix3Xd BodyAt(const BodyFromRecording& m, const std::vector<double>& times,
+                        const std::vector<Eigen::Matrix3Xd>& frames, double r, std::size_t* seg) {
+  while (*seg + 1 < times.size() && times[*seg + 1] <= r) ++*seg;
+  const std::size_t i = *seg;
+  Eigen::Matrix3Xd rec = frames[i];
+  if (i + 1 < times.size() && r > times[i]) {
+    const double u = (r - times[i]) / (times[i + 1] - times[i]);
+    rec = (1 - u) * frames[i] + u * frames[i + 1];
+  }
+  Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(m.column.size()));
+  for (std::size_t b = 0; b < m.column.size(); ++b) {
+    if (m.column[b] >= 0) p.col(static_cast<Eigen::Index>(b)) = rec.col(m.column[b]);
+  }
+  if (m.derives()) {
+    const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+    const Eigen::Vector3d n_W = 0.5 * (p.col(m.shoulder_l) + p.col(m.shoulder_r)) + kShoulderBelowNeck * up;
+    if (m.neck >= 0) p.col(m.neck) = n_W;
+    if (m.head >= 0) p.col(m.head) = n_W + kNeckToHead * up;
+    if (m.torso >= 0) p.col(m.torso) = n_W - kTorsoToNeck * up;
+  }
+  return p;
+}
+
+}  // namespace
+
 PersonStream RecordedPersonStream(const intent::SkeletonDataset& data, const std::string& file,
                                   const std::string& sequence, const std::map<std::string, std::string>& joint_map,
                                   const RecordedPlacement& placement, const std::vector<std::string>& body_joints,
@@ -93,53 +179,10 @@ PersonStream RecordedPersonStream(const intent::SkeletonDataset& data, const std
   rp.joint_map = joint_map;
   rp.X_WS = RecordingPose(data, sequence, placement);
   perception::SkeletonReplay replay(rp, std::move(one));
-  const std::vector<std::string>& names = replay.published_joint_names();
-
-  // Which body joints come from the recording, which are derived.
-  std::vector<int> column(body_joints.size(), -1);
-  int neck = -1, head = -1, torso = -1, shoulder_l = -1, shoulder_r = -1;
-  for (std::size_t b = 0; b < body_joints.size(); ++b) {
-    const auto it = std::find(names.begin(), names.end(), body_joints[b]);
-    if (it != names.end()) {
-      column[b] = static_cast<int>(it - names.begin());
-    } else if (body_joints[b] == "neck") {
-      neck = static_cast<int>(b);
-    } else if (body_joints[b] == "head") {
-      head = static_cast<int>(b);
-    } else if (body_joints[b] == "torso") {
-      torso = static_cast<int>(b);
-    } else {
-      throw std::invalid_argument("body joint '" + body_joints[b] + "' is not in " + file +
-                                  " (after joint_map) and cannot be derived (only head, neck and torso are)");
-    }
-    if (body_joints[b] == "shoulder_l") shoulder_l = static_cast<int>(b);
-    if (body_joints[b] == "shoulder_r") shoulder_r = static_cast<int>(b);
-  }
-  if ((neck >= 0 || head >= 0 || torso >= 0) && (shoulder_l < 0 || shoulder_r < 0 || column[shoulder_l] < 0 ||
-                                                 column[shoulder_r] < 0)) {
-    throw std::invalid_argument("head, neck and torso are derived from shoulder_l and shoulder_r, which " + file +
-                                " lacks");
-  }
-
-  // Recorded frames in W, undetected joints held; before every joint has
-  // been seen once, frames are skipped.
+  const BodyFromRecording map = MapBodyJoints(body_joints, replay.published_joint_names(), file);
   std::vector<double> times;
   std::vector<Eigen::Matrix3Xd> frames;
-  std::vector<bool> seen(names.size(), false);
-  Eigen::Matrix3Xd last = Eigen::Matrix3Xd::Zero(3, static_cast<Eigen::Index>(names.size()));
-  perception::ReplayFrame f;
-  while (replay.Next(1e300, &f)) {
-    for (const auto& j : f.joints) {
-      const auto it = std::find(names.begin(), names.end(), j.name);
-      const std::size_t k = static_cast<std::size_t>(it - names.begin());
-      last.col(static_cast<Eigen::Index>(k)) = j.position_W;
-      seen[k] = true;
-    }
-    if (std::find(seen.begin(), seen.end(), false) != seen.end()) continue;
-    if (!times.empty() && !(f.play_time > times.back())) continue;
-    times.push_back(f.play_time);
-    frames.push_back(last);
-  }
+  ReplayFrames(&replay, &times, &frames);
   if (frames.empty()) throw std::invalid_argument("sequence '" + sequence + "' never shows every joint of " + file);
 
   PersonStream s;
@@ -151,24 +194,7 @@ PersonStream RecordedPersonStream(const intent::SkeletonDataset& data, const std
   for (int i = 0; i < n; ++i) {
     // Recording time of this frame: the first pose until the delay is over.
     const double r = t0 + placement.clip_start + std::max(0.0, i / rate_hz - placement.delay);
-    while (seg + 1 < times.size() && times[seg + 1] <= r) ++seg;
-    Eigen::Matrix3Xd rec = frames[seg];
-    if (seg + 1 < times.size() && r > times[seg]) {
-      const double u = (r - times[seg]) / (times[seg + 1] - times[seg]);
-      rec = (1 - u) * frames[seg] + u * frames[seg + 1];
-    }
-    Eigen::Matrix3Xd p(3, static_cast<Eigen::Index>(body_joints.size()));
-    for (std::size_t b = 0; b < body_joints.size(); ++b) {
-      if (column[b] >= 0) p.col(static_cast<Eigen::Index>(b)) = rec.col(column[b]);
-    }
-    if (neck >= 0 || head >= 0 || torso >= 0) {
-      const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-      const Eigen::Vector3d n_W = 0.5 * (p.col(shoulder_l) + p.col(shoulder_r)) + kShoulderBelowNeck * up;
-      if (neck >= 0) p.col(neck) = n_W;
-      if (head >= 0) p.col(head) = n_W + kNeckToHead * up;
-      if (torso >= 0) p.col(torso) = n_W - kTorsoToNeck * up;
-    }
-    s.truth.push_back(std::move(p));
+    s.truth.push_back(BodyAt(map, times, frames, r, &seg));
   }
   AddNoise(noise_std, seed, &s);
   return s;
