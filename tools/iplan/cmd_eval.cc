@@ -13,6 +13,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <iostream>
 #include <memory>
 #include <sstream>
@@ -73,110 +74,93 @@ Json VectorJson(const Eigen::VectorXd& v) {
   return a;
 }
 
-int RunInteraction(const InteractionOptions& o) {
-  // Options first: a bad request is refused before anything is loaded.
+// --predictors as a list; prints why and returns nullopt when it is bad.
+std::optional<std::vector<Predictor>> ParsePredictors(const std::string& text) {
   std::vector<Predictor> predictors;
-  {
-    std::stringstream ss(o.predictors);
-    std::string name;
-    while (std::getline(ss, name, ',')) {
-      if (name.empty()) continue;
-      const auto p = cell_sim::ParsePredictor(name);
-      if (!p) {
-        std::string known;
-        for (const auto& n : cell_sim::PredictorNames()) known += (known.empty() ? "" : ", ") + n;
-        std::cerr << "iplan eval interaction: unknown predictor '" << name << "' (known: " << known << ")\n";
-        return 2;
-      }
-      if (std::find(predictors.begin(), predictors.end(), *p) != predictors.end()) {
-        std::cerr << "iplan eval interaction: predictor '" << name << "' named twice\n";
-        return 2;
-      }
-      predictors.push_back(*p);
+  std::stringstream ss(text);
+  std::string name;
+  while (std::getline(ss, name, ',')) {
+    if (name.empty()) continue;
+    const auto p = cell_sim::ParsePredictor(name);
+    if (!p) {
+      std::string known;
+      for (const auto& n : cell_sim::PredictorNames()) known += (known.empty() ? "" : ", ") + n;
+      std::cerr << "iplan eval interaction: unknown predictor '" << name << "' (known: " << known << ")\n";
+      return std::nullopt;
     }
+    if (std::find(predictors.begin(), predictors.end(), *p) != predictors.end()) {
+      std::cerr << "iplan eval interaction: predictor '" << name << "' named twice\n";
+      return std::nullopt;
+    }
+    predictors.push_back(*p);
   }
   if (predictors.empty()) {
     std::cerr << "iplan eval interaction: --predictors names no predictor\n";
-    return 2;
+    return std::nullopt;
   }
+  return predictors;
+}
+
+// The other options; prints why and returns false when one is bad.
+bool CheckOptions(const InteractionOptions& o) {
   if (o.scenarios < 1) {
     std::cerr << "iplan eval interaction: --scenarios must be at least 1, got " << o.scenarios << "\n";
-    return 2;
+    return false;
   }
   if (!(o.time_limit > 0)) {
     std::cerr << "iplan eval interaction: --time-limit must be > 0 s\n";
-    return 2;
+    return false;
   }
   if (o.monitor != "same" && o.monitor != "model") {
     std::cerr << "iplan eval interaction: --monitor-prediction must be 'same' or 'model', got '" << o.monitor << "'\n";
-    return 2;
+    return false;
   }
-  const std::string dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
-  if (dir.empty()) {
-    std::cerr << "iplan eval interaction: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
-    return 2;
-  }
-  // The recorded motion sits beside the checkout (../shared, as the
-  // perception replay's example path says).
-  const std::string recordings_file =
-      o.recordings.empty() ? (fs::path(dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
-                           : o.recordings;
+  return true;
+}
 
-  const auto wall0 = std::chrono::steady_clock::now();
+// What the benchmark loads before it runs.
+struct EvalInputs {
+  std::string dir, recordings_file;
   cell_sim::CellConfig cell;
   intent::SkeletonDataset recordings;
   CellModelResult model;
   std::shared_ptr<const intent::IntentModel> intent_model;
-  try {
-    cell = cell_sim::LoadCellConfig(dir, o.threads);
-    if (!fs::exists(recordings_file)) {
-      throw std::runtime_error("no recorded motion at " + recordings_file + " (set --recordings)");
-    }
-    recordings = intent::LoadSkeletonCsv(recordings_file);
-    // The demo cell's model, trained or taken from the cache exactly as
-    // `iplan demo --prepare-only` does.
-    const std::string fallback = o.model_dir.empty() ? (fs::temp_directory_path() / "iplan-eval-model").string() : o.model_dir;
-    model = EnsureCellModel((fs::path(dir) / "perception.yaml").string(), (fs::path(dir) / "intent.yaml").string(),
-                            fallback, o.retrain);
-    intent_model = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(model.path));
-  } catch (const std::exception& e) {
-    std::cerr << "iplan eval interaction: " << e.what() << "\n";
-    return 2;
-  }
+};
 
-  cell_sim::BenchmarkSetup setup = cell.MakeSetup();
-  setup.intent_model = intent_model;
-  setup.recordings = &recordings;
-  setup.recordings_file = recordings_file;
-  // As perception.replay.joint_map would rename them for this body model.
-  setup.joint_map = {{"wrist_l", "hand_l"}, {"wrist_r", "hand_r"}};
-  setup.time_limit = o.time_limit;
-  setup.loop.max_duration = o.time_limit + 1.0;
-  setup.monitor_input = o.monitor == "same" ? cell_sim::MonitorInput::kSame : cell_sim::MonitorInput::kModel;
-  try {
-    cell_sim::CalibrateBaselines(RecordCellDemonstrations(cell.person), &setup);
-  } catch (const std::exception& e) {
-    std::cerr << "iplan eval interaction: baseline calibration: " << e.what() << "\n";
-    return 2;
+// Loads the cell's configuration, the recorded motion and the intent model
+// (trained or taken from the cache exactly as `iplan demo --prepare-only`
+// does). Throws std::runtime_error.
+void LoadInputs(const InteractionOptions& o, EvalInputs* in) {
+  in->dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
+  if (in->dir.empty()) throw std::runtime_error("no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)");
+  // The recorded motion sits beside the checkout (../shared, as the
+  // perception replay's example path says).
+  in->recordings_file =
+      o.recordings.empty()
+          ? (fs::path(in->dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
+          : o.recordings;
+  in->cell = cell_sim::LoadCellConfig(in->dir, o.threads);
+  if (!fs::exists(in->recordings_file)) {
+    throw std::runtime_error("no recorded motion at " + in->recordings_file + " (set --recordings)");
   }
+  in->recordings = intent::LoadSkeletonCsv(in->recordings_file);
+  const std::string fallback = o.model_dir.empty() ? (fs::temp_directory_path() / "iplan-eval-model").string() : o.model_dir;
+  in->model = EnsureCellModel((fs::path(in->dir) / "perception.yaml").string(), (fs::path(in->dir) / "intent.yaml").string(),
+                              fallback, o.retrain);
+  in->intent_model = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(in->model.path));
+}
 
-  std::vector<cell_sim::ScenarioSpec> specs;
-  try {
-    specs = cell_sim::MakeScenarios(setup, o.scenarios, o.seed);
-  } catch (const std::exception& e) {
-    std::cerr << "iplan eval interaction: " << e.what() << "\n";
-    return 2;
-  }
-
-  std::cout << "iplan eval interaction: " << specs.size() << " scenarios, seed " << o.seed << ", predictors";
+void PrintHeader(const InteractionOptions& o, const EvalInputs& in, const cell_sim::BenchmarkSetup& setup,
+                 const std::vector<Predictor>& predictors, std::size_t num_scenarios) {
+  std::cout << "iplan eval interaction: " << num_scenarios << " scenarios, seed " << o.seed << ", predictors";
   for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
-  std::cout << "\n  configuration " << dir << "\n  recorded motion " << recordings_file << "\n  " << model.summary
+  std::cout << "\n  configuration " << in.dir << "\n  recorded motion " << in.recordings_file << "\n  " << in.model.summary
             << "\n  monitor prediction: "
             << (setup.monitor_input == cell_sim::MonitorInput::kModel ? "the model's, for every predictor"
                                                                         : "the planner's (with none: the model's)")
             << "; planner threads " << (o.threads > 0 ? std::to_string(o.threads) : std::string("as configured"))
             << "\n  baseline covariance growth per joint, fitted on the model's training demonstrations:";
-  const auto& body_joints = cell.body->params().joints;
+  const auto& body_joints = in.cell.body->params().joints;
   for (const auto* b : {&setup.constant_position, &setup.constant_velocity}) {
     std::cout << "\n    " << (b == &setup.constant_position ? "constant-position speed_std m/s:       "
                                                              : "constant-velocity acceleration_std m/s^2:");
@@ -185,116 +169,80 @@ int RunInteraction(const InteractionOptions& o) {
     }
   }
   std::cout << "\n\n";
+}
 
-  std::vector<std::vector<cell_sim::InteractionResult>> results;
-  std::vector<double> cycle_times;
-  Json scenarios = Json::array();
-  for (const auto& s : specs) {
-    if (o.trace >= 0 && s.index != o.trace) continue;
-    const auto t0 = std::chrono::steady_clock::now();
-    if (o.trace >= 0) {
-      setup.loop.trace = [](double t, const std::string& event) {
-        std::cerr << "    " << std::fixed << std::setprecision(2) << std::setw(6) << t << " " << event << "\n";
-      };
-    }
-    try {
-      results.push_back(cell_sim::RunScenario(setup, s, predictors));
-    } catch (const std::exception& e) {
-      std::cerr << "iplan eval interaction: scenario " << s.index << ": " << e.what() << "\n";
-      return 1;
-    }
-    const auto& row = results.back();
-    if (!o.quiet) {
-      std::cerr << "  scenario " << std::setw(3) << s.index + 1 << "/" << specs.size() << " " << s.source << " "
-                << s.sequence.substr(0, 24) << ", " << s.task << " from " << s.start << ":";
-      for (std::size_t p = 0; p < predictors.size(); ++p) {
-        std::cerr << " " << cell_sim::ToString(predictors[p]) << " " << Fixed(row[p].task_time, 1) << " s/"
-                  << row[p].protective_stops << "st";
-      }
-      std::cerr << " (" << Fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1)
-                << " s)\n";
-    }
-    for (std::size_t p = 0; p < predictors.size(); ++p) {
-      const cell_sim::InteractionResult& r = row[p];
-      cycle_times.insert(cycle_times.end(), r.planning_times.begin(), r.planning_times.end());
-      Json j;
-      j["scenario"] = s.index;
-      j["predictor"] = cell_sim::ToString(predictors[p]);
-      j["source"] = s.source;
-      j["subject"] = s.subject;
-      j["sequence"] = s.sequence;
-      j["placement_m"] = VectorJson(s.placement_W);
-      j["yaw_rad"] = s.yaw;
-      if (s.source == "recorded") j["clip_start_s"] = s.clip_start;
-      j["delay_s"] = s.delay;
-      j["task"] = s.task;
-      j["start"] = s.start;
-      j["start_q"] = VectorJson(s.start_q);
-      j["goal_q"] = VectorJson(s.goal_q);
-      if (s.retreat_q.size() > 0) j["retreat_q"] = VectorJson(s.retreat_q);
-      if (s.task == "reach") j["reach_p_m"] = VectorJson(s.reach_p_WE);
-      j["noise_seed"] = s.seed;
-      j["succeeded"] = r.finished && r.status == trajopt::TaskStatus::kSucceeded;
-      if (!r.reason.empty()) j["reason"] = r.reason;
-      j["task_time_s"] = r.task_time;
-      j["protective_stops"] = r.protective_stops;
-      j["stops_by_separation"] = r.stops_separation;
-      j["stops_by_bound"] = r.stops_bound;
-      j["stop_time_s"] = r.stop_time;
-      j["min_separation_m"] = r.min_separation;
-      j["max_bound"] = r.max_bound;
-      j["true_contacts"] = r.true_contacts;
-      j["waits"] = r.waits;
-      j["planner_delay_s"] = r.planner_delay;
-      if (!r.first_stop_reason.empty()) j["first_stop"] = r.first_stop_reason;
-      scenarios.push_back(std::move(j));
-    }
-  }
+// One scenario's run with one predictor, for the JSON.
+Json ScenarioJson(const cell_sim::ScenarioSpec& s, Predictor predictor, const cell_sim::InteractionResult& r) {
+  Json j;
+  j["scenario"] = s.index;
+  j["predictor"] = cell_sim::ToString(predictor);
+  j["source"] = s.source;
+  j["subject"] = s.subject;
+  j["sequence"] = s.sequence;
+  j["placement_m"] = VectorJson(s.placement_W);
+  j["yaw_rad"] = s.yaw;
+  if (s.source == "recorded") j["clip_start_s"] = s.clip_start;
+  j["delay_s"] = s.delay;
+  j["task"] = s.task;
+  j["start"] = s.start;
+  j["start_q"] = VectorJson(s.start_q);
+  j["goal_q"] = VectorJson(s.goal_q);
+  if (s.retreat_q.size() > 0) j["retreat_q"] = VectorJson(s.retreat_q);
+  if (s.task == "reach") j["reach_p_m"] = VectorJson(s.reach_p_WE);
+  j["noise_seed"] = s.seed;
+  j["succeeded"] = r.finished && r.status == trajopt::TaskStatus::kSucceeded;
+  if (!r.reason.empty()) j["reason"] = r.reason;
+  j["task_time_s"] = r.task_time;
+  j["protective_stops"] = r.protective_stops;
+  j["stops_by_separation"] = r.stops_separation;
+  j["stops_by_bound"] = r.stops_bound;
+  j["stop_time_s"] = r.stop_time;
+  j["min_separation_m"] = r.min_separation;
+  j["max_bound"] = r.max_bound;
+  j["true_contacts"] = r.true_contacts;
+  j["waits"] = r.waits;
+  j["planner_delay_s"] = r.planner_delay;
+  if (!r.first_stop_reason.empty()) j["first_stop"] = r.first_stop_reason;
+  return j;
+}
 
-  const std::vector<cell_sim::PredictorSummary> summary = cell_sim::Summarize(predictors, results);
-  Json per = Json::object();
-  for (const auto& s : summary) {
-    Json j;
-    j["scenarios"] = s.scenarios;
-    j["succeeded"] = s.succeeded;
-    j["task_time_s"] = SpreadJson(s.task_time);
-    Json stops = SpreadJson(s.protective_stops);
-    stops["total"] = s.protective_stops_total;
-    stops["by_separation"] = s.stops_separation_total;
-    stops["by_bound"] = s.stops_bound_total;
-    j["protective_stops"] = stops;
-    Json stop_time = SpreadJson(s.stop_time);
-    stop_time["total"] = s.stop_time_total;
-    j["stop_time_s"] = stop_time;
-    j["min_separation_m"] = SpreadJson(s.min_separation);
-    j["max_bound"] = SpreadJson(s.max_bound);
-    j["true_contacts"] = s.true_contacts;
-    if (s.has_reference) {
-      j["vs_none"] = Json{{"task_time_median_ratio", RatioJson(s.task_time_median_ratio)},
-                          {"task_time_paired_ratio", SpreadJson(s.task_time_ratio)},
-                          {"protective_stops_ratio", RatioJson(s.protective_stops_ratio)},
-                          {"stop_time_ratio", RatioJson(s.stop_time_ratio)}};
-    }
-    per[cell_sim::ToString(s.predictor)] = std::move(j);
+// One predictor's summary, for the JSON.
+Json SummaryJson(const cell_sim::PredictorSummary& s) {
+  Json j;
+  j["scenarios"] = s.scenarios;
+  j["succeeded"] = s.succeeded;
+  j["task_time_s"] = SpreadJson(s.task_time);
+  Json stops = SpreadJson(s.protective_stops);
+  stops["total"] = s.protective_stops_total;
+  stops["by_separation"] = s.stops_separation_total;
+  stops["by_bound"] = s.stops_bound_total;
+  j["protective_stops"] = stops;
+  Json stop_time = SpreadJson(s.stop_time);
+  stop_time["total"] = s.stop_time_total;
+  j["stop_time_s"] = stop_time;
+  j["min_separation_m"] = SpreadJson(s.min_separation);
+  j["max_bound"] = SpreadJson(s.max_bound);
+  j["true_contacts"] = s.true_contacts;
+  if (s.has_reference) {
+    j["vs_none"] = Json{{"task_time_median_ratio", RatioJson(s.task_time_median_ratio)},
+                        {"task_time_paired_ratio", SpreadJson(s.task_time_ratio)},
+                        {"protective_stops_ratio", RatioJson(s.protective_stops_ratio)},
+                        {"stop_time_ratio", RatioJson(s.stop_time_ratio)}};
   }
-  Json doc;
-  doc["command"] = "iplan eval interaction";
-  doc["seed"] = o.seed;
-  doc["num_scenarios"] = specs.size();
-  doc["monitor_prediction"] = o.monitor;
-  doc["time_limit_s"] = o.time_limit;
-  doc["recordings"] = fs::path(recordings_file).filename().string();
+  return j;
+}
+
+Json GrowthJson(const cell_sim::BenchmarkSetup& setup, const std::vector<std::string>& body_joints) {
   Json growth = Json::object();
   for (const auto* b : {&setup.constant_position, &setup.constant_velocity}) {
     Json g = Json::object();
     for (std::size_t j = 0; j < b->joint_growth.size(); ++j) g[body_joints[j]] = b->joint_growth[j];
     growth[b == &setup.constant_position ? "constant-position_speed_std_m_s" : "constant-velocity_acceleration_std_m_s2"] = g;
   }
-  doc["baseline_growth"] = std::move(growth);
-  doc["predictors"] = std::move(per);
-  doc["scenarios"] = std::move(scenarios);
+  return growth;
+}
 
-  // The table.
+void PrintTable(const std::vector<cell_sim::PredictorSummary>& summary) {
   const int w = 19;
   std::cout << std::left << std::setw(w) << "predictor" << std::setw(24) << "task time s" << std::setw(20)
             << "stops tot sep/bnd" << std::setw(24) << "time in stop s" << std::setw(24) << "min separation m"
@@ -308,22 +256,114 @@ int RunInteraction(const InteractionOptions& o) {
               << std::setw(24) << SpreadText(s.max_bound, 3) << std::setw(9) << s.true_contacts << s.succeeded << "/"
               << s.scenarios << "\n";
   }
-  if (!summary.empty() && summary.front().has_reference) {
-    std::cout << "\npaired against none: task time (median of per-scenario ratios [p10, p90]; ratio of medians),\n"
-              << "protective stops and time in stop (ratio of totals)\n";
-    for (const auto& s : summary) {
-      std::cout << "  " << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
-                << SpreadText(s.task_time_ratio, 2) << std::setw(8) << Fixed(s.task_time_median_ratio, 2)
-                << " stops " << std::setw(8) << Fixed(s.protective_stops_ratio, 2) << " stop time "
-                << Fixed(s.stop_time_ratio, 2) << "\n";
+  if (summary.empty() || !summary.front().has_reference) return;
+  std::cout << "\npaired against none: task time (median of per-scenario ratios [p10, p90]; ratio of medians),\n"
+            << "protective stops and time in stop (ratio of totals)\n";
+  for (const auto& s : summary) {
+    std::cout << "  " << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
+              << SpreadText(s.task_time_ratio, 2) << std::setw(8) << Fixed(s.task_time_median_ratio, 2)
+              << " stops " << std::setw(8) << Fixed(s.protective_stops_ratio, 2) << " stop time "
+              << Fixed(s.stop_time_ratio, 2) << "\n";
+  }
+}
+
+// Runs every scenario with every predictor: results per scenario, the
+// planning cycle times, and the scenarios' JSON. Returns false on a failure
+// (printed).
+bool RunScenarios(const InteractionOptions& o, const std::vector<Predictor>& predictors,
+                  const std::vector<cell_sim::ScenarioSpec>& specs, cell_sim::BenchmarkSetup* setup,
+                  std::vector<std::vector<cell_sim::InteractionResult>>* results, std::vector<double>* cycle_times,
+                  Json* scenarios) {
+  for (const auto& s : specs) {
+    if (o.trace >= 0 && s.index != o.trace) continue;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (o.trace >= 0) {
+      setup->loop.trace = [](double t, const std::string& event) {
+        std::cerr << "    " << std::fixed << std::setprecision(2) << std::setw(6) << t << " " << event << "\n";
+      };
+    }
+    try {
+      results->push_back(cell_sim::RunScenario(*setup, s, predictors));
+    } catch (const std::exception& e) {
+      std::cerr << "iplan eval interaction: scenario " << s.index << ": " << e.what() << "\n";
+      return false;
+    }
+    const auto& row = results->back();
+    if (!o.quiet) {
+      std::cerr << "  scenario " << std::setw(3) << s.index + 1 << "/" << specs.size() << " " << s.source << " "
+                << s.sequence.substr(0, 24) << ", " << s.task << " from " << s.start << ":";
+      for (std::size_t p = 0; p < predictors.size(); ++p) {
+        std::cerr << " " << cell_sim::ToString(predictors[p]) << " " << Fixed(row[p].task_time, 1) << " s/"
+                  << row[p].protective_stops << "st";
+      }
+      std::cerr << " (" << Fixed(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 1)
+                << " s)\n";
+    }
+    for (std::size_t p = 0; p < predictors.size(); ++p) {
+      cycle_times->insert(cycle_times->end(), row[p].planning_times.begin(), row[p].planning_times.end());
+      scenarios->push_back(ScenarioJson(s, predictors[p], row[p]));
     }
   }
+  return true;
+}
+
+int RunInteraction(const InteractionOptions& o) {
+  // Options first: a bad request is refused before anything is loaded.
+  const std::optional<std::vector<Predictor>> parsed = ParsePredictors(o.predictors);
+  if (!parsed || !CheckOptions(o)) return 2;
+  const std::vector<Predictor>& predictors = *parsed;
+  const auto wall0 = std::chrono::steady_clock::now();
+  EvalInputs in;
+  cell_sim::BenchmarkSetup setup;
+  std::vector<cell_sim::ScenarioSpec> specs;
+  try {
+    LoadInputs(o, &in);
+    setup = in.cell.MakeSetup();
+    setup.intent_model = in.intent_model;
+    setup.recordings = &in.recordings;
+    setup.recordings_file = in.recordings_file;
+    // As perception.replay.joint_map would rename them for this body model.
+    setup.joint_map = {{"wrist_l", "hand_l"}, {"wrist_r", "hand_r"}};
+    setup.time_limit = o.time_limit;
+    setup.loop.max_duration = o.time_limit + 1.0;
+    setup.monitor_input = o.monitor == "same" ? cell_sim::MonitorInput::kSame : cell_sim::MonitorInput::kModel;
+    try {
+      cell_sim::CalibrateBaselines(RecordCellDemonstrations(in.cell.person), &setup);
+    } catch (const std::exception& e) {
+      throw std::runtime_error(std::string("baseline calibration: ") + e.what());
+    }
+    specs = cell_sim::MakeScenarios(setup, o.scenarios, o.seed);
+  } catch (const std::exception& e) {
+    std::cerr << "iplan eval interaction: " << e.what() << "\n";
+    return 2;
+  }
+  PrintHeader(o, in, setup, predictors, specs.size());
+
+  std::vector<std::vector<cell_sim::InteractionResult>> results;
+  std::vector<double> cycle_times;
+  Json scenarios = Json::array();
+  if (!RunScenarios(o, predictors, specs, &setup, &results, &cycle_times, &scenarios)) return 1;
+
+  const std::vector<cell_sim::PredictorSummary> summary = cell_sim::Summarize(predictors, results);
+  Json per = Json::object();
+  for (const auto& s : summary) per[cell_sim::ToString(s.predictor)] = SummaryJson(s);
+  Json doc;
+  doc["command"] = "iplan eval interaction";
+  doc["seed"] = o.seed;
+  doc["num_scenarios"] = specs.size();
+  doc["monitor_prediction"] = o.monitor;
+  doc["time_limit_s"] = o.time_limit;
+  doc["recordings"] = fs::path(in.recordings_file).filename().string();
+  doc["baseline_growth"] = GrowthJson(setup, in.cell.body->params().joints);
+  doc["predictors"] = std::move(per);
+  doc["scenarios"] = std::move(scenarios);
+
+  PrintTable(summary);
   const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
   std::sort(cycle_times.begin(), cycle_times.end());
   std::cout << "\nwall time " << Fixed(wall, 1) << " s; planning cycles " << cycle_times.size() << ", p50 "
             << Fixed(1e3 * core::QuantileSorted(cycle_times, 0.5), 1) << " ms, p99 "
             << Fixed(1e3 * core::QuantileSorted(cycle_times, 0.99), 1) << " ms (wall time, not in the JSON)\n";
-
   if (!o.json_file.empty()) {
     try {
       core::WriteFileAtomically(o.json_file, doc.dump(2) + "\n");
