@@ -52,38 +52,40 @@ double LargestPermitGap(const CellHarness& cell, const std::string& source, Cloc
   return last ? gap : 1e9;
 }
 
-TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCounters) {
-  CellHarness cell("cell-attack-" + GetParam().name, GetParam().vendor, 91);
-  ASSERT_TRUE(cell.ready());
-  framework::Node& node = cell.node();
-  using SI = const dds::SampleInfo&;
-  std::optional<msg::TaskCommand> running;  // the supervisor's latest START
-  node.Subscribe(framework::topics::TaskCommand(), std::function<void(const msg::TaskCommand&, SI)>(
-                                                       [&](const msg::TaskCommand& c, SI) {
-                                                         if (c.command == msg::TaskCommand::START) running = c;
-                                                       }),
-                 framework::SubscribeOptions{false});
-  std::optional<msg::HumanSkeleton> skeleton;
-  node.Subscribe(framework::topics::HumanSkeleton(),
-                 std::function<void(const msg::HumanSkeleton&, SI)>([&](const msg::HumanSkeleton& s, SI) { skeleton = s; }));
-  int predictions = 0;
-  node.Subscribe(framework::topics::HumanPrediction(),
-                 std::function<void(const msg::HumanPrediction&, SI)>([&](const msg::HumanPrediction&, SI) { ++predictions; }));
+// One run: the cell, what the test process sees of it, and the stranger.
+// Each phase is a method; the test stops at the first fatal failure.
+class AttackRun {
+ public:
+  explicit AttackRun(const Variant& v)
+      : vendor_(v.vendor),
+        cell("cell-attack-" + v.name, v.vendor, 91),
+        rogue_("rogue", v.vendor, cell.domain()),
+        permit_w(rogue_.node->Advertise(framework::topics::SafetyPermit())),
+        traj_w(rogue_.node->Advertise(framework::topics::RobotTrajectory())),
+        risk_w(rogue_.node->Advertise(framework::topics::CollisionRisk())),
+        cmd_w(rogue_.node->Advertise(framework::topics::TaskCommand())),
+        outcome_w(rogue_.node->Advertise(framework::topics::TaskOutcome())),
+        skel_w(rogue_.node->Advertise(framework::topics::HumanSkeleton())) {}
 
-  // The stranger: a participant of its own, named like none of the services.
-  TestNode rogue("rogue", GetParam().vendor, cell.domain());
-  framework::Node& r = *rogue.node;
-  auto& permit_w = r.Advertise(framework::topics::SafetyPermit());
-  auto& traj_w = r.Advertise(framework::topics::RobotTrajectory());
-  auto& risk_w = r.Advertise(framework::topics::CollisionRisk());
-  auto& cmd_w = r.Advertise(framework::topics::TaskCommand());
-  auto& outcome_w = r.Advertise(framework::topics::TaskOutcome());
-  auto& skel_w = r.Advertise(framework::topics::HumanSkeleton());
+  void Start() {
+    ASSERT_TRUE(cell.ready());
+    framework::Node& node = cell.node();
+    using SI = const dds::SampleInfo&;
+    node.Subscribe(framework::topics::TaskCommand(), std::function<void(const msg::TaskCommand&, SI)>(
+                                                         [this](const msg::TaskCommand& c, SI) {
+                                                           if (c.command == msg::TaskCommand::START) running = c;
+                                                         }),
+                   framework::SubscribeOptions{false});
+    node.Subscribe(framework::topics::HumanSkeleton(), std::function<void(const msg::HumanSkeleton&, SI)>(
+                                                           [this](const msg::HumanSkeleton& s, SI) { skeleton = s; }));
+    node.Subscribe(framework::topics::HumanPrediction(), std::function<void(const msg::HumanPrediction&, SI)>(
+                                                             [this](const msg::HumanPrediction&, SI) { ++predictions; }));
+    cell.StartAll();
+    ASSERT_TRUE(cell.SpinUntil([&] { return cell.outcomes().size() >= 1 && cell.Moving(); }, 120s))
+        << "the cell does not work; supervisor: " << cell.LastReason("supervisor") << "\n" << cell.Logs("supervisor");
+  }
 
-  cell.StartAll();
-  ASSERT_TRUE(cell.SpinUntil([&] { return cell.outcomes().size() >= 1 && cell.Moving(); }, 120s))
-      << "the cell does not work; supervisor: " << cell.LastReason("supervisor") << "\n" << cell.Logs("supervisor");
-
+  void StrangerCommandAndOutcome() {
   // 1. A stranger's task command and outcome while a task runs.
   ASSERT_TRUE(running.has_value());
   const uint32_t task = running->task_id;
@@ -117,6 +119,9 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
   EXPECT_LE(cell.DiagNumber("supervisor", "tasks_completed"), completed_before + 1)
       << "the supervisor learned from the stranger's outcomes";
 
+  }
+
+  void StrangerMovesStoppedRobot() {
   // 2. Protective stop (perception frozen), then a stranger tries to move
   // the robot: permits claiming to be the supervisor at 100 Hz, "OK" verdicts
   // at 500 Hz, and a trajectory to somewhere else.
@@ -168,6 +173,9 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
   cell[std::string("perception")].Signal(SIGCONT);
   ASSERT_TRUE(cell.SpinUntil([&] { return cell.Moving(); }, 60s)) << cell.LastReason("supervisor");
 
+  }
+
+  void FutureSkeleton() {
   // 3. One skeleton stamped an hour ahead with the real body's id.
   ASSERT_TRUE(skeleton.has_value());
   const double intent_rejected = cell.DiagNumber("intent", "rejected/rt/iplan/human/skeleton");
@@ -186,6 +194,9 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
     EXPECT_EQ(p.permit.reason.find("prediction: no usable sample"), std::string::npos) << p.permit.reason;
   }
 
+  }
+
+  void HugeSkeletons() {
   // 4. Huge skeletons: 20,000 joints (about 2.3 MB), then 5,000 (580 kB):
   // refused by size before any other work, and no monitor misses a permit
   // period over them (50 ms supervisor, 1/15 s collision risk). The readers
@@ -227,7 +238,7 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
       std::cout << joints << "-joint skeleton, " << svc << ": "
                 << (g ? cell.Diag(svc, "last_rejection/rt/iplan/human/skeleton") : "not delivered") << " (" << sends
                 << " sent)\n";
-      if (GetParam().vendor == dds::Vendor::kCyclone) EXPECT_TRUE(g) << svc << " never received one";
+      if (vendor_ == dds::Vendor::kCyclone) EXPECT_TRUE(g) << svc << " never received one";
     }
   }
   EXPECT_GT(refusals, 0) << "no service received a huge skeleton: the case was not exercised";
@@ -238,6 +249,9 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
   EXPECT_LT(sup_gap, 0.2) << "the supervisor missed its permit validity";
   EXPECT_LT(risk_gap, 0.2) << "collision risk missed its permit validity";
 
+  }
+
+  void SupervisorFreezesAtTaskEnd() {
   // 5. Three 4 s supervisor freezes, each right at a task's end (the moment
   // its outcome is out): the cell goes on.
   for (int i = 0; i < 3; ++i) {
@@ -252,6 +266,9 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
         << "\n" << cell.Logs("supervisor");
   }
 
+  }
+
+  void CorruptQTable() {
   // 6. The Q-table: corrupt it under a stopped supervisor, twice, with a save
   // between; a good table is loaded every time.
   for (int round = 0; round < 2; ++round) {
@@ -268,7 +285,39 @@ TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCoun
     cell.SpinFor(500ms);
   }
 
-  cell.ExpectNoContactAndCleanShutdown();
+  }
+
+ private:
+  dds::Vendor vendor_;
+
+ public:
+  CellHarness cell;
+
+ private:
+  TestNode rogue_;  // the stranger: a participant of its own, named like none of the services
+
+ public:
+  dds::Writer<msg::SafetyPermit>& permit_w;
+  dds::Writer<msg::JointTrajectory>& traj_w;
+  dds::Writer<msg::CollisionRisk>& risk_w;
+  dds::Writer<msg::TaskCommand>& cmd_w;
+  dds::Writer<msg::TaskOutcome>& outcome_w;
+  dds::Writer<msg::HumanSkeleton>& skel_w;
+  std::optional<msg::TaskCommand> running;  // the supervisor's latest START
+  std::optional<msg::HumanSkeleton> skeleton;
+  int predictions = 0;
+};
+
+TEST_P(CellAttack, StrangersForgedTimeHugeMessagesAndFreezesChangeNothingButCounters) {
+  AttackRun run(GetParam());
+  ASSERT_NO_FATAL_FAILURE(run.Start());
+  ASSERT_NO_FATAL_FAILURE(run.StrangerCommandAndOutcome());
+  ASSERT_NO_FATAL_FAILURE(run.StrangerMovesStoppedRobot());
+  ASSERT_NO_FATAL_FAILURE(run.FutureSkeleton());
+  ASSERT_NO_FATAL_FAILURE(run.HugeSkeletons());
+  ASSERT_NO_FATAL_FAILURE(run.SupervisorFreezesAtTaskEnd());
+  ASSERT_NO_FATAL_FAILURE(run.CorruptQTable());
+  run.cell.ExpectNoContactAndCleanShutdown();
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellAttack,

@@ -40,6 +40,52 @@ struct Scenario {
   double duration;           // s
 };
 
+// The person standing with the torso at `torso`, as perception publishes it.
+msg::HumanSkeleton SkeletonAt(const msg::Time& stamp, const Eigen::Vector3d& torso) {
+  msg::HumanSkeleton s;
+  s.header.stamp = stamp;
+  s.header.frame_id = "world";
+  s.body_id = 1;
+  s.confidence = 1;
+  const auto joints = Person(torso);
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    msg::HumanJoint h;
+    h.name = kJoints[j];
+    h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
+    h.confidence = 1;
+    s.joints.push_back(h);
+  }
+  return s;
+}
+
+// A one-action constant-velocity prediction from `torso`, 15 steps of 1/15 s,
+// sigma growing from 3 cm by 5 cm per second.
+msg::HumanPrediction PredictionFrom(const msg::Time& stamp, const Eigen::Vector3d& torso, const Eigen::Vector3d& velocity) {
+  msg::HumanPrediction m;
+  m.header.stamp = stamp;
+  m.observation_stamp = stamp;
+  m.header.frame_id = "world";
+  m.body_id = 1;
+  m.time_step = 1.0 / 15;
+  m.num_steps = 15;
+  m.joint_names = kJoints;
+  msg::ActionPrediction a;
+  a.action = "walk_to_robot";
+  a.probability = 1;
+  for (int k = 0; k < 15; ++k) {
+    const double tau = (k + 1) / 15.0;
+    const double var = std::pow(0.03 + 0.05 * tau, 2);
+    for (const auto& j : Person(torso + velocity * tau)) {
+      msg::JointGaussian g;
+      g.mean = {j.x(), j.y(), j.z()};
+      g.covariance = {var, 0, 0, 0, var, 0, 0, 0, var};
+      a.joints.push_back(g);
+    }
+  }
+  m.actions = {a};
+  return m;
+}
+
 std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
   const int domain = UniqueDomain(41 + static_cast<int>(sc.velocity.norm() * 10));
   // The test plays robot, trajectory optimiser, perception and intent from
@@ -89,46 +135,11 @@ std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
       next_js += 20ms;
     }
     if (now >= next_skel) {
-      msg::HumanSkeleton s;
-      s.header.stamp = stamp;
-      s.header.frame_id = "world";
-      s.body_id = 1;
-      s.confidence = 1;
-      const auto joints = Person(torso);
-      for (std::size_t j = 0; j < joints.size(); ++j) {
-        msg::HumanJoint h;
-        h.name = kJoints[j];
-        h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
-        h.confidence = 1;
-        s.joints.push_back(h);
-      }
-      skel.Write(s);
+      skel.Write(SkeletonAt(stamp, torso));
       next_skel += 33ms;
     }
     if (now >= next_pred) {
-      msg::HumanPrediction m;
-      m.header.stamp = stamp;
-      m.observation_stamp = stamp;
-      m.header.frame_id = "world";
-      m.body_id = 1;
-      m.time_step = 1.0 / 15;
-      m.num_steps = 15;
-      m.joint_names = kJoints;
-      msg::ActionPrediction a;
-      a.action = "walk_to_robot";
-      a.probability = 1;
-      for (int k = 0; k < 15; ++k) {
-        const double tau = (k + 1) / 15.0;
-        const double var = std::pow(0.03 + 0.05 * tau, 2);
-        for (const auto& j : Person(torso + sc.velocity * tau)) {
-          msg::JointGaussian g;
-          g.mean = {j.x(), j.y(), j.z()};
-          g.covariance = {var, 0, 0, 0, var, 0, 0, 0, var};
-          a.joints.push_back(g);
-        }
-      }
-      m.actions = {a};
-      pred.Write(m);
+      pred.Write(PredictionFrom(stamp, torso, sc.velocity));
       next_pred += 66ms;
     }
     node.SpinOnce(5ms);

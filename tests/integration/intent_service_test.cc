@@ -90,6 +90,17 @@ class IntentServiceTest : public ::testing::Test {
                            "]\n  rate_hz: " + std::to_string(rate) + "\n  body_timeout: 1.0\n");
   }
 
+  // A perception configuration replaying kPlayed once, moved into W.
+  static std::string ReplayConfig() {
+    std::string seqs;
+    for (const auto& s : kPlayed) seqs += (seqs.empty() ? "" : ", ") + s;
+    return Write("perception.yaml",
+                 "node:\n  diagnostics_period: 0.2\nperception:\n  provider: replay\n  frame_id: world\n  replay:\n"
+                 "    file: " + kCsv + "\n    sequences: [" + seqs + "]\n    loop: false\n    rate: 1.0\n    pause: 0.3\n"
+                 "    start_delay: 2.0\n    joint_map:\n      wrist_l: hand_l\n      wrist_r: hand_r\n"
+                 "    transform:\n      translation: [0.5, -0.2, 0.1]\n      yaw: 0\n");
+  }
+
   static std::string* dir_;
   static intent::IntentModel* model_;
   static intent::SkeletonDataset* played_;
@@ -135,50 +146,118 @@ void SpinFor(framework::Node& node, std::chrono::milliseconds d) {
   while (std::chrono::steady_clock::now() < end) node.SpinOnce(10ms);
 }
 
+// What the observer saw, by stamp (ns): skeletons by their stamp, beliefs
+// and predictions by the stamp of the skeleton they come from.
+struct Observed {
+  std::map<int64_t, msg::HumanSkeleton> skeletons;
+  std::map<int64_t, msg::ActionBelief> beliefs;
+  std::map<int64_t, msg::HumanPrediction> predictions;
+  int duplicate_outputs = 0;
+  void Subscribe(framework::Node& node) {
+    node.Subscribe(framework::topics::HumanSkeleton(),
+                   std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                       [this](const msg::HumanSkeleton& s, const dds::SampleInfo&) {
+                         skeletons[msg::ToNanoseconds(s.header.stamp)] = s;
+                       }));
+    node.Subscribe(framework::topics::ActionBelief(),
+                   std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
+                       [this](const msg::ActionBelief& b, const dds::SampleInfo&) {
+                         // Outputs carry intent's own stamp, never older than the skeleton's.
+                         EXPECT_GE(msg::ToNanoseconds(b.header.stamp), msg::ToNanoseconds(b.observation_stamp));
+                         duplicate_outputs += beliefs.count(msg::ToNanoseconds(b.observation_stamp));
+                         beliefs[msg::ToNanoseconds(b.observation_stamp)] = b;
+                       }));
+    node.Subscribe(framework::topics::HumanPrediction(),
+                   std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
+                       [this](const msg::HumanPrediction& p, const dds::SampleInfo&) {
+                         EXPECT_GE(msg::ToNanoseconds(p.header.stamp), msg::ToNanoseconds(p.observation_stamp));
+                         duplicate_outputs += predictions.count(msg::ToNanoseconds(p.observation_stamp));
+                         predictions[msg::ToNanoseconds(p.observation_stamp)] = p;
+                       }));
+  }
+};
+
+// The belief and prediction made from skeleton `s`: the model's actions, a
+// distribution, SPD covariances, and step 0 near the skeleton. Adds the
+// joints compared to *checked_steps.
+void CheckOutputs(const intent::IntentModel& model, const std::vector<std::string>& joints, const msg::HumanSkeleton& s,
+                  const msg::ActionBelief& belief, const msg::HumanPrediction& pred, int* checked_steps) {
+  EXPECT_EQ(belief.body_id, s.body_id);
+  EXPECT_EQ(pred.body_id, s.body_id);
+  EXPECT_EQ(belief.header.frame_id, "world");
+  ASSERT_EQ(belief.actions, model.actions);
+  ASSERT_EQ(belief.probabilities.size(), model.actions.size());
+  double sum = 0;
+  for (double q : belief.probabilities) {
+    EXPECT_GE(q, 0.0);
+    EXPECT_LE(q, 1.0);
+    sum += q;
+  }
+  EXPECT_NEAR(sum, 1.0, 1e-9);
+  EXPECT_DOUBLE_EQ(pred.time_step, 1.0 / 15.0);
+  ASSERT_EQ(pred.num_steps, 6u);
+  ASSERT_EQ(pred.joint_names, joints);
+  ASSERT_EQ(pred.actions.size(), model.actions.size());
+  // Probability-weighted mean of step 0 for each joint, to compare with the skeleton.
+  std::vector<Eigen::Vector3d> step0(joints.size(), Eigen::Vector3d::Zero());
+  for (std::size_t c = 0; c < pred.actions.size(); ++c) {
+    const auto& a = pred.actions[c];
+    EXPECT_EQ(a.action, model.actions[c]);
+    EXPECT_EQ(a.probability, belief.probabilities[c]);
+    ASSERT_EQ(a.joints.size(), 6u * joints.size());
+    for (std::size_t k = 0; k < a.joints.size(); ++k) {
+      const auto& g = a.joints[k];
+      const Eigen::Vector3d mean(g.mean.x, g.mean.y, g.mean.z);
+      ASSERT_TRUE(mean.allFinite());
+      Eigen::Matrix3d cov;
+      for (int r = 0; r < 3; ++r) {
+        for (int q = 0; q < 3; ++q) cov(r, q) = g.covariance[static_cast<std::size_t>(3 * r + q)];
+      }
+      ASSERT_TRUE(cov.allFinite());
+      EXPECT_LT((cov - cov.transpose()).cwiseAbs().maxCoeff(), 1e-12);
+      EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues().minCoeff(), 0.0);
+      if (k < joints.size()) step0[k] += a.probability * mean;
+    }
+  }
+  // One step (67 ms) ahead the person is still near where they were.
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    for (const auto& sj : s.joints) {
+      if (sj.name != joints[j]) continue;
+      EXPECT_LT((step0[j] - Eigen::Vector3d(sj.position.x, sj.position.y, sj.position.z)).norm(), 0.25)
+          << joints[j] << " at stamp " << msg::ToNanoseconds(s.header.stamp);
+      ++*checked_steps;
+    }
+  }
+}
+
+// Within a body, stamps keep the recorded spacing (scaled by rate 1); one
+// body per played sequence.
+void ExpectRecordedSpacing(const std::map<int64_t, msg::HumanSkeleton>& skeletons, const intent::SkeletonSequence& seq0) {
+  std::map<uint32_t, std::vector<int64_t>> by_body;
+  for (const auto& [stamp, s] : skeletons) by_body[s.body_id].push_back(stamp);
+  EXPECT_EQ(by_body.size(), kPlayed.size());
+  const auto& body1 = by_body[1];
+  ASSERT_EQ(body1.size(), static_cast<std::size_t>(seq0.time.size()));
+  EXPECT_NEAR((body1.back() - body1.front()) * 1e-9, seq0.time(seq0.time.size() - 1) - seq0.time(0), 1e-6);
+}
+
 TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) {
   const int domain = UniqueDomain(11);
   TestNode observer("observer", dds::Vendor::kCyclone, domain);
   framework::Node& node = *observer.node;
   Diagnostics diag;
   diag.Subscribe(node);
-  std::map<int64_t, msg::HumanSkeleton> skeletons;  // by stamp (ns)
-  std::map<int64_t, msg::ActionBelief> beliefs;
-  std::map<int64_t, msg::HumanPrediction> predictions;
-  int duplicate_outputs = 0;
-  node.Subscribe(framework::topics::HumanSkeleton(),
-                 std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
-                     [&](const msg::HumanSkeleton& s, const dds::SampleInfo&) {
-                       skeletons[msg::ToNanoseconds(s.header.stamp)] = s;
-                     }));
-  node.Subscribe(framework::topics::ActionBelief(),
-                 std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
-                     [&](const msg::ActionBelief& b, const dds::SampleInfo&) {
-                       // Outputs carry intent's own stamp, never older than the skeleton's.
-                       EXPECT_GE(msg::ToNanoseconds(b.header.stamp), msg::ToNanoseconds(b.observation_stamp));
-                       duplicate_outputs += beliefs.count(msg::ToNanoseconds(b.observation_stamp));
-                       beliefs[msg::ToNanoseconds(b.observation_stamp)] = b;
-                     }));
-  node.Subscribe(framework::topics::HumanPrediction(),
-                 std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
-                     [&](const msg::HumanPrediction& p, const dds::SampleInfo&) {
-                       EXPECT_GE(msg::ToNanoseconds(p.header.stamp), msg::ToNanoseconds(p.observation_stamp));
-                       duplicate_outputs += predictions.count(msg::ToNanoseconds(p.observation_stamp));
-                       predictions[msg::ToNanoseconds(p.observation_stamp)] = p;
-                     }));
-
+  Observed seen;
+  seen.Subscribe(node);
+  const auto& skeletons = seen.skeletons;
+  const auto& beliefs = seen.beliefs;
+  const auto& predictions = seen.predictions;
   const std::vector<std::string>& joints = model_->config.joints.joints;
   Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",
                   "cyclonedds", "--domain", std::to_string(domain)});
   ASSERT_TRUE(SpinUntil(node, 30s, [&] { return diag.state["intent"] == "active"; })) << intent.Stderr();
 
-  std::string seqs;
-  for (const auto& s : kPlayed) seqs += (seqs.empty() ? "" : ", ") + s;
-  const std::string perception_yaml = Write(
-      "perception.yaml",
-      "node:\n  diagnostics_period: 0.2\nperception:\n  provider: replay\n  frame_id: world\n  replay:\n"
-      "    file: " + kCsv + "\n    sequences: [" + seqs + "]\n    loop: false\n    rate: 1.0\n    pause: 0.3\n"
-      "    start_delay: 2.0\n    joint_map:\n      wrist_l: hand_l\n      wrist_r: hand_r\n"
-      "    transform:\n      translation: [0.5, -0.2, 0.1]\n      yaw: 0\n");
+  const std::string perception_yaml = ReplayConfig();
   Process perception({BinPath("iplan-perception"), "--config", perception_yaml, "--dds", "fastdds", "--domain",
                       std::to_string(domain)});
   ASSERT_TRUE(SpinUntil(node, 60s, [&] { return diag.Get("perception", "replay_finished") == "true"; }))
@@ -192,7 +271,7 @@ TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) 
   }
   EXPECT_EQ(diag.Get("perception", "published"), std::to_string(frames));
   ASSERT_GE(static_cast<int>(skeletons.size()), frames - 2) << "observer missed skeletons";
-  EXPECT_EQ(duplicate_outputs, 0);
+  EXPECT_EQ(seen.duplicate_outputs, 0);
 
   // The first frame of the first sequence: renamed joints, moved into W.
   const msg::HumanSkeleton& first = skeletons.begin()->second;
@@ -217,53 +296,7 @@ TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) 
     const auto p = predictions.find(stamp);
     if (b == beliefs.end() || p == predictions.end()) continue;
     ++matched;
-    EXPECT_EQ(b->second.body_id, s.body_id);
-    EXPECT_EQ(p->second.body_id, s.body_id);
-    EXPECT_EQ(b->second.header.frame_id, "world");
-    ASSERT_EQ(b->second.actions, model_->actions);
-    ASSERT_EQ(b->second.probabilities.size(), model_->actions.size());
-    double sum = 0;
-    for (double q : b->second.probabilities) {
-      EXPECT_GE(q, 0.0);
-      EXPECT_LE(q, 1.0);
-      sum += q;
-    }
-    EXPECT_NEAR(sum, 1.0, 1e-9);
-    const msg::HumanPrediction& pred = p->second;
-    EXPECT_DOUBLE_EQ(pred.time_step, 1.0 / 15.0);
-    ASSERT_EQ(pred.num_steps, 6u);
-    ASSERT_EQ(pred.joint_names, joints);
-    ASSERT_EQ(pred.actions.size(), model_->actions.size());
-    // Probability-weighted mean of step 0 for each joint, to compare with the skeleton.
-    std::vector<Eigen::Vector3d> step0(joints.size(), Eigen::Vector3d::Zero());
-    for (std::size_t c = 0; c < pred.actions.size(); ++c) {
-      const auto& a = pred.actions[c];
-      EXPECT_EQ(a.action, model_->actions[c]);
-      EXPECT_EQ(a.probability, b->second.probabilities[c]);
-      ASSERT_EQ(a.joints.size(), 6u * joints.size());
-      for (std::size_t k = 0; k < a.joints.size(); ++k) {
-        const auto& g = a.joints[k];
-        const Eigen::Vector3d mean(g.mean.x, g.mean.y, g.mean.z);
-        ASSERT_TRUE(mean.allFinite());
-        Eigen::Matrix3d cov;
-        for (int r = 0; r < 3; ++r) {
-          for (int q = 0; q < 3; ++q) cov(r, q) = g.covariance[static_cast<std::size_t>(3 * r + q)];
-        }
-        ASSERT_TRUE(cov.allFinite());
-        EXPECT_LT((cov - cov.transpose()).cwiseAbs().maxCoeff(), 1e-12);
-        EXPECT_GT(Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvalues().minCoeff(), 0.0);
-        if (k < joints.size()) step0[k] += a.probability * mean;
-      }
-    }
-    // One step (67 ms) ahead the person is still near where they were.
-    for (std::size_t j = 0; j < joints.size(); ++j) {
-      for (const auto& sj : s.joints) {
-        if (sj.name != joints[j]) continue;
-        EXPECT_LT((step0[j] - Eigen::Vector3d(sj.position.x, sj.position.y, sj.position.z)).norm(), 0.25)
-            << joints[j] << " at stamp " << stamp;
-        ++checked_steps;
-      }
-    }
+    ASSERT_NO_FATAL_FAILURE(CheckOutputs(*model_, joints, s, b->second, p->second, &checked_steps));
   }
   EXPECT_GE(matched, static_cast<int>(skeletons.size()) - 2) << "skeletons without a belief and prediction";
   std::cout << frames << " frames replayed, " << skeletons.size() << " skeletons seen, " << matched
@@ -275,14 +308,7 @@ TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) 
   for (const auto& [stamp, b] : beliefs) unknown_stamps += skeletons.count(stamp) ? 0 : 1;
   EXPECT_LE(unknown_stamps, frames - static_cast<int>(skeletons.size()));
 
-  // Within a body, stamps keep the recorded spacing (scaled by rate 1).
-  std::map<uint32_t, std::vector<int64_t>> by_body;
-  for (const auto& [stamp, s] : skeletons) by_body[s.body_id].push_back(stamp);
-  EXPECT_EQ(by_body.size(), kPlayed.size());
-  const auto& body1 = by_body[1];
-  ASSERT_EQ(body1.size(), static_cast<std::size_t>(seq0.time.size()));
-  EXPECT_NEAR((body1.back() - body1.front()) * 1e-9, seq0.time(seq0.time.size() - 1) - seq0.time(0), 1e-6);
-
+  ExpectRecordedSpacing(skeletons, seq0);
   EXPECT_EQ(diag.Get("intent", "frames_rejected"), "0");
   EXPECT_GE(std::stoi(diag.Get("intent", "frames_accepted")), matched);
   EXPECT_EQ(diag.Get("intent", "rejected/" + kSkeletonTopic), "0");
@@ -312,6 +338,48 @@ msg::HumanSkeleton Skeleton(uint32_t body, const std::vector<std::string>& names
   return s;
 }
 
+// Writes a skeleton and gives the service time to answer.
+void Send(framework::Node& node, dds::Writer<msg::HumanSkeleton>& w, const msg::HumanSkeleton& s) {
+  ASSERT_TRUE(w.Write(s));
+  SpinFor(node, 60ms);
+}
+
+// Three good skeletons of body 500; garbage the boundary refuses (NaN, no
+// joints, a duplicate joint) and the core refuses (no model joint, one
+// missing, one at (0, 0, 0)); a fourth good one; then a backwards stamp on
+// the same writer (boundary) and an older stamp for body 500 from writer b
+// (core).
+void SendGoodAndGarbage(framework::Node& node, dds::Writer<msg::HumanSkeleton>& a, dds::Writer<msg::HumanSkeleton>& b,
+                        const std::vector<std::string>& joints) {
+  const double nan = std::numeric_limits<double>::quiet_NaN();
+  for (int i = 0; i < 3; ++i) Send(node, a, Skeleton(500, joints, msg::Now()));  // good: 3 outputs
+
+  msg::HumanSkeleton bad = Skeleton(501, joints, msg::Now());
+  bad.joints[2].position.y = nan;  // boundary check: non-finite
+  Send(node, a, bad);
+  bad = Skeleton(502, {}, msg::Now());  // boundary check: no joints
+  Send(node, a, bad);
+  bad = Skeleton(503, joints, msg::Now());
+  bad.joints.push_back(bad.joints[0]);  // boundary check: duplicate joint name
+  Send(node, a, bad);
+  std::vector<std::string> wrong = joints;
+  for (auto& n : wrong) n = "openpose_" + n;
+  Send(node, a, Skeleton(504, wrong, msg::Now()));  // core: no model joint
+  bad = Skeleton(505, joints, msg::Now());
+  bad.joints.pop_back();  // core: one model joint missing
+  Send(node, a, bad);
+  bad = Skeleton(506, joints, msg::Now());
+  bad.joints[1].position = {};  // core: (0, 0, 0) is "not detected"
+  Send(node, a, bad);
+  const msg::Time last_good_stamp = msg::Now();
+  Send(node, a, Skeleton(500, joints, last_good_stamp));  // good: output 4
+  // Backwards stamp on the same writer: boundary check.
+  Send(node, a, Skeleton(507, joints, msg::TimeFromSeconds(msg::ToSeconds(msg::Now()) - 1.0)));
+  // Another writer (first stamp of its own is accepted by the boundary check)
+  // repeats body 500 at an older stamp: the core rejects it.
+  Send(node, b, Skeleton(500, joints, msg::TimeFromSeconds(msg::ToSeconds(last_good_stamp) - 0.5)));
+}
+
 TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
   const int domain = UniqueDomain(12);
   TestNode garbage("garbage", dds::Vendor::kFastDds, domain);
@@ -339,37 +407,7 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
   })) << intent.Stderr();
   SpinFor(node, 500ms);
 
-  auto send = [&](dds::Writer<msg::HumanSkeleton>& w, const msg::HumanSkeleton& s) {
-    ASSERT_TRUE(w.Write(s));
-    SpinFor(node, 60ms);
-  };
-  const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (int i = 0; i < 3; ++i) send(a, Skeleton(500, joints, msg::Now()));  // good: 3 outputs
-
-  msg::HumanSkeleton bad = Skeleton(501, joints, msg::Now());
-  bad.joints[2].position.y = nan;  // boundary check: non-finite
-  send(a, bad);
-  bad = Skeleton(502, {}, msg::Now());  // boundary check: no joints
-  send(a, bad);
-  bad = Skeleton(503, joints, msg::Now());
-  bad.joints.push_back(bad.joints[0]);  // boundary check: duplicate joint name
-  send(a, bad);
-  std::vector<std::string> wrong = joints;
-  for (auto& n : wrong) n = "openpose_" + n;
-  send(a, Skeleton(504, wrong, msg::Now()));  // core: no model joint
-  bad = Skeleton(505, joints, msg::Now());
-  bad.joints.pop_back();  // core: one model joint missing
-  send(a, bad);
-  bad = Skeleton(506, joints, msg::Now());
-  bad.joints[1].position = {};  // core: (0, 0, 0) is "not detected"
-  send(a, bad);
-  const msg::Time last_good_stamp = msg::Now();
-  send(a, Skeleton(500, joints, last_good_stamp));  // good: output 4
-  // Backwards stamp on the same writer: boundary check.
-  send(a, Skeleton(507, joints, msg::TimeFromSeconds(msg::ToSeconds(msg::Now()) - 1.0)));
-  // Another writer (first stamp of its own is accepted by the boundary check)
-  // repeats body 500 at an older stamp: the core rejects it.
-  send(b, Skeleton(500, joints, msg::TimeFromSeconds(msg::ToSeconds(last_good_stamp) - 0.5)));
+  ASSERT_NO_FATAL_FAILURE(SendGoodAndGarbage(node, a, b, joints));
   SpinFor(node, 1000ms);
 
   EXPECT_TRUE(intent.Running()) << intent.Stderr();
@@ -384,7 +422,7 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
       << diag.Get("intent", "last_rejected_frame");
 
   // Still serving after the garbage.
-  send(a, Skeleton(500, joints, msg::Now()));
+  ASSERT_NO_FATAL_FAILURE(Send(node, a, Skeleton(500, joints, msg::Now())));
   SpinFor(node, 500ms);
   EXPECT_EQ(belief_bodies.count(500), 5u);
 

@@ -48,6 +48,98 @@ struct Result {
   std::string contacts;
 };
 
+// A person standing still with joints `joints`: 10 steps of 0.1 s, 3 cm sigma.
+msg::HumanPrediction StandingPrediction(const msg::Time& stamp, const std::vector<Eigen::Vector3d>& joints) {
+  msg::HumanPrediction m;
+  m.header.stamp = stamp;
+  m.header.frame_id = "world";
+  m.observation_stamp = stamp;
+  m.time_step = 0.1;
+  m.num_steps = 10;
+  m.joint_names = kJoints;
+  msg::ActionPrediction a;
+  a.action = "stand";
+  a.probability = 1;
+  for (int k = 0; k < 10; ++k) {
+    for (const auto& j : joints) {
+      msg::JointGaussian g;
+      g.mean = {j.x(), j.y(), j.z()};
+      g.covariance = {9e-4, 0, 0, 0, 9e-4, 0, 0, 0, 9e-4};
+      a.joints.push_back(g);
+    }
+  }
+  m.actions = {a};
+  return m;
+}
+
+msg::HumanSkeleton SkeletonOf(const msg::Time& stamp, const std::vector<Eigen::Vector3d>& joints) {
+  msg::HumanSkeleton s;
+  s.header.stamp = stamp;
+  s.header.frame_id = "world";
+  s.confidence = 1;
+  for (std::size_t j = 0; j < joints.size(); ++j) {
+    msg::HumanJoint h;
+    h.name = kJoints[j];
+    h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
+    h.confidence = 1;
+    s.joints.push_back(h);
+  }
+  return s;
+}
+
+// The test's subscriptions: trajectories until the outcome, outcomes, and the
+// simulator's true contacts.
+void Observe(framework::Node& node, const bool& started, Result* r) {
+  node.Subscribe(framework::topics::RobotTrajectory(),
+                 std::function<void(const msg::JointTrajectory&, const dds::SampleInfo&)>(
+                     [&started, r](const msg::JointTrajectory& t, const dds::SampleInfo&) {
+                       if (started && !r->outcome) {
+                         ++r->trajectories;
+                         if (!t.points.empty()) r->last_waypoint = t.points.back().positions;
+                       }
+                       EXPECT_EQ(t.joint_names.size(), 7u);
+                     }));
+  node.Subscribe(framework::topics::TaskOutcome(),
+                 std::function<void(const msg::TaskOutcome&, const dds::SampleInfo&)>(
+                     [r](const msg::TaskOutcome& m, const dds::SampleInfo&) {
+                       ++r->outcomes;
+                       (r->outcome ? r->repeated : r->outcome) = m;
+                     }),
+                 framework::SubscribeOptions{false});
+  node.Subscribe(framework::topics::Diagnostics(),
+                 std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
+                     [r](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
+                       for (const auto& s : a.status) {
+                         if (s.name != "robot_sim") continue;
+                         for (const auto& kv : s.values) {
+                           if (kv.key == "true_contacts") r->contacts = kv.value;
+                         }
+                       }
+                     }));
+}
+
+// Where the hand (last link) of the Panda is at kGoal (m, W).
+Eigen::Vector3d GoalHand() {
+  auto model = collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
+  collision::RobotData data(model);
+  collision::CalcForwardKinematics(model, Eigen::Map<const Eigen::VectorXd>(kGoal.data(), 7), &data);
+  return data.X_WL.back().translation();
+}
+
+// Task 42 to kGoal (then `retreat`, if any), 30 s time limit.
+msg::TaskCommand StartCommand(const std::vector<double>& retreat) {
+  msg::TaskCommand c;
+  c.header.stamp = msg::Now();
+  c.task_id = 42;
+  c.task_name = "reach_goal";
+  c.command = msg::TaskCommand::START;
+  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
+  c.goal_positions = kGoal;
+  c.retreat_positions = retreat;
+  c.time_limit = 30;
+  return c;
+}
+
 // Sends one task to the goal kGoal (with `retreat`, if any) while a person
 // stands on the goal for `block_for_s`.
 Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
@@ -67,32 +159,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
   auto& truth = node.Advertise(framework::topics::HumanTruth());
   Result r;
   bool started = false;
-  node.Subscribe(framework::topics::RobotTrajectory(),
-                 std::function<void(const msg::JointTrajectory&, const dds::SampleInfo&)>(
-                     [&](const msg::JointTrajectory& t, const dds::SampleInfo&) {
-                       if (started && !r.outcome) {
-                         ++r.trajectories;
-                         if (!t.points.empty()) r.last_waypoint = t.points.back().positions;
-                       }
-                       EXPECT_EQ(t.joint_names.size(), 7u);
-                     }));
-  node.Subscribe(framework::topics::TaskOutcome(),
-                 std::function<void(const msg::TaskOutcome&, const dds::SampleInfo&)>(
-                     [&](const msg::TaskOutcome& m, const dds::SampleInfo&) {
-                       ++r.outcomes;
-                       (r.outcome ? r.repeated : r.outcome) = m;
-                     }),
-                 framework::SubscribeOptions{false});
-  node.Subscribe(framework::topics::Diagnostics(),
-                 std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
-                     [&](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
-                       for (const auto& s : a.status) {
-                         if (s.name != "robot_sim") continue;
-                         for (const auto& kv : s.values) {
-                           if (kv.key == "true_contacts") r.contacts = kv.value;
-                         }
-                       }
-                     }));
+  Observe(node, started, &r);
   // Both services up: the optimiser reads commands, and a hold trajectory flows.
   const auto up = Clock::now() + 30s;
   while (Clock::now() < up && (cmd.MatchedReaders() == 0 || pred.MatchedReaders() == 0 || truth.MatchedReaders() == 0)) {
@@ -101,20 +168,8 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
   for (int i = 0; i < 20; ++i) node.SpinOnce(20ms);
   EXPECT_GT(cmd.MatchedReaders(), 0) << opt.Stderr();
 
-  auto model = collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
-  collision::RobotData data(model);
-  collision::CalcForwardKinematics(model, Eigen::Map<const Eigen::VectorXd>(kGoal.data(), 7), &data);
-  const Eigen::Vector3d goal_hand = data.X_WL.back().translation();
-
-  msg::TaskCommand c;
-  c.header.stamp = msg::Now();
-  c.task_id = 42;
-  c.task_name = "reach_goal";
-  c.command = msg::TaskCommand::START;
-  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
-  c.goal_positions = kGoal;
-  c.retreat_positions = retreat;
-  c.time_limit = 30;
+  const Eigen::Vector3d goal_hand = GoalHand();
+  msg::TaskCommand c = StartCommand(retreat);
   const auto start = Clock::now();
   auto next = start;
   started = true;
@@ -139,38 +194,8 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
       const Eigen::Vector3d hand = t < block_for_s ? goal_hand : Eigen::Vector3d(1.8, 0.8, 1.0);
       const auto joints = PersonWithHandAt(hand);
       const msg::Time stamp = msg::Now();
-      msg::HumanPrediction m;
-      m.header.stamp = stamp;
-      m.header.frame_id = "world";
-      m.observation_stamp = stamp;
-      m.time_step = 0.1;
-      m.num_steps = 10;
-      m.joint_names = kJoints;
-      msg::ActionPrediction a;
-      a.action = "stand";
-      a.probability = 1;
-      for (int k = 0; k < 10; ++k) {
-        for (const auto& j : joints) {
-          msg::JointGaussian g;
-          g.mean = {j.x(), j.y(), j.z()};
-          g.covariance = {9e-4, 0, 0, 0, 9e-4, 0, 0, 0, 9e-4};
-          a.joints.push_back(g);
-        }
-      }
-      m.actions = {a};
-      pred.Write(m);
-      msg::HumanSkeleton s;
-      s.header.stamp = stamp;
-      s.header.frame_id = "world";
-      s.confidence = 1;
-      for (std::size_t j = 0; j < joints.size(); ++j) {
-        msg::HumanJoint h;
-        h.name = kJoints[j];
-        h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
-        h.confidence = 1;
-        s.joints.push_back(h);
-      }
-      truth.Write(s);
+      pred.Write(StandingPrediction(stamp, joints));
+      truth.Write(SkeletonOf(stamp, joints));
       next += 66ms;
     }
     node.SpinOnce(10ms);

@@ -27,6 +27,7 @@
 #include "../test/test_util.h"
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/collision/human_model.h"
+#include "iplan/collision/scene.h"
 #include "iplan/planning/planner.h"
 
 using namespace iplan;
@@ -268,6 +269,43 @@ void RunReplanning(const Planner& replanner, const std::vector<Problem>& problem
               cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
 }
 
+// Static clearance per configuration, the optimiser's analytic distances
+// (Planner::CalcClearance: FK + every checked sphere-object pair, with the
+// link-ball culling) against FCL (FK + StaticScene::CalcMinimumDistance over
+// every pair), on 500 seeded configurations within the joint limits.
+void CompareClearance(const Planner& planner, const collision::RobotModel& robot) {
+  const collision::StaticScene scene(testing::LoadCell());
+  std::mt19937_64 rng(15);
+  const Eigen::VectorXd lo = robot.LowerLimits(), hi = robot.UpperLimits();
+  std::vector<Eigen::VectorXd> qs;
+  for (int i = 0; i < 500; ++i) {
+    Eigen::VectorXd q(robot.nq);
+    for (int j = 0; j < robot.nq; ++j) q[j] = std::uniform_real_distribution<double>(lo[j], hi[j])(rng);
+    qs.push_back(q);
+  }
+  std::vector<double> radii;
+  for (const auto& sp : robot.spheres) radii.push_back(sp.radius);
+  collision::RobotData data(robot);
+  std::vector<double> analytic, fcl;
+  volatile double sink = 0.0;
+  for (int rep = 0; rep < 5; ++rep) {
+    for (const auto& q : qs) {
+      auto t0 = std::chrono::steady_clock::now();
+      sink = sink + planner.CalcClearance(q);
+      auto t1 = std::chrono::steady_clock::now();
+      collision::CalcForwardKinematics(robot, q, &data);
+      sink = sink + scene.CalcMinimumDistance(data.p_WS, radii).distance;
+      auto t2 = std::chrono::steady_clock::now();
+      analytic.push_back(std::chrono::duration<double>(t1 - t0).count());
+      fcl.push_back(std::chrono::duration<double>(t2 - t1).count());
+    }
+  }
+  std::printf("static clearance per configuration (%zu spheres x %d objects, FK included, %zu calls): "
+              "analytic p50 %.1f us, p99 %.1f us; FCL p50 %.1f us, p99 %.1f us\n",
+              radii.size(), scene.num_objects(), analytic.size(), 1e6 * Pct(analytic, 0.5), 1e6 * Pct(analytic, 0.99),
+              1e6 * Pct(fcl, 0.5), 1e6 * Pct(fcl, 0.99));
+}
+
 // A whole number >= `min` from argv[i], or the default.
 int Argument(int argc, char** argv, int i, int fallback, int min) {
   if (argc <= i) return fallback;
@@ -295,6 +333,7 @@ int main(int argc, char** argv) {
               num_problems, ik_rejected, threads, params.dt, params.horizon);
   std::uint64_t fingerprint = 14695981039346656037ULL;
   for (int nopt : {8, 1}) RunOneShot(planner, problems, nopt, threads, &fingerprint);
+  CompareClearance(planner, robot);
 
   // Replanning cycles with a moving person.
   const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
