@@ -177,10 +177,12 @@ class TrajoptService : public framework::Service {
       last_status_ = r.status;
     }
     node.SetDiagnosticValue("status", r.status);
+    if (r.budget_exhausted) node.SetDiagnosticValue("budget_exhausted_cycles", std::to_string(++budget_exhausted_));
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
 
   double planning_step_ = 0.1;  // s
+  int budget_exhausted_ = 0;    // cycles whose planning ran out of the cycle budget
   bool use_prediction_ = true;
   std::unique_ptr<planning::Planner> planner_;
   std::unique_ptr<collision::HumanBodyModel> body_;

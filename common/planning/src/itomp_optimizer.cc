@@ -79,11 +79,11 @@ void PlannerModel::StartOptimizer(const Problem& at, int o, std::uint64_t seed, 
 void PlannerModel::IterateOptimizer(const Problem& at, int until, Workspace* ws, OptimizerState* st) const {
   const double inv_ws = 1.0 / params.weights.smoothness;
   until = std::min(until, params.max_iterations);
-  while (!st->done && st->iterations < until) {
+  while (!st->done && st->iterations < until && !at.OutOfTime()) {
     const Eigen::MatrixXd D = st->G.middleCols(at.k, at.m) * at.Hinv * inv_ws;
     double alpha = params.step_size;
     bool accepted = false;
-    for (int ls = 0; ls < 6; ++ls) {
+    for (int ls = 0; ls < 6 && !at.OutOfTime(); ++ls) {
       st->Qn = st->Q;
       st->Qn.middleCols(at.k, at.m) -= alpha * D;
       Project(at, &st->Qn);

@@ -28,6 +28,9 @@ std::vector<Candidate> PlannerModel::RunOptimizers(const Problem& at, int num_op
       Workspace* ws = &wss[t];
       for (int o = next.fetch_add(1); o < num_opt; o = next.fetch_add(1)) {
         OptimizerState& s = st[o];
+        // Out of time, optimisers not yet started are left out (an
+        // optimiser that never started has no candidate: cost infinity).
+        if (!s.started && o > 0 && at.OutOfTime()) continue;
         if (!s.started) StartOptimizer(at, o, seed, ws, &s);
         IterateOptimizer(at, until, ws, &s);
         CheckOptimizer(at, ws, &s, t0);
@@ -45,7 +48,7 @@ std::vector<Candidate> PlannerModel::RunOptimizers(const Problem& at, int num_op
       all_done = all_done && s.done;
       any_ok = any_ok || (s.c.static_ok && s.c.safe);
     }
-    if (all_done || any_ok || until >= params.max_iterations) break;
+    if (all_done || any_ok || until >= params.max_iterations || at.OutOfTime()) break;
   }
   std::vector<Candidate> out(num_opt);
   for (int o = 0; o < num_opt; ++o) out[o] = std::move(st[o].c);

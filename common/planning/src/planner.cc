@@ -243,6 +243,8 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     return result;
   }
   Problem at = M.MakeProblem(req, q_goal);
+  if (req.time_budget > 0.0)
+    at.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(req.time_budget));
   // The initial warm start keeps its shape; other first attempts are smoothed.
   const bool warm = req.warm_start.cols() > 1;
   const int wait_steps = std::max(1, static_cast<int>(std::round(P.wait_duration / P.dt)));
@@ -251,6 +253,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
   for (int attempt = 0;; ++attempt) {
     M.PrepareAttempt(&at, !warm && attempt == 0);
     const std::vector<Candidate> cands = M.RunOptimizers(at, num_optimizers, num_threads, seed, t0);
+    result.budget_exhausted = result.budget_exhausted || at.OutOfTime();
     const internal::Selection sel = PlannerModel::Select(cands);
     any_static = any_static || sel.reference >= 0;
     if (sel.winner >= 0) {
@@ -265,8 +268,8 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     best_fail = cands[pick];
     have_fail = true;
     result.winning_optimizer = pick;
-    // Waiting helps only against the person.
-    if (at.prediction == nullptr || result.num_waits >= P.max_waits) break;
+    // Waiting helps only against the person, and takes another attempt.
+    if (at.prediction == nullptr || result.num_waits >= P.max_waits || at.OutOfTime()) break;
     M.InsertWait(&at, sel.reference >= 0 ? &cands[sel.reference] : nullptr, wait_steps);
     ++result.num_waits;
     result.delay += wait_steps * P.dt;

@@ -65,6 +65,10 @@ struct Problem {
   std::vector<double> fixed_bounds;
   double prediction_dt = 0.1, prediction_start = 0.0;
   bool perturb_base = true;
+  // Wall time at which the optimisers stop (PlanningRequest::time_budget);
+  // time_point::max() without a budget.
+  Clock::time_point deadline = Clock::time_point::max();
+  bool OutOfTime() const { return deadline != Clock::time_point::max() && Clock::now() >= deadline; }
 };
 
 /// Cost terms of one trajectory (PlannerParams::weights applied).

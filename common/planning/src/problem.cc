@@ -47,6 +47,8 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
     if (!std::isfinite(req.prediction_start))
       Bad("prediction_start must be finite, got " + std::to_string(req.prediction_start));
   }
+  if (!(req.time_budget >= 0.0) || !std::isfinite(req.time_budget))
+    Bad("time_budget must be finite and >= 0, got " + std::to_string(req.time_budget));
   if (req.goal.kind == Goal::Kind::kJoint) {
     if (req.goal.q.size() != nq)
       Bad("goal has " + std::to_string(req.goal.q.size()) + " joint values, the robot has " + std::to_string(nq));

@@ -265,6 +265,42 @@ TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
   EXPECT_EQ(a.num_waits, b.num_waits);
 }
 
+TEST_F(PlannerTest, AnExhaustedBudgetStopsTheOptimisersAndInsertsNoWait) {
+  // The person standing on the goal: without a budget the planner inserts
+  // waits (PersonStandingOnTheGoalForcesWaitsAndAReportedDelay).
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction pred =
+      testing::MakeReachingPrediction(body_, {{0.45, 0.15, 0.30}}, 15, 0.02, 0.02);
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.prediction = &pred;
+  req.prediction_dt = 0.1;
+  const PlanningResult unlimited = planner_.Plan(req);
+  EXPECT_FALSE(unlimited.budget_exhausted);
+  ASSERT_GT(unlimited.num_waits, 0) << unlimited.reason;
+  // A budget no optimiser can meet: they stop at once, no wait is inserted,
+  // and the outcome is what the first attempt's initial trajectories give.
+  req.time_budget = 1e-9;
+  const PlanningResult cut = planner_.Plan(req);
+  EXPECT_TRUE(cut.budget_exhausted);
+  EXPECT_EQ(cut.num_waits, 0);
+  EXPECT_FALSE(cut.success()) << "the initial straight line runs through the person";
+  EXPECT_EQ(cut.status, PlanStatus::kNoSafeTrajectory) << cut.reason;
+  // A budget that is never reached changes nothing, bit for bit.
+  req.time_budget = 1e6;
+  const PlanningResult generous = planner_.Plan(req);
+  EXPECT_FALSE(generous.budget_exhausted);
+  EXPECT_EQ(generous.status, unlimited.status);
+  EXPECT_EQ(generous.num_waits, unlimited.num_waits);
+  EXPECT_TRUE(generous.positions == unlimited.positions);
+  EXPECT_EQ(generous.cost, unlimited.cost);
+  req.time_budget = -1;
+  EXPECT_THROW(planner_.Plan(req), std::invalid_argument);
+}
+
 TEST_F(PlannerTest, OneAndManyOptimisersAreValid) {
   PlanningRequest req;
   req.start_q = Ready();

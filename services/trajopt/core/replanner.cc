@@ -18,6 +18,8 @@ std::string ReplannerParams::Validate() const {
   if (!(max_tracking_error > 0)) return "max_tracking_error must be > 0";
   if (!(joint_limit_tolerance >= 0)) return "joint_limit_tolerance must be >= 0";
   if (!(joint_velocity_factor >= 1)) return "joint_velocity_factor must be >= 1";
+  if (!(cycle_budget >= 0) || !(cycle_budget < planning_step))
+    return "cycle_budget must be in [0, planning_step)";
   return "";
 }
 
@@ -157,6 +159,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   }
   t.planning_times.push_back(res.planning_time);
   r.planning_time = res.planning_time;
+  r.budget_exhausted = res.budget_exhausted;
   if (res.status == planning::PlanStatus::kIkFailed || res.status == planning::PlanStatus::kGoalInCollision) {
     CycleResult bad = Hold(now_ns, q_->second, "goal unreachable");
     bad.outcome = Finish(TaskStatus::kFailed, res.reason, now_ns);
@@ -226,6 +229,7 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_
     req.num_frozen = 1;
   }
   req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
+  req.time_budget = params_.cycle_budget;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
   if (prediction_ && prediction_->FreshAt(now_ns, stale)) {
     req.prediction = &prediction_->spheres();

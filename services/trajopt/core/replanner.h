@@ -44,6 +44,11 @@ struct ReplannerParams {
   /// A robot state whose joint speed exceeds this many times the joint's
   /// velocity limit is refused; above 1 for noisy measured velocities.
   double joint_velocity_factor = 1.2;
+  /// s of wall time one cycle's planning may take (PlanningRequest::
+  /// time_budget); 0: none. With a budget a loaded machine gets worse plans
+  /// (or a wait), not late ones; the simulated-time benchmark plans without
+  /// one so that it stays deterministic.
+  double cycle_budget = 0.0;
   std::string Validate() const;
 };
 
@@ -85,6 +90,7 @@ struct CycleResult {
   bool waiting = false;              ///< the plan holds the robot (waits inserted or no safe trajectory)
   bool held_off = false;             ///< the plan keeps out of the person's space (PlannerParams::human_separation)
   double max_bound = 0;              ///< highest per-waypoint collision bound of the plan
+  bool budget_exhausted = false;     ///< planning ran out of ReplannerParams::cycle_budget
   std::optional<TaskOutcome> outcome;
   std::string status;                ///< what happened, for logs/diagnostics
 };

@@ -80,6 +80,14 @@ struct PlanningRequest {
   const collision::HumanPrediction* prediction = nullptr;
   double prediction_dt = 0.1;     ///< time between prediction steps (s), > 0
   double prediction_start = 0.0;  ///< time of step 0 minus time of waypoint 0 (s)
+  /// Wall time Plan may take (s); 0: no limit. With a budget the planner is
+  /// anytime: when it runs out, the optimisers stop at their next iteration,
+  /// no further wait is inserted, and the best feasible and safe trajectory
+  /// found so far wins; without one the status is kNoSafeTrajectory or
+  /// kInfeasible (a replanner then holds: a wait). PlanningResult::
+  /// budget_exhausted tells. Results then depend on timing; without a budget
+  /// they are bit-identical for the same request, parameters and seed.
+  double time_budget = 0.0;
 };
 
 enum class PlanStatus {
@@ -106,6 +114,7 @@ struct PlanningResult {
   double delay = 0.0;            ///< total inserted wait time (s)
   int num_waits = 0;
   double planning_time = 0.0;    ///< wall time of Plan (s)
+  bool budget_exhausted = false; ///< PlanningRequest::time_budget ran out before the optimisers finished
   double time_to_first_feasible = -1.0;  ///< wall time until some optimiser was feasible (s), -1 if never
   double max_bound = 0.0;        ///< max_i P_i over the non-frozen waypoints (0 without prediction)
   std::vector<double> bounds;    ///< P_i per waypoint (empty without prediction)
