@@ -86,10 +86,10 @@ struct EvalOptions {
   int stride = 1;
 };
 
-void RunTrain(const TrainOptions& o) {
+// The model configuration from the options and the joints of `data`.
+iplan::intent::IntentModelConfig MakeConfig(const TrainOptions& o,
+                                            const iplan::intent::SkeletonDataset& data) {
   using namespace iplan::intent;
-  const SkeletonDataset all = LoadSkeletonCsv(o.data);
-  const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
   IntentModelConfig config;
   // The options first; defaults only for what they leave unset, computed
   // from the chosen joints (a one-joint tracker has no default skeleton).
@@ -119,7 +119,11 @@ void RunTrain(const TrainOptions& o) {
   config.sensor_noise_std = o.noise;
   config.features.torso_motion_weight = o.torso_weight;
   config.features.normalise_body_size = o.normalise_size;
-  TrainParams params;
+  return config;
+}
+
+iplan::intent::TrainParams MakeTrainParams(const TrainOptions& o) {
+  iplan::intent::TrainParams params;
   params.max_gap = o.max_gap;
   if (!o.sigma_factors.empty()) params.sigma_factors = ParseDoubles(o.sigma_factors, "--sigma-factors");
   if (!o.lambdas.empty()) params.lambdas = ParseDoubles(o.lambdas, "--lambdas");
@@ -143,16 +147,14 @@ void RunTrain(const TrainOptions& o) {
   params.max_forecast_windows = o.max_forecast_windows;
   params.forecast_stride = o.forecast_stride;
   params.seed = o.seed;
+  return params;
+}
 
-  const auto t0 = std::chrono::steady_clock::now();
-  TrainReport rep;
-  const IntentModel model = TrainIntentModel(data, config, params, &rep);
-  const double seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  SaveIntentModel(model, o.out);
-
-  std::cout << "trained on " << data.sequences.size() << " sequences of subjects " << o.subjects
-            << "\njoints:";
+// Joint set, actions and the classifier's cross-validation tables.
+void PrintClassifierReport(const iplan::intent::IntentModelConfig& config,
+                           const iplan::intent::IntentModel& model,
+                           const iplan::intent::TrainReport& rep) {
+  std::cout << "\njoints:";
   for (const std::string& j : config.joints.joints) std::cout << " " << j;
   std::cout << "\ntorso:";
   for (const std::string& j : config.joints.torso) std::cout << " " << j;
@@ -179,8 +181,13 @@ void RunTrain(const TrainOptions& o) {
     }
   }
   std::cout << "  chosen belief filter: time constant " << rep.belief_time_constant << " s, "
-            << (rep.belief_motion_weighted ? "motion weighted" : "not motion weighted")
-            << "\nforecasters (" << params.pseudo_inputs << " pseudo-inputs each): windows per action:";
+            << (rep.belief_motion_weighted ? "motion weighted" : "not motion weighted");
+}
+
+// Forecaster windows and the kinematic baseline table (best tau per L).
+void PrintBaselineReport(const iplan::intent::TrainParams& params,
+                         const iplan::intent::TrainReport& rep) {
+  std::cout << "\nforecasters (" << params.pseudo_inputs << " pseudo-inputs each): windows per action:";
   for (size_t c = 0; c < rep.forecast_windows.size(); ++c) {
     std::cout << " " << rep.forecast_windows[c] << (rep.forecast_padded[c] ? "*" : "");
   }
@@ -201,30 +208,54 @@ void RunTrain(const TrainOptions& o) {
   }
   std::cout << "  (holding the last pose: " << rep.error_const_position << " m)\n  chosen L "
             << rep.baseline.smoothing_frames << ", tau " << rep.baseline.damping_time_constant << " s\n";
-  if (rep.forecast_cv_folds > 0) {
-    std::cout << "  residual weight, cross-validation (" << rep.forecast_cv_folds
-              << " folds: the training subjects, or with one subject its sequences; "
-              << rep.forecast_cv_windows << " held-out windows), held-out mean joint error [m]:\n"
-              << "    w  step~0.5s  last_step  all_steps\n";
-    for (const auto& row : rep.residual_cv_table) {
-      std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
-    }
-    std::cout << "  chosen w " << rep.residual_weight << "\n";
-    if (!rep.motion_cv_table.empty()) {
-      std::cout << "  covariance activity offset m0, held-out (after calibration):\n"
-                << "    m0_m_per_s  nll  coverage\n";
-      for (const auto& row : rep.motion_cv_table) {
-        std::cout << "    " << row[0] << "  " << row[1] << "  " << 100.0 * row[2] << " %\n";
-      }
-      std::cout << "  chosen m0 " << rep.motion_offset << " m/s\n";
-    }
-    std::cout << "  held-out 95 % coverage " << 100.0 * rep.cv_coverage_raw
-              << " % raw, " << 100.0 * rep.cv_coverage_calibrated << " % calibrated (variance scales min "
-              << rep.variance_scale_min << ", median " << rep.variance_scale_median << ", max "
-              << rep.variance_scale_max << ")\n";
-  } else {
+}
+
+// The forecaster cross-validation: residual weight, activity offset, coverage.
+void PrintForecastCvReport(const iplan::intent::TrainReport& rep) {
+  if (rep.forecast_cv_folds <= 0) {
     std::cout << "  no forecaster cross-validation (fewer than two training groups): w = 1, uncalibrated\n";
+    return;
   }
+  std::cout << "  residual weight, cross-validation (" << rep.forecast_cv_folds
+            << " folds: the training subjects, or with one subject its sequences; "
+            << rep.forecast_cv_windows << " held-out windows), held-out mean joint error [m]:\n"
+            << "    w  step~0.5s  last_step  all_steps\n";
+  for (const auto& row : rep.residual_cv_table) {
+    std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
+  }
+  std::cout << "  chosen w " << rep.residual_weight << "\n";
+  if (!rep.motion_cv_table.empty()) {
+    std::cout << "  covariance activity offset m0, held-out (after calibration):\n"
+              << "    m0_m_per_s  nll  coverage\n";
+    for (const auto& row : rep.motion_cv_table) {
+      std::cout << "    " << row[0] << "  " << row[1] << "  " << 100.0 * row[2] << " %\n";
+    }
+    std::cout << "  chosen m0 " << rep.motion_offset << " m/s\n";
+  }
+  std::cout << "  held-out 95 % coverage " << 100.0 * rep.cv_coverage_raw
+            << " % raw, " << 100.0 * rep.cv_coverage_calibrated << " % calibrated (variance scales min "
+            << rep.variance_scale_min << ", median " << rep.variance_scale_median << ", max "
+            << rep.variance_scale_max << ")\n";
+}
+
+void RunTrain(const TrainOptions& o) {
+  using namespace iplan::intent;
+  const SkeletonDataset all = LoadSkeletonCsv(o.data);
+  const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
+  const IntentModelConfig config = MakeConfig(o, data);
+  const TrainParams params = MakeTrainParams(o);
+
+  const auto t0 = std::chrono::steady_clock::now();
+  TrainReport rep;
+  const IntentModel model = TrainIntentModel(data, config, params, &rep);
+  const double seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  SaveIntentModel(model, o.out);
+
+  std::cout << "trained on " << data.sequences.size() << " sequences of subjects " << o.subjects;
+  PrintClassifierReport(config, model, rep);
+  PrintBaselineReport(params, rep);
+  PrintForecastCvReport(rep);
   std::cout << "  " << rep.seconds_forecaster << " s\ntraining time: " << seconds
             << " s\nmodel written to " << o.out << "\n";
 }

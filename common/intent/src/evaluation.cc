@@ -30,18 +30,21 @@ double Percentile(std::vector<double> v, double q) {
   return v[lo] + (pos - lo) * (v[hi] - v[lo]);
 }
 
-}  // namespace
+// PredictIntent, timing every call (the report's inference percentiles).
+struct TimedPredictor {
+  const IntentModel& model;
+  MixturePrediction pred;
+  std::vector<double> times_ms;
 
-std::string FormatKey(double value) {
-  std::ostringstream os;
-  os << std::setprecision(3) << value;
-  std::string s = os.str();
-  if (s.find('.') == std::string::npos && s.find('e') == std::string::npos) s += ".0";
-  return s;
-}
+  void operator()(const Eigen::MatrixXd& window) {
+    const auto t0 = std::chrono::steady_clock::now();
+    PredictIntent(model, window, &pred);
+    times_ms.push_back(
+        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+};
 
-EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& data,
-                               const EvalParams& params) {
+void CheckEvalParams(const EvalParams& params) {
   if (params.fractions.empty() || params.forecast_stride < 1) {
     throw std::invalid_argument("EvalParams: need fractions and forecast_stride >= 1");
   }
@@ -49,7 +52,10 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
       *std::min_element(params.velocity_frames.begin(), params.velocity_frames.end()) < 1) {
     throw std::invalid_argument("EvalParams: velocity_frames must be non-empty with entries >= 1");
   }
-  const std::vector<Track> tracks = MakeTracks(data, model.config, params.max_gap);
+}
+
+// Model action ids; throws for a track whose action the model does not know.
+std::map<std::string, int> ActionIds(const IntentModel& model, const std::vector<Track>& tracks) {
   std::map<std::string, int> action_id;
   for (size_t c = 0; c < model.actions.size(); ++c) action_id[model.actions[c]] = static_cast<int>(c);
   for (const Track& t : tracks) {
@@ -59,30 +65,19 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
                                   ") that the model was not trained on");
     }
   }
+  return action_id;
+}
+
+// Accuracy: as online, the model's belief filter combines the windows
+// ending at every frame of the observed prefix (one update per model frame).
+void ScoreAccuracy(const std::vector<Track>& tracks, const std::map<std::string, int>& action_id,
+                   const EvalParams& params, TimedPredictor& timed_predict, EvalReport* report) {
+  const IntentModel& model = timed_predict.model;
+  const MixturePrediction& pred = timed_predict.pred;
+  EvalReport& r = *report;
   const int C = static_cast<int>(model.actions.size());
-  const int J = static_cast<int>(model.config.joints.joints.size());
-  const int H = model.config.horizon;
   const int T = model.config.window;
   const double rate = model.config.rate;
-
-  EvalReport r;
-  r.actions = model.actions;
-  r.fractions = params.fractions;
-  r.accuracy.assign(params.fractions.size(), 0.0);
-  r.mean_true_probability.assign(params.fractions.size(), 0.0);
-  r.confusion = Eigen::MatrixXi::Zero(C, C);
-  r.num_sequences = static_cast<int>(tracks.size());
-  std::vector<double> times_ms;
-  MixturePrediction pred;
-  auto timed_predict = [&](const Eigen::MatrixXd& window) {
-    const auto t0 = std::chrono::steady_clock::now();
-    PredictIntent(model, window, &pred);
-    times_ms.push_back(
-        std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
-  };
-
-  // Accuracy: as online, the model's belief filter combines the windows
-  // ending at every frame of the observed prefix (one update per model frame).
   BeliefFilter filter(C, model.classifier.belief);
   Eigen::VectorXd window_p(C);
   for (const Track& t : tracks) {
@@ -117,67 +112,126 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
     r.accuracy[fi] /= std::max(1, r.num_sequences);
     r.mean_true_probability[fi] /= std::max(1, r.num_sequences);
   }
+}
 
-  // Forecasts.
+// Sums over the forecast windows (divided by windows x joints at the end):
+// per step k the model's joint error em, holding the current pose ep, and
+// per L of velocity_frames the least-squares line ev and its current value
+// es (V, H); the mixture-mean errors inside the 95 % ellipsoid.
+struct ForecastSums {
+  std::vector<double> em, ep;
+  Eigen::MatrixXd ev, es;
+  long inside = 0, total = 0;
+};
+
+// The mixture `pred` of the window ending at row e against the recorded future after row e.
+void AddModelErrors(const Track& t, int e, const MixturePrediction& pred, int H, int J,
+                    ForecastSums* s) {
+  const Eigen::RowVectorXd now = t.positions.row(e);
+  for (int k = 0; k < H; ++k) {
+    const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
+    for (int j = 0; j < J; ++j) {
+      const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
+      const JointGaussian g = pred.Combined(k, j);
+      const Eigen::Vector3d err = p_true - g.mean;
+      s->em[k] += err.norm();
+      s->ep[k] += (p_true - now.segment<3>(3 * j).transpose()).norm();
+      const double d2 = err.dot(g.covariance.ldlt().solve(err));
+      if (d2 <= kChi2Dof3P95) ++s->inside;
+      ++s->total;
+    }
+  }
+}
+
+// Least-squares baselines over the recorded frames up to e.
+void AddLineBaselineErrors(const Track& t, int e, const EvalParams& params, double rate, int H,
+                           int J, ForecastSums* s) {
+  Eigen::VectorXd line_p, line_v;
+  const int V = static_cast<int>(params.velocity_frames.size());
+  for (int v = 0; v < V; ++v) {
+    FitLine(t.positions.topRows(e + 1), params.velocity_frames[v], rate, &line_p, &line_v);
+    for (int k = 0; k < H; ++k) {
+      const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
+      const double ahead = (k + 1) / rate;
+      for (int j = 0; j < J; ++j) {
+        const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
+        s->ev(v, k) += (p_true - line_p.segment<3>(3 * j) - ahead * line_v.segment<3>(3 * j)).norm();
+        s->es(v, k) += (p_true - line_p.segment<3>(3 * j)).norm();
+      }
+    }
+  }
+}
+
+// Forecasts.
+void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
+                    TimedPredictor& timed_predict, EvalReport* report) {
+  const IntentModel& model = timed_predict.model;
+  EvalReport& r = *report;
+  const int J = static_cast<int>(model.config.joints.joints.size());
+  const int H = model.config.horizon;
+  const int T = model.config.window;
+  const double rate = model.config.rate;
   r.horizon_s.resize(H);
   for (int k = 0; k < H; ++k) r.horizon_s[k] = (k + 1) / rate;
   const int V = static_cast<int>(params.velocity_frames.size());
-  std::vector<double> em(H, 0.0), ep(H, 0.0);
-  Eigen::MatrixXd ev = Eigen::MatrixXd::Zero(V, H), es = Eigen::MatrixXd::Zero(V, H);
-  Eigen::VectorXd line_p, line_v;
-  long inside = 0, total = 0;
+  ForecastSums s{std::vector<double>(H, 0.0), std::vector<double>(H, 0.0),
+                 Eigen::MatrixXd::Zero(V, H), Eigen::MatrixXd::Zero(V, H), 0, 0};
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
     for (int e = 0; e + H <= n - 1; e += params.forecast_stride) {
       const Eigen::MatrixXd window = WindowEndingAt(t.positions, e, T);
       timed_predict(window);
       ++r.num_forecast_windows;
-      const Eigen::RowVectorXd now = t.positions.row(e);
-      for (int k = 0; k < H; ++k) {
-        const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
-        for (int j = 0; j < J; ++j) {
-          const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
-          const JointGaussian g = pred.Combined(k, j);
-          const Eigen::Vector3d err = p_true - g.mean;
-          em[k] += err.norm();
-          ep[k] += (p_true - now.segment<3>(3 * j).transpose()).norm();
-          const double d2 = err.dot(g.covariance.ldlt().solve(err));
-          if (d2 <= kChi2Dof3P95) ++inside;
-          ++total;
-        }
-      }
-      // Least-squares baselines over the recorded frames up to e.
-      for (int v = 0; v < V; ++v) {
-        FitLine(t.positions.topRows(e + 1), params.velocity_frames[v], rate, &line_p, &line_v);
-        for (int k = 0; k < H; ++k) {
-          const Eigen::RowVectorXd truth = t.positions.row(e + k + 1);
-          const double ahead = (k + 1) / rate;
-          for (int j = 0; j < J; ++j) {
-            const Eigen::Vector3d p_true = truth.segment<3>(3 * j).transpose();
-            ev(v, k) += (p_true - line_p.segment<3>(3 * j) - ahead * line_v.segment<3>(3 * j)).norm();
-            es(v, k) += (p_true - line_p.segment<3>(3 * j)).norm();
-          }
-        }
-      }
+      AddModelErrors(t, e, timed_predict.pred, H, J, &s);
+      AddLineBaselineErrors(t, e, params, rate, H, J, &s);
     }
   }
   const double denom = std::max(1.0, static_cast<double>(r.num_forecast_windows) * J);
   r.velocity_frames = params.velocity_frames;
-  r.error_const_velocity_by_frames = ev / denom;
-  r.error_smoothed_position_by_frames = es / denom;
+  r.error_const_velocity_by_frames = s.ev / denom;
+  r.error_smoothed_position_by_frames = s.es / denom;
   for (int k = 0; k < H; ++k) {
-    r.error_model.push_back(em[k] / denom);
-    r.error_const_position.push_back(ep[k] / denom);
+    r.error_model.push_back(s.em[k] / denom);
+    r.error_const_position.push_back(s.ep[k] / denom);
     Eigen::Index best_v = 0, best_s = 0;
     r.error_const_velocity.push_back(r.error_const_velocity_by_frames.col(k).minCoeff(&best_v));
     r.const_velocity_frames.push_back(params.velocity_frames[best_v]);
     r.error_smoothed_position.push_back(r.error_smoothed_position_by_frames.col(k).minCoeff(&best_s));
     r.smoothed_position_frames.push_back(params.velocity_frames[best_s]);
   }
-  r.coverage95 = total > 0 ? static_cast<double>(inside) / total : 0.0;
-  r.inference_p50_ms = Percentile(times_ms, 0.5);
-  r.inference_p99_ms = Percentile(times_ms, 0.99);
-  r.num_inference_calls = static_cast<int>(times_ms.size());
+  r.coverage95 = s.total > 0 ? static_cast<double>(s.inside) / s.total : 0.0;
+}
+
+}  // namespace
+
+std::string FormatKey(double value) {
+  std::ostringstream os;
+  os << std::setprecision(3) << value;
+  std::string s = os.str();
+  if (s.find('.') == std::string::npos && s.find('e') == std::string::npos) s += ".0";
+  return s;
+}
+
+EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& data,
+                               const EvalParams& params) {
+  CheckEvalParams(params);
+  const std::vector<Track> tracks = MakeTracks(data, model.config, params.max_gap);
+  const std::map<std::string, int> action_id = ActionIds(model, tracks);
+  const int C = static_cast<int>(model.actions.size());
+
+  EvalReport r;
+  r.actions = model.actions;
+  r.fractions = params.fractions;
+  r.accuracy.assign(params.fractions.size(), 0.0);
+  r.mean_true_probability.assign(params.fractions.size(), 0.0);
+  r.confusion = Eigen::MatrixXi::Zero(C, C);
+  r.num_sequences = static_cast<int>(tracks.size());
+  TimedPredictor timed_predict{model, {}, {}};
+  ScoreAccuracy(tracks, action_id, params, timed_predict, &r);
+  ScoreForecasts(tracks, params, timed_predict, &r);
+  r.inference_p50_ms = Percentile(timed_predict.times_ms, 0.5);
+  r.inference_p99_ms = Percentile(timed_predict.times_ms, 0.99);
+  r.num_inference_calls = static_cast<int>(timed_predict.times_ms.size());
   return r;
 }
 

@@ -48,17 +48,18 @@ double ParseNumber(const std::string& text, const std::string& path, long line,
   return value;
 }
 
-}  // namespace
+// The leading columns of the shared CSV layout, before the joint triples.
+const std::vector<std::string>& LeadColumns() {
+  static const std::vector<std::string> lead = {"sequence", "subject", "action",
+                                                "frame", "time"};
+  return lead;
+}
 
-SkeletonDataset LoadSkeletonCsv(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw std::runtime_error(path + ": cannot open file");
-  std::string line;
-  long line_no = 1;
-  if (!std::getline(in, line)) ThrowAt(path, 1, "empty file (no header)");
-  const std::vector<std::string> header = SplitCsvLine(line);
-  const std::vector<std::string> lead = {"sequence", "subject", "action",
-                                         "frame", "time"};
+// Checks the header line (split into `header`) and returns the joint names
+// of its "<joint>.x,<joint>.y,<joint>.z" triples.
+std::vector<std::string> ParseHeader(const std::vector<std::string>& header,
+                                     const std::string& path) {
+  const std::vector<std::string>& lead = LeadColumns();
   if (header.size() < lead.size() + 3) {
     ThrowAt(path, 1, "header has " + std::to_string(header.size()) +
                          " columns; expected sequence,subject,action,frame,"
@@ -75,7 +76,7 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
                          std::to_string(header.size() - lead.size()) +
                          " joint columns)");
   }
-  SkeletonDataset data;
+  std::vector<std::string> joint_names;
   const char* axes[3] = {".x", ".y", ".z"};
   for (size_t c = lead.size(); c < header.size(); c += 3) {
     const std::string& first = header[c];
@@ -89,26 +90,28 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
                              axes[a] + "'");
       }
     }
-    data.joint_names.push_back(name);
+    joint_names.push_back(name);
   }
-  const int num_joints = static_cast<int>(data.joint_names.size());
+  return joint_names;
+}
 
-  struct Builder {
-    SkeletonSequence seq;
-    std::vector<double> time;
-    std::vector<double> values;
-  };
+// One sequence while its rows are read.
+struct Builder {
+  SkeletonSequence seq;
+  std::vector<double> time;
+  std::vector<double> values;
+};
+
+// The sequences of the rows read so far; rows of one sequence are contiguous.
+struct RowReader {
+  const std::string& path;
+  const std::vector<std::string>& header;
   std::vector<Builder> builders;
   std::set<std::string> finished;
-  while (std::getline(in, line)) {
-    ++line_no;
-    if (line.empty() || line == "\r") continue;
-    const std::vector<std::string> f = SplitCsvLine(line);
-    if (f.size() != header.size()) {
-      ThrowAt(path, line_no, "row has " + std::to_string(f.size()) +
-                                 " fields, header has " +
-                                 std::to_string(header.size()));
-    }
+
+  // The builder of the sequence of row `f` (line `line_no`), a new one at
+  // the first row of a sequence.
+  Builder& SequenceOf(const std::vector<std::string>& f, long line_no) {
     if (f[0].empty()) ThrowAt(path, line_no, "empty sequence id");
     if (builders.empty() || builders.back().seq.id != f[0]) {
       if (!builders.empty()) finished.insert(builders.back().seq.id);
@@ -127,6 +130,17 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
               "sequence '" + f[0] + "' changes subject or action mid-way ('" +
                   f[1] + "', '" + f[2] + "')");
     }
+    return b;
+  }
+
+  void AddRow(const std::string& line, long line_no) {
+    const std::vector<std::string> f = SplitCsvLine(line);
+    if (f.size() != header.size()) {
+      ThrowAt(path, line_no, "row has " + std::to_string(f.size()) +
+                                 " fields, header has " +
+                                 std::to_string(header.size()));
+    }
+    Builder& b = SequenceOf(f, line_no);
     ParseNumber(f[3], path, line_no, "frame");
     const double t = ParseNumber(f[4], path, line_no, "time");
     if (!b.time.empty() && !(t > b.time.back())) {
@@ -135,7 +149,7 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
                   "'");
     }
     b.time.push_back(t);
-    for (size_t c = lead.size(); c < f.size(); ++c) {
+    for (size_t c = LeadColumns().size(); c < f.size(); ++c) {
       // A joint the tracker did not detect may be written as nan or left empty.
       if (f[c].empty() || f[c] == "nan" || f[c] == "NaN" || f[c] == "-nan") {
         b.values.push_back(std::numeric_limits<double>::quiet_NaN());
@@ -144,8 +158,29 @@ SkeletonDataset LoadSkeletonCsv(const std::string& path) {
       }
     }
   }
-  if (builders.empty()) ThrowAt(path, line_no, "no data rows");
-  for (Builder& b : builders) {
+};
+
+}  // namespace
+
+SkeletonDataset LoadSkeletonCsv(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw std::runtime_error(path + ": cannot open file");
+  std::string line;
+  long line_no = 1;
+  if (!std::getline(in, line)) ThrowAt(path, 1, "empty file (no header)");
+  const std::vector<std::string> header = SplitCsvLine(line);
+  SkeletonDataset data;
+  data.joint_names = ParseHeader(header, path);
+  const int num_joints = static_cast<int>(data.joint_names.size());
+
+  RowReader rows{path, header, {}, {}};
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.empty() || line == "\r") continue;
+    rows.AddRow(line, line_no);
+  }
+  if (rows.builders.empty()) ThrowAt(path, line_no, "no data rows");
+  for (Builder& b : rows.builders) {
     const int n = static_cast<int>(b.time.size());
     b.seq.time = Eigen::Map<Eigen::VectorXd>(b.time.data(), n);
     b.seq.positions = Eigen::Map<Eigen::Matrix<double, Eigen::Dynamic,

@@ -1,0 +1,311 @@
+// Training of the action classifier, METHOD.md section 2: windows of the
+// training tracks at the early-prediction prefixes, the DTW kernel, the
+// multi-class IVM with (sigma, lambda) chosen by leave-one-subject-out
+// cross-validation, and the belief filter over successive windows chosen the
+// same way (docs/intent.md, pipeline steps 3, 4 and 7).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <set>
+#include <vector>
+
+#include "intent_training.h"
+#include "iplan/intent/belief_filter.h"
+#include "iplan/intent/dtw.h"
+
+namespace iplan::intent::detail {
+namespace {
+
+struct ClassifierSamples {
+  std::vector<Eigen::MatrixXd> windows;  // (F, T) each
+  std::vector<int> labels;
+  std::vector<int> subject;              // fold id
+};
+
+// The rows of the windows ending at the prefix fractions of a track of n rows.
+std::set<int> PrefixEnds(int n, const std::vector<double>& fractions) {
+  std::set<int> ends;
+  for (double f : fractions) {
+    ends.insert(std::max(1, static_cast<int>(std::ceil(f * n - 1e-9))) - 1);
+  }
+  return ends;
+}
+
+// ---- Classifier samples: windows ending at prefix fractions. ----
+ClassifierSamples MakeClassifierSamples(const TrainingGroups& g, const FeatureLayout& layout,
+                                        const IntentModelConfig& config,
+                                        const TrainParams& params) {
+  ClassifierSamples cs;
+  for (const Track& t : g.tracks) {
+    const int n = static_cast<int>(t.positions.rows());
+    const std::set<int> ends = PrefixEnds(n, params.prefix_fractions);
+    for (int e : ends) {
+      cs.windows.push_back(
+          layout.FrameFeatures(WindowEndingAt(t.positions, e, config.window)).transpose());
+      cs.labels.push_back(g.action_id.at(t.action));
+      cs.subject.push_back(g.subject_id.at(t.subject));
+    }
+  }
+  return cs;
+}
+
+Eigen::MatrixXd DtwMatrix(const std::vector<Eigen::MatrixXd>& w, int band) {
+  const Eigen::Index N = static_cast<Eigen::Index>(w.size());
+  Eigen::MatrixXd D = Eigen::MatrixXd::Zero(N, N);
+  std::vector<double> ws;
+  for (Eigen::Index i = 0; i < N; ++i) {
+    for (Eigen::Index j = i + 1; j < N; ++j) {
+      D(i, j) = D(j, i) = DtwDistanceColumns(w[i], w[j], band, &ws);
+    }
+  }
+  return D;
+}
+
+// The median of the off-diagonal DTW distances (the unit of sigma), >= 1e-9;
+// 1 without pairs.
+double MedianDtw(const Eigen::MatrixXd& Dm) {
+  const int N = static_cast<int>(Dm.rows());
+  std::vector<double> off;
+  off.reserve(static_cast<size_t>(N) * (N - 1) / 2);
+  for (int i = 0; i < N; ++i) for (int j = i + 1; j < N; ++j) off.push_back(Dm(i, j));
+  std::nth_element(off.begin(), off.begin() + off.size() / 2, off.end());
+  return off.empty() ? 1.0 : std::max(off[off.size() / 2], 1e-9);
+}
+
+Eigen::MatrixXd KernelFromDtw(const Eigen::MatrixXd& D, double sigma) {
+  return (-D.array().square() / (2.0 * sigma * sigma)).exp().matrix();
+}
+
+// The IVM fitted on the samples `tr` of the kernel K at regulariser lambda.
+IvmModel FitIvmOnRows(const Eigen::MatrixXd& K, const ClassifierSamples& cs,
+                      const std::vector<int>& tr, int C, const TrainParams& params,
+                      double lambda) {
+  Eigen::MatrixXd Ktr(tr.size(), tr.size());
+  std::vector<int> ytr;
+  for (size_t a = 0; a < tr.size(); ++a) {
+    ytr.push_back(cs.labels[tr[a]]);
+    for (size_t b = 0; b < tr.size(); ++b) Ktr(a, b) = K(tr[a], tr[b]);
+  }
+  IvmParams ip = params.ivm;
+  ip.lambda = lambda;
+  return FitIvm(Ktr, ytr, C, ip);
+}
+
+// Kernel-values probabilities for rows `test` against the fitted import set.
+Eigen::MatrixXd PredictRows(const IvmModel& ivm, const Eigen::MatrixXd& K,
+                            const std::vector<int>& train_rows,
+                            const std::vector<int>& test_rows) {
+  const Eigen::Index q = ivm.import_index.size();
+  Eigen::MatrixXd P(static_cast<Eigen::Index>(test_rows.size()), ivm.num_classes());
+  Eigen::VectorXd k(q), p;
+  for (size_t t = 0; t < test_rows.size(); ++t) {
+    for (Eigen::Index s = 0; s < q; ++s) k(s) = K(test_rows[t], train_rows[ivm.import_index(s)]);
+    ivm.Probabilities(k, &p);
+    P.row(static_cast<Eigen::Index>(t)) = p.transpose();
+  }
+  return P;
+}
+
+// Leave-one-subject-out at (K, lambda): the held-out log-loss summed over
+// all samples and the number classified correctly.
+void LeaveOneSubjectOut(const Eigen::MatrixXd& K, const ClassifierSamples& cs, int num_subjects,
+                        int C, const TrainParams& params, double lambda, double* loss,
+                        int* correct) {
+  const int N = static_cast<int>(cs.windows.size());
+  for (int fold = 0; fold < num_subjects; ++fold) {
+    std::vector<int> tr, te;
+    for (int i = 0; i < N; ++i) (cs.subject[i] == fold ? te : tr).push_back(i);
+    if (te.empty() || tr.empty()) continue;
+    const IvmModel ivm = FitIvmOnRows(K, cs, tr, C, params, lambda);
+    const Eigen::MatrixXd P = PredictRows(ivm, K, tr, te);
+    std::vector<int> yte;
+    for (int i : te) yte.push_back(cs.labels[i]);
+    *loss += MeanLogLoss(P, yte) * te.size();
+    for (size_t r = 0; r < te.size(); ++r) {
+      Eigen::Index arg;
+      P.row(static_cast<Eigen::Index>(r)).maxCoeff(&arg);
+      if (arg == yte[r]) ++*correct;
+    }
+  }
+}
+
+struct KernelChoice {
+  double sigma = 0.0;
+  double lambda = 0.0;
+};
+
+// ---- Cross-validation over (sigma, lambda), leave-one-subject-out. ----
+// Without two subjects or a grid, the middle of the grids.
+KernelChoice ChooseKernel(const ClassifierSamples& cs, const Eigen::MatrixXd& Dm, double median,
+                          int num_subjects, int C, const TrainParams& params, TrainReport* rep) {
+  const int N = static_cast<int>(cs.windows.size());
+  double best_loss = std::numeric_limits<double>::infinity();
+  KernelChoice best;
+  best.sigma = params.sigma_factors[params.sigma_factors.size() / 2] * median;
+  best.lambda = params.lambdas[params.lambdas.size() / 2];
+  if (num_subjects < 2 || (params.sigma_factors.size() <= 1 && params.lambdas.size() <= 1)) {
+    return best;
+  }
+  for (double sf : params.sigma_factors) {
+    const double sigma = sf * median;
+    const Eigen::MatrixXd K = KernelFromDtw(Dm, sigma);
+    for (double lambda : params.lambdas) {
+      double loss = 0.0;
+      int correct = 0;
+      LeaveOneSubjectOut(K, cs, num_subjects, C, params, lambda, &loss, &correct);
+      loss /= N;
+      rep->cv_table.push_back({sigma, lambda, loss, static_cast<double>(correct) / N});
+      if (loss < best_loss) {
+        best_loss = loss;
+        best.sigma = sigma;
+        best.lambda = lambda;
+      }
+    }
+  }
+  return best;
+}
+
+// Per training track: the held-out fold's probabilities of the windows
+// ending at every frame (n, C), and their WindowMotion (n).
+struct HeldOutFrames {
+  std::vector<Eigen::MatrixXd> probs;
+  std::vector<Eigen::VectorXd> motion;
+};
+
+HeldOutFrames HeldOutFrameProbabilities(const TrainingGroups& g, const ClassifierSamples& cs,
+                                        const Eigen::MatrixXd& K, const KernelChoice& kc,
+                                        const FeatureLayout& layout,
+                                        const IntentModelConfig& config,
+                                        const TrainParams& params) {
+  const int N = static_cast<int>(cs.windows.size());
+  const int C = g.num_actions;
+  HeldOutFrames h;
+  h.probs.resize(g.tracks.size());
+  h.motion.resize(g.tracks.size());
+  std::vector<double> ws;
+  for (int fold = 0; fold < g.num_subjects; ++fold) {
+    std::vector<int> tr;
+    for (int i = 0; i < N; ++i) if (cs.subject[i] != fold) tr.push_back(i);
+    if (tr.empty()) continue;
+    const IvmModel ivm = FitIvmOnRows(K, cs, tr, C, params, kc.lambda);
+    const Eigen::Index q = ivm.import_index.size();
+    Eigen::VectorXd k(q), p;
+    for (size_t ti = 0; ti < g.tracks.size(); ++ti) {
+      const Track& t = g.tracks[ti];
+      if (g.subject_id.at(t.subject) != fold) continue;
+      const int n = static_cast<int>(t.positions.rows());
+      h.probs[ti].resize(n, C);
+      h.motion[ti].resize(n);
+      for (int e = 0; e < n; ++e) {
+        const Eigen::MatrixXd window = WindowEndingAt(t.positions, e, config.window);
+        h.motion[ti](e) = WindowMotion(window);
+        const Eigen::MatrixXd f = layout.FrameFeatures(window).transpose();
+        for (Eigen::Index s = 0; s < q; ++s) {
+          const double d = DtwDistanceColumns(f, cs.windows[tr[ivm.import_index(s)]],
+                                              config.dtw_band, &ws);
+          k(s) = DtwKernel(d, kc.sigma);
+        }
+        ivm.Probabilities(k, &p);
+        h.probs[ti].row(e) = p.transpose();
+      }
+    }
+  }
+  return h;
+}
+
+// A cross-validation score: held-out mean log-loss and accuracy.
+struct CvScore {
+  double loss = 0.0;
+  double accuracy = 0.0;
+};
+
+// The belief filter (tau, motion_weighted) run over every frame of the
+// held-out tracks, scored at the training prefix fractions.
+CvScore ScoreBeliefFilter(const TrainingGroups& g, const HeldOutFrames& h, double tau,
+                          bool motion_weighted, const IntentModelConfig& config,
+                          const TrainParams& params) {
+  BeliefFilter filter(g.num_actions,
+                      BeliefFilterParams{tau, params.belief_min_probability, motion_weighted});
+  double loss = 0.0;
+  int correct = 0, count = 0;
+  for (size_t ti = 0; ti < g.tracks.size(); ++ti) {
+    const Eigen::MatrixXd& P = h.probs[ti];
+    if (P.rows() == 0) continue;
+    const int n = static_cast<int>(P.rows());
+    const int truth = g.action_id.at(g.tracks[ti].action);
+    const std::set<int> ends = PrefixEnds(n, params.prefix_fractions);
+    filter.Reset();
+    for (int e = 0; e <= *ends.rbegin(); ++e) {
+      if (e + 1 < config.window) filter.Reset();  // partial window: see BeliefFilter
+      filter.Update(P.row(e).transpose(), e / config.rate,
+                    motion_weighted ? std::max(h.motion[ti](e), 1e-6) : 1.0);
+      if (ends.count(e) == 0) continue;
+      loss -= std::log(std::max(filter.probabilities()(truth), 1e-12));
+      if (filter.MostLikely() == truth) ++correct;
+      ++count;
+    }
+  }
+  loss /= std::max(1, count);
+  return {loss, static_cast<double>(correct) / std::max(1, count)};
+}
+
+// ---- Belief filter time constant, leave-one-subject-out at (sigma, lambda). ----
+void ChooseBeliefFilter(const TrainingGroups& g, const ClassifierSamples& cs,
+                        const Eigen::MatrixXd& Dm, const KernelChoice& kc,
+                        const FeatureLayout& layout, const IntentModelConfig& config,
+                        const TrainParams& params, BeliefFilterParams* belief, TrainReport* rep) {
+  belief->min_probability = params.belief_min_probability;
+  belief->time_constant = params.belief_time_constants.front();
+  belief->motion_weighted = params.belief_motion_weighting.front();
+  if (g.num_subjects < 2 ||
+      params.belief_time_constants.size() * params.belief_motion_weighting.size() <= 1) {
+    return;
+  }
+  const Eigen::MatrixXd K = KernelFromDtw(Dm, kc.sigma);
+  const HeldOutFrames h = HeldOutFrameProbabilities(g, cs, K, kc, layout, config, params);
+  double best_belief_loss = std::numeric_limits<double>::infinity();
+  for (const bool motion_weighted : params.belief_motion_weighting)
+  for (double tau : params.belief_time_constants) {
+    const CvScore score = ScoreBeliefFilter(g, h, tau, motion_weighted, config, params);
+    rep->belief_cv_table.push_back({motion_weighted ? 1.0 : 0.0, tau, score.loss, score.accuracy});
+    if (score.loss < best_belief_loss) {
+      best_belief_loss = score.loss;
+      belief->time_constant = tau;
+      belief->motion_weighted = motion_weighted;
+    }
+  }
+}
+
+}  // namespace
+
+void TrainClassifier(const TrainingGroups& groups, const FeatureLayout& layout,
+                     const IntentModelConfig& config, const TrainParams& params,
+                     ActionClassifier* classifier, TrainReport* rep) {
+  const ClassifierSamples cs = MakeClassifierSamples(groups, layout, config, params);
+  const Eigen::MatrixXd Dm = DtwMatrix(cs.windows, config.dtw_band);
+  const double median = MedianDtw(Dm);
+  rep->median_dtw = median;
+  rep->num_classifier_samples = static_cast<int>(cs.windows.size());
+
+  const KernelChoice kc =
+      ChooseKernel(cs, Dm, median, groups.num_subjects, groups.num_actions, params, rep);
+  {
+    IvmParams ip = params.ivm;
+    ip.lambda = kc.lambda;
+    const Eigen::MatrixXd K = KernelFromDtw(Dm, kc.sigma);
+    classifier->sigma = kc.sigma;
+    classifier->ivm = FitIvm(K, cs.labels, groups.num_actions, ip);
+    for (Eigen::Index s = 0; s < classifier->ivm.import_index.size(); ++s) {
+      classifier->import_windows.push_back(cs.windows[classifier->ivm.import_index(s)]);
+    }
+  }
+  rep->sigma = kc.sigma;
+  rep->lambda = kc.lambda;
+
+  ChooseBeliefFilter(groups, cs, Dm, kc, layout, config, params, &classifier->belief, rep);
+  rep->belief_time_constant = classifier->belief.time_constant;
+  rep->belief_motion_weighted = classifier->belief.motion_weighted;
+  rep->num_import_vectors = static_cast<int>(classifier->import_windows.size());
+}
+
+}  // namespace iplan::intent::detail
