@@ -18,6 +18,8 @@ PACKAGES=(
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libsystemd-dev systemd
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the planning benchmark's peer planner (benchmark only, no service links it)
+  libompl-dev
 )
 
 missing=()

@@ -27,7 +27,11 @@
 #include "../test/test_util.h"
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/collision/human_model.h"
+#include "iplan/cell/joint_trajectory.h"
 #include "iplan/collision/scene.h"
+#ifdef IPLAN_HAVE_OMPL
+#include "ompl_peer.h"
+#endif
 #include "iplan/planning/planner.h"
 
 using namespace iplan;
@@ -314,6 +318,72 @@ void CompareClearance(const Planner& planner, const collision::RobotModel& robot
               1e6 * Pct(fcl, 0.5), 1e6 * Pct(fcl, 0.99));
 }
 
+#ifdef IPLAN_HAVE_OMPL
+// Path figures of a trajectory sampled every dt: joint-space length (rad),
+// duration until it stays within 0.01 rad of its end (the replanner's
+// goal_tolerance: arrived) (s), and smoothness
+// sum_i dt ||a_i||^2 (rad^2/s^3, the optimiser's smoothness term without
+// its weight, starting and ending at rest).
+struct PathFigures {
+  double length = 0, duration = 0, smoothness = 0;
+};
+
+PathFigures Figures(const Eigen::MatrixXd& Q, double dt) {
+  PathFigures f;
+  for (Eigen::Index i = 0; i + 1 < Q.cols(); ++i) f.length += (Q.col(i + 1) - Q.col(i)).norm();
+  Eigen::Index last = Q.cols() - 1;
+  while (last > 0 && (Q.col(last - 1) - Q.col(Q.cols() - 1)).cwiseAbs().maxCoeff() < 0.01) --last;
+  f.duration = static_cast<double>(last) * dt;
+  Eigen::MatrixXd A;
+  cell::FiniteDifferenceAccelerations(Q, Eigen::VectorXd::Zero(Q.rows()), dt, &A);
+  f.smoothness = dt * A.squaredNorm();
+  return f;
+}
+
+// iplan and OMPL RRTConnect (+ simplification, time parameterisation) on the
+// same problems, the same collision model and joint goals (iplan's IK
+// solution for the pose goals), within 1 s each.
+void ComparePeer(const Planner& planner, const std::vector<Problem>& problems, int threads) {
+  struct Row {
+    int solved = 0;
+    std::vector<double> first, length, duration, smoothness;
+    void Add(double t_first, const PathFigures& f) {
+      ++solved;
+      first.push_back(t_first);
+      length.push_back(f.length);
+      duration.push_back(f.duration);
+      smoothness.push_back(f.smoothness);
+    }
+  };
+  Row ours, ours1, peer;
+  const double dt = planner.params().dt;
+  for (std::size_t i = 0; i < problems.size(); ++i) {
+    PlanningRequest req;
+    req.start_q = problems[i].start;
+    req.goal = problems[i].goal;
+    const PlanningResult r = planner.Plan(req, 8, std::min(threads, 8), 1000 + i);
+    const PlanningResult r1 = planner.Plan(req, 1, 1, 1000 + i);
+    if (r.success() && r.planning_time <= 1.0) ours.Add(r.time_to_first_feasible, Figures(r.positions, dt));
+    if (r1.success() && r1.planning_time <= 1.0) ours1.Add(r1.time_to_first_feasible, Figures(r1.positions, dt));
+    if (r.goal_q.size() == 0) continue;
+    const bench::PeerResult p = bench::PlanWithRrtConnect(planner, req.start_q, r.goal_q, 1.0, 2026);
+    if (p.solved && p.planning_time <= 1.0) peer.Add(p.time_to_solution, Figures(p.positions, dt));
+  }
+  std::printf("peer comparison on the %zu problems (same robot spheres, scene and min_clearance; joint goals; 1 s each):\n",
+              problems.size());
+  std::printf("  %-44s %9s %22s %18s %16s %22s\n", "planner", "success", "first solution p50/p99", "length p50 rad",
+              "duration p50 s", "smoothness p50 rad2/s3");
+  auto line = [&](const char* name, const Row& w) {
+    std::printf("  %-44s %4d/%-4zu %9.1f / %6.1f ms %18.2f %16.1f %22.2f\n", name, w.solved, problems.size(),
+                1e3 * Pct(w.first, 0.5), 1e3 * Pct(w.first, 0.99), Pct(w.length, 0.5), Pct(w.duration, 0.5),
+                Pct(w.smoothness, 0.5));
+  };
+  line("iplan, 8 optimisers, 2 threads", ours);
+  line("iplan, 1 optimiser, 1 thread", ours1);
+  line("OMPL RRTConnect + simplifyMax, 1 thread", peer);
+}
+#endif
+
 // s, the trajectory optimiser's default cycle budget (config/trajopt.yaml).
 constexpr double kCycleBudget = 0.05;
 
@@ -345,6 +415,11 @@ int main(int argc, char** argv) {
   std::uint64_t fingerprint = 14695981039346656037ULL;
   for (int nopt : {8, 1}) RunOneShot(planner, problems, nopt, threads, &fingerprint);
   CompareClearance(planner, robot);
+#ifdef IPLAN_HAVE_OMPL
+  ComparePeer(planner, problems, threads);
+#else
+  std::printf("peer comparison: OMPL not found at build time (Debian libompl-dev; scripts/setup.sh installs it)\n");
+#endif
 
   // Replanning cycles with a moving person.
   const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
