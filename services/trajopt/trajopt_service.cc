@@ -44,7 +44,14 @@ class TrajoptService : public framework::Service {
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      if (!use_prediction_) return;
-                     node.CountRejection("prediction", replanner_->UpdatePrediction(services::ToJointMixture(m)));
+                     const auto why = replanner_->UpdatePrediction(services::ToJointMixture(m));
+                     node.CountRejection("prediction", why);
+                     if (why) return;
+                     latest_prediction_ = {msg::ToNanoseconds(m.observation_stamp), msg::ToNanoseconds(m.header.stamp)};
+                     // Replan at once with the new prediction (not at the next tick), unless a cycle
+                     // ran less than half a planning step ago.
+                     const auto now = std::chrono::steady_clock::now();
+                     if (replan_on_prediction_ && active_ && now - last_cycle_ >= MinCycleGap()) Step(node);
                    }));
     // The supervisor's permit tells whether the cell is stopped (its stop
     // covers the collision-risk verdict too): stop time counts as delay.
@@ -61,15 +68,27 @@ class TrajoptService : public framework::Service {
     return Result::Ok();
   }
 
+  // Cycles run when a prediction arrives (replan_on_prediction) and, when
+  // none arrives within a planning step (nobody seen, intent down, ablation),
+  // every planning step.
   Result OnActivate(Node& node) override {
-    timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(planning_step_ * 1e9)),
-                           [this, &node] { Step(node); });
+    active_ = true;
+    timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(planning_step_ * 1e9)), [this, &node] {
+      const auto since = std::chrono::steady_clock::now() - last_cycle_;
+      if (!replan_on_prediction_ || since >= std::chrono::duration<double>(0.9 * planning_step_)) Step(node);
+    });
     return Result::Ok();
   }
 
   Result OnDeactivate(Node& node) override {
+    active_ = false;
     node.CancelTimer(timer_);
     return Result::Ok();
+  }
+
+  std::chrono::steady_clock::duration MinCycleGap() const {
+    return std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+        std::chrono::duration<double>(0.5 * planning_step_));
   }
 
  private:
@@ -148,7 +167,9 @@ class TrajoptService : public framework::Service {
 
   void Step(Node& node) {
     const auto t0 = std::chrono::steady_clock::now();
-    const CycleResult r = replanner_->Cycle(msg::ToNanoseconds(msg::Now()));
+    last_cycle_ = t0;
+    const int64_t cycle_start_ns = msg::ToNanoseconds(msg::Now());
+    const CycleResult r = replanner_->Cycle(cycle_start_ns);
     msg::PlanStatus status;
     if (r.publish) {
       trajectory_writer_->Write(services::ToTrajectory(msg::TimeFromNanoseconds(r.start_ns), replanner_->joint_names(),
@@ -160,6 +181,14 @@ class TrajoptService : public framework::Service {
       if (r.prediction_t0_ns > 0) {
         status.skeleton_stamp = msg::TimeFromNanoseconds(r.prediction_t0_ns);
         status.latency = std::max(0.0, 1e-9 * static_cast<double>(published_ns - r.prediction_t0_ns));
+        // The stages of that latency (perception -> intent -> this cycle -> plan out).
+        if (latest_prediction_.first == r.prediction_t0_ns) {
+          status.intent_latency = std::max(0.0, 1e-9 * static_cast<double>(latest_prediction_.second - r.prediction_t0_ns));
+          status.queue_latency = std::max(0.0, 1e-9 * static_cast<double>(cycle_start_ns - latest_prediction_.second));
+          node.SetDiagnosticValue("latency_intent_s", std::to_string(status.intent_latency));
+          node.SetDiagnosticValue("latency_queue_s", std::to_string(status.queue_latency));
+        }
+        node.SetDiagnosticValue("latency_s", std::to_string(status.latency));
       }
     }
     if (r.publish || r.planning_time > 0) {
@@ -182,6 +211,11 @@ class TrajoptService : public framework::Service {
   }
 
   double planning_step_ = 0.1;  // s
+  bool replan_on_prediction_ = true;
+  bool active_ = false;
+  std::chrono::steady_clock::time_point last_cycle_{};
+  // Observation and publication stamps (ns) of the newest accepted prediction.
+  std::pair<int64_t, int64_t> latest_prediction_{0, 0};
   int budget_exhausted_ = 0;    // cycles whose planning ran out of the cycle budget
   bool use_prediction_ = true;
   std::unique_ptr<planning::Planner> planner_;

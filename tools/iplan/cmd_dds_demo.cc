@@ -89,7 +89,12 @@ class CellMonitor {
                                               [this](const msg::TaskOutcome& m, SI) { OnOutcome(m); }),
                    any_order);
     node.Subscribe(topics::PlanStatus(), std::function<void(const msg::PlanStatus&, SI)>([this](const msg::PlanStatus& m, SI) {
-                     if (m.latency > 0) latency_ms_.push_back(1e3 * m.latency);
+                     if (m.latency > 0) {
+                       latency_ms_.push_back(1e3 * m.latency);
+                       intent_ms_.push_back(1e3 * m.intent_latency);
+                       queue_ms_.push_back(1e3 * m.queue_latency);
+                       planning_ms_.push_back(1e3 * m.planning_time);
+                     }
                      waiting_ = m.waiting;
                      max_plan_bound_ = std::max(max_plan_bound_, m.max_bound);
                    }));
@@ -161,6 +166,9 @@ class CellMonitor {
   std::vector<std::string> TakeEvents() { return std::exchange(events_, {}); }
 
   std::vector<double> latency_ms_;
+  // Its stages, per trajectory: skeleton to prediction (intent), prediction
+  // to the planning cycle's start (DDS and waiting), the cycle's planning.
+  std::vector<double> intent_ms_, queue_ms_, planning_ms_;
   double max_bound_ = 0, max_plan_bound_ = 0;
   double separation_ = 1e18, min_observed_separation_ = 1e18;
   uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0;
@@ -393,6 +401,11 @@ int RunDemo(const DemoOptions& o) {
             << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
             << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
             << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
+  const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
+             planning_lat = core::Summarize(mon.planning_ms_);
+  std::cout << "    stages p50/p99: intent " << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
+            << " ms, prediction to planning " << Fixed(queue_lat.p50, 1) << "/" << Fixed(queue_lat.p99, 1)
+            << " ms, planning " << Fixed(planning_lat.p50, 1) << "/" << Fixed(planning_lat.p99, 1) << " ms\n";
   for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
   std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
   for (const auto& [n, e] : mon.episodes()) {
@@ -422,6 +435,9 @@ int RunDemo(const DemoOptions& o) {
     j["protective_stops"] = mon.stops_;
     j["true_contacts"] = contacts;
     j["latency_ms"] = {{"p50", lat.p50}, {"p99", lat.p99}, {"max", lat.max}, {"count", lat.count}};
+    j["latency_stages_ms"] = {{"intent", {{"p50", intent_lat.p50}, {"p99", intent_lat.p99}}},
+                              {"prediction_to_planning", {{"p50", queue_lat.p50}, {"p99", queue_lat.p99}}},
+                              {"planning", {{"p50", planning_lat.p50}, {"p99", planning_lat.p99}}}};
     j["learning_curve"] = nlohmann::json::array();
     for (const auto& [n, e] : mon.episodes()) {
       j["learning_curve"].push_back({{"episode", n},
