@@ -1,29 +1,19 @@
 #include "iplan/intent/model_io.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "iplan/core/atomic_file.h"
+#include "iplan/core/checksum.h"
+
 namespace iplan::intent {
 namespace {
 
 constexpr char kMagic[8] = {'I', 'P', 'L', 'A', 'N', 'I', 'N', 'T'};
-
-std::uint64_t Fnv1a64(const char* data, size_t size) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (size_t i = 0; i < size; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 class Writer {
  public:
@@ -146,10 +136,6 @@ std::string JointDifference(const std::vector<std::string>& model,
   return "a joint is listed twice";
 }
 
-void ThrowErrno(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " '" + path + "': " + std::strerror(errno));
-}
-
 }  // namespace
 
 std::string SerializeIntentModel(const IntentModel& m) {
@@ -201,13 +187,11 @@ std::string SerializeIntentModel(const IntentModel& m) {
   w.F64(m.forecast.motion_offset);
   w.Vec(m.forecast.reference_speed);
   const std::string payload = std::move(w.bytes());
-  Writer file;
-  file.bytes().append(kMagic, sizeof(kMagic));
-  file.Pod<std::uint32_t>(kIntentModelFormatVersion);
-  file.U64(payload.size());
-  file.bytes() += payload;
-  file.U64(Fnv1a64(payload.data(), payload.size()));
-  return std::move(file.bytes());
+  Writer header;
+  header.bytes().append(kMagic, sizeof(kMagic));
+  header.Pod<std::uint32_t>(kIntentModelFormatVersion);
+  header.U64(payload.size());
+  return core::SealChecksummed(header.bytes(), payload, core::ChecksumAt::kAfterPayload);
 }
 
 IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& source) {
@@ -230,9 +214,7 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
                              std::to_string(bytes.size() - std::min(bytes.size(), header + 8)) +
                              " present)");
   }
-  std::uint64_t stored;
-  std::memcpy(&stored, bytes.data() + header + size, 8);
-  if (stored != Fnv1a64(bytes.data() + header, size)) {
+  if (!core::OpenChecksummed(bytes, header, core::ChecksumAt::kAfterPayload)) {
     throw std::runtime_error(source + ": intent model checksum mismatch: the file is corrupt");
   }
   Reader r(bytes.data() + header, size, source);
@@ -334,44 +316,7 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
 }
 
 void SaveIntentModel(const IntentModel& model, const std::string& path) {
-  const std::string bytes = SerializeIntentModel(model);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) ThrowErrno("cannot create", tmp);
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int e = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      errno = e;
-      ThrowErrno("cannot write", tmp);
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int e = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    errno = e;
-    ThrowErrno("cannot fsync", tmp);
-  }
-  ::close(fd);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(tmp.c_str());
-    errno = e;
-    ThrowErrno("cannot rename temporary file onto", path);
-  }
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  core::WriteFileAtomically(path, SerializeIntentModel(model));
 }
 
 IntentModel LoadIntentModel(const std::string& path, const ModelExpectation& expected) {

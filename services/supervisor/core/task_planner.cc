@@ -11,6 +11,7 @@
 #include <yaml-cpp/yaml.h>
 
 #include "iplan/core/atomic_file.h"
+#include "iplan/core/checksum.h"
 #include "iplan/core/yaml.h"
 
 namespace iplan::supervisor {
@@ -20,15 +21,6 @@ namespace {
 // version 1 tables (without it) still load, as 0 episodes.
 constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
 constexpr char kMagicV1[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
-
-uint64_t Fnv(const void* data, std::size_t n, uint64_t h = 1469598103934665603ULL) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 template <class T>
 void Put(std::string* out, const T& v) {
@@ -252,10 +244,10 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
 }
 
 uint64_t TaskPlanner::GraphHash() const {
-  uint64_t h = Fnv("graph", 5);
+  uint64_t h = core::Fnv1a64("graph", core::kIplanFnvSeed);
   for (const auto& t : graph_.tasks) {
-    h = Fnv(t.name.data(), t.name.size(), h);
-    for (const auto& a : t.after) h = Fnv(a.data(), a.size(), h);
+    h = core::Fnv1a64(t.name, h);
+    for (const auto& a : t.after) h = core::Fnv1a64(a, h);
   }
   return h;
 }
@@ -280,9 +272,6 @@ void TaskPlanner::Write(const std::string& path) const {
     Put(&body, s);
     for (double v : row) Put(&body, v);
   }
-  std::string file(kMagic, sizeof(kMagic));
-  Put(&file, Fnv(body.data(), body.size()));
-  file += body;
   // Keep the previous good table: if the new one is ever damaged, the
   // loader falls back to it. Only a file that passes Load's checks becomes
   // the backup: after Load refused a corrupt main file and used the backup,
@@ -293,7 +282,8 @@ void TaskPlanner::Write(const std::string& path) const {
     uint64_t unused_episodes = 0;
     if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
   }
-  core::WriteFileAtomically(path, file);
+  core::WriteChecksummedFileAtomically(path, std::string_view(kMagic, sizeof(kMagic)), body,
+                                      core::ChecksumAt::kBeforePayload);
 }
 
 std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
@@ -318,9 +308,11 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
   const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
   if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
   std::size_t pos = sizeof(kMagic);
-  uint64_t checksum = 0, hash = 0, ntasks = 0, nrows = 0;
-  Get(data, &pos, &checksum);
-  if (Fnv(data.data() + pos, data.size() - pos) != checksum) return path + " is corrupt (checksum mismatch)";
+  uint64_t hash = 0, ntasks = 0, nrows = 0;
+  if (!core::OpenChecksummed(data, sizeof(kMagic), core::ChecksumAt::kBeforePayload)) {
+    return path + " is corrupt (checksum mismatch)";
+  }
+  pos += sizeof(uint64_t);  // the checksum
   uint64_t episodes = 0;
   if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows) ||
       (!v1 && !Get(data, &pos, &episodes))) {

@@ -15,6 +15,7 @@
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
 #include "iplan/core/atomic_file.h"
+#include "iplan/core/checksum.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -211,11 +212,7 @@ TEST(TaskPlanner, TableOfTheFirstFormatStillLoads) {
   }
   ASSERT_EQ(v2.substr(0, 8), "IPLQTBL2");
   std::string body = v2.substr(16, 24) + v2.substr(48);  // without the episode count at 40..47
-  uint64_t sum = 1469598103934665603ULL;
-  for (unsigned char c : body) {
-    sum ^= c;
-    sum *= 1099511628211ULL;
-  }
+  const uint64_t sum = core::Fnv1a64(body, core::kIplanFnvSeed);
   std::string v1 = "IPLQTBL1";
   v1.append(reinterpret_cast<const char*>(&sum), 8);
   v1 += body;
@@ -382,11 +379,7 @@ TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
   ASSERT_EQ(data.size(), 48u + 8 + 3 * 8);
   const double inf = -std::numeric_limits<double>::infinity();
   std::memcpy(&data[48 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
-  uint64_t sum = 1469598103934665603ULL;
-  for (std::size_t i = 16; i < data.size(); ++i) {
-    sum ^= static_cast<unsigned char>(data[i]);
-    sum *= 1099511628211ULL;
-  }
+  const uint64_t sum = core::Fnv1a64(data.data() + 16, data.size() - 16, core::kIplanFnvSeed);
   std::memcpy(&data[8], &sum, 8);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << data;
 
