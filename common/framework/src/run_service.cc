@@ -61,8 +61,13 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
       ->capture_default_str();
   app.add_option("--set", overrides,
                  "override a setting of the configuration file: KEY=VALUE with a dotted key from the "
-                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable)");
-  app.add_flag("--check-config", check_only, "validate the configuration file and exit");
+                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable); "
+                 "a key may continue into a parameter file the configuration names, e.g. "
+                 "--set trajopt.planner.max_iterations=30 (docs/configuration.md)");
+  app.add_flag("--check-config", check_only,
+               "read the configuration and every parameter file it names as the service would (all "
+               "keys, types and ranges, Validate() included), print the problems and exit: 0 valid, "
+               "2 not");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -89,9 +94,8 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
         config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
                             : ConfigSection::Load(config_file));
     for (const std::string& o : overrides) {
-      const size_t eq = o.find('=');
-      if (eq == std::string::npos || eq == 0) throw ConfigError("--set " + o + ": expected KEY=VALUE");
-      config->Override(o.substr(0, eq), o.substr(eq + 1));
+      const auto [key, value] = core::ParseOverride(o);
+      config->Override(key, value);
     }
     ConfigSection node_section = config->Section("node");
     node_section.Read("diagnostics_period", &nopts.diagnostics_period, NonNegative<double>());
@@ -130,6 +134,8 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
       config->Finish();
     } catch (const ConfigError& e) {
       std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
+      // A parameter file the service loaded failed too: say so as well.
+      if (!r.ok) std::cerr << "iplan-" << info.name << ": configure failed: " << r.reason << "\n";
       return kExitConfigError;
     }
     if (!r.ok) {
