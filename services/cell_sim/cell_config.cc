@@ -66,7 +66,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   Check(tconf);
   if (const std::string why = topt.replanner.Validate(); !why.empty()) throw std::runtime_error(file("trajopt") + ": " + why);
   c.replanner = topt.replanner;
-  planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file);
+  planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file, topt.planner_overrides);
   if (planner_threads > 0) pp.num_threads = planner_threads;
   c.planner = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(topt.robot_file),
                                                   collision::LoadSceneParams(topt.scene_file), pp);

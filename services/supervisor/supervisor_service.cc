@@ -12,6 +12,7 @@
 
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
+#include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 
 namespace iplan::supervisor {
@@ -31,14 +32,7 @@ class SupervisorService : public framework::Service {
     config.Read("task_graph", &graph_file);
     config.Read("q_table", &q_table_);
     config.Read("mode", &mode, framework::OneOf({"learning", "deployment"}));
-    config.Read("alpha", &q.alpha, framework::InRange(1e-6, 1.0));
-    config.Read("gamma", &q.gamma, framework::InRange(0.0, 0.999));
-    config.Read("epsilon", &q.epsilon, framework::InRange(0.0, 1.0));
-    config.Read("epsilon_decay", &q.epsilon_decay, framework::InRange(1e-6, 1.0));
-    config.Read("epsilon_min", &q.epsilon_min, framework::InRange(0.0, 1.0));
-    config.Read("delay_weight", &q.delay_weight, framework::NonNegative<double>());
-    int seed = 1;
-    config.Read("seed", &seed, framework::NonNegative<int>());
+    core::ReadParams(config, &q);  // alpha ... seed; ranges: QLearningParams::Validate
     config.Read("watch", &watched);
     config.Read("pause_between_tasks", &pause_, framework::NonNegative<double>());
     double resume_delay = 0.5;
@@ -58,7 +52,6 @@ class SupervisorService : public framework::Service {
       }
     }
     q.learning = mode == "learning";
-    q.seed = static_cast<uint64_t>(seed);
     q_table_ = config.ResolvePath(q_table_);
     try {
       planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph(config.ResolvePath(graph_file)), q);

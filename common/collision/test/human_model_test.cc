@@ -127,7 +127,7 @@ TEST(HumanModelTest, LoadsYamlStrictly) {
     LoadHumanBodyParams(bad);
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown key 'radus' in segments[0]"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("unknown key 'segments[0].radus'"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find(bad), std::string::npos);
   }

@@ -8,11 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 #include "iplan/core/atomic_file.h"
 #include "iplan/core/checksum.h"
-#include "iplan/core/yaml.h"
+#include "iplan/core/params.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -87,47 +85,7 @@ std::string TaskGraph::Validate() const {
 }
 
 TaskGraph LoadTaskGraph(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = core::LoadYamlFile(path);  // a task written twice under one key is an error
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  auto fail = [&](const std::string& key, const std::string& why) {
-    throw std::runtime_error(path + ": key '" + key + "': " + why);
-  };
-  for (auto it = root.begin(); it != root.end(); ++it) {
-    const std::string k = it->first.as<std::string>();
-    if (k != "human_actions" && k != "robot_tasks") fail(k, "unknown key");
-  }
-  TaskGraph g;
-  try {
-    if (root["human_actions"]) g.human_actions = root["human_actions"].as<std::vector<std::string>>();
-    if (!root["robot_tasks"] || !root["robot_tasks"].IsSequence()) fail("robot_tasks", "a list of tasks is required");
-    for (std::size_t i = 0; i < root["robot_tasks"].size(); ++i) {
-      const YAML::Node n = root["robot_tasks"][i];
-      const std::string where = "robot_tasks[" + std::to_string(i) + "]";
-      for (auto it = n.begin(); it != n.end(); ++it) {
-        const std::string k = it->first.as<std::string>();
-        if (k != "name" && k != "goal" && k != "retreat" && k != "after" && k != "conflicts_with") {
-          fail(where + "." + k, "unknown key");
-        }
-      }
-      RobotTask t;
-      if (!n["name"]) fail(where + ".name", "is required");
-      t.name = n["name"].as<std::string>();
-      if (!n["goal"]) fail(where + ".goal", "is required");
-      t.goal = n["goal"].as<std::vector<double>>();
-      if (n["retreat"]) t.retreat = n["retreat"].as<std::vector<double>>();
-      if (n["after"]) t.after = n["after"].as<std::vector<std::string>>();
-      if (n["conflicts_with"]) t.conflicts_with = n["conflicts_with"].as<std::vector<std::string>>();
-      g.tasks.push_back(std::move(t));
-    }
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  if (const std::string why = g.Validate(); !why.empty()) throw std::runtime_error(path + ": " + why);
-  return g;
+  return core::LoadParamsFile<TaskGraph>(path, {}, core::ConfigSection::EmptyFile::kError);
 }
 
 std::string QLearningParams::Validate() const {

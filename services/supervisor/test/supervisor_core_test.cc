@@ -12,6 +12,8 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 #include "core/safety_monitor.h"
 #include "core/task_planner.h"
 #include "iplan/core/atomic_file.h"
@@ -478,6 +480,31 @@ TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
   d = m.Evaluate(&changed, 11 * s + 9 * s / 10);
   EXPECT_FALSE(d.stop);
   EXPECT_TRUE(changed);
+}
+
+TEST(QLearningParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+  const std::string doc = std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md";
+  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(QLearningParams{})), "");
+  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(TaskGraph{})), "");
+}
+
+TEST(TaskGraph, MissingAndUnknownKeysNameTheFileAndTheKey) {
+  const std::string path = TempPath("missing.yaml");
+  std::ofstream(path) << "robot_tasks:\n  - {name: a, gaol: [0, 1]}\n";
+  try {
+    LoadTaskGraph(path);
+    FAIL() << "a task without a goal was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks[0].goal': is required but missing\n" + path +
+                                         ": unknown key 'robot_tasks[0].gaol'");
+  }
+  std::ofstream(path, std::ios::trunc) << "human_actions: [reach]\n";
+  try {
+    LoadTaskGraph(path);
+    FAIL() << "a graph without tasks was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks': is required but missing");
+  }
 }
 
 }  // namespace
