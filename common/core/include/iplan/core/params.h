@@ -19,7 +19,8 @@
 //
 // Field types: bool, int, std::uint64_t, double, std::string,
 // std::vector<double>, std::vector<std::string>, std::array<double, N>,
-// std::vector<std::pair<std::string, std::string>> (a list of [a, b]), and
+// std::vector<std::pair<std::string, std::string>> (a list of [a, b]),
+// std::optional of those (absent: nullopt), and
 // any struct with its own Serialize (read from a nested mapping) and
 // std::vector of such structs (a list of mappings). IPLAN_NVP_REQUIRED marks
 // a key a file must give.
@@ -27,6 +28,7 @@
 
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <type_traits>
 #include <utility>
@@ -70,6 +72,15 @@ class ParamsReader {
   template <class T>
   void ReadValue(const char* key, T* value) {
     section_.Read(key, value);
+  }
+  // Absent: nullopt (or the default); present: the value.
+  template <class T>
+  void ReadValue(const char* key, std::optional<T>* value) {
+    if (!section_.Has(key)) return;
+    const std::size_t before = section_.Problems().size();
+    T v{};
+    ReadValue(key, &v);
+    if (section_.Problems().size() == before) *value = v;
   }
   // A list of mappings, one struct each; present, it replaces the default list.
   template <class T, class = std::enable_if_t<HasSerialize<T>::value>>
@@ -147,6 +158,10 @@ std::string ParamText(const std::vector<std::pair<std::string, std::string>>& v)
 template <std::size_t N>
 std::string ParamText(const std::array<double, N>& v) {
   return ParamText(std::vector<double>(v.begin(), v.end()));
+}
+template <class T>
+std::string ParamText(const std::optional<T>& v) {
+  return v ? ParamText(*v) : std::string("(none)");
 }
 
 /// Lists every field of a params struct with its current value.
