@@ -151,23 +151,16 @@ collision::HumanPrediction RecordedPrediction(const collision::HumanBodyModel& b
   return pred;
 }
 
-int main(int argc, char** argv) {
-  const int num_problems = argc > 1 ? std::atoi(argv[1]) : 60;
-  const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
-  const collision::RobotModel robot = testing::LoadPanda();
-  PlannerParams params = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml");
-  Planner planner(robot, testing::LoadCell(), params);
+// `n` seeded table-top problems for `planner`; counts the candidates rejected.
+std::vector<Problem> MakeProblems(const Planner& planner, int n, int* ik_rejected) {
   Eigen::VectorXd ready(7);
   ready << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
-
-  // Problems.
   const auto poses = testing::TableTopPoses();
   std::mt19937_64 rng(2026);
   std::uniform_int_distribution<int> pick(0, static_cast<int>(poses.size()) - 1);
   std::uniform_real_distribution<double> jit(-0.03, 0.03), yaw(-0.3, 0.3);
   std::vector<Problem> problems;
-  int ik_rejected = 0;
-  while (static_cast<int>(problems.size()) < num_problems) {
+  while (static_cast<int>(problems.size()) < n) {
     const int a = pick(rng), b = pick(rng);
     if (a == b) continue;
     const Eigen::Vector3d pa = poses[a].p + Eigen::Vector3d(jit(rng), jit(rng), jit(rng));
@@ -175,7 +168,7 @@ int main(int argc, char** argv) {
     const double ya = yaw(rng), yb = yaw(rng);
     const IkResult s = planner.SolveIk(pa, testing::DownOrientation(ya), ready, problems.size());
     if (!s.success || planner.CalcClearance(s.q) < 0.0) {
-      ++ik_rejected;
+      ++*ik_rejected;
       continue;
     }
     Problem pr;
@@ -186,18 +179,19 @@ int main(int argc, char** argv) {
     } else {
       const IkResult g = planner.SolveIk(pb, testing::DownOrientation(yb), s.q, problems.size() + 7);
       if (!g.success || planner.CalcClearance(g.q) < 0.0) {
-        ++ik_rejected;
+        ++*ik_rejected;
         continue;
       }
       pr.goal = Goal::Joint(g.q);
     }
     problems.push_back(pr);
   }
+  return problems;
+}
 
-  std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
-              "%d worker threads, dt %.2f s, horizon %.1f s\n",
-              num_problems, ik_rejected, threads, params.dt, params.horizon);
-  std::uint64_t fingerprint = core::kStandardFnvSeed;
+// One-shot planning of every problem with 8 and with 1 optimiser.
+void RunOneShot(const Planner& planner, const std::vector<Problem>& problems, int threads,
+                std::uint64_t* fingerprint) {
   for (int nopt : {8, 1}) {
     int ok = 0, ok_1s = 0;
     std::vector<double> t_first, t_total, cost;
@@ -207,7 +201,7 @@ int main(int argc, char** argv) {
       req.goal = problems[i].goal;
       const PlanningResult r = planner.Plan(req, nopt, std::min(threads, nopt), 1000 + i);
       t_total.push_back(r.planning_time);
-      Fingerprint(r, &fingerprint);
+      Fingerprint(r, fingerprint);
       if (r.success) {
         ++ok;
         if (r.planning_time <= 1.0) ++ok_1s;
@@ -225,6 +219,67 @@ int main(int argc, char** argv) {
                 1e3 * Pct(t_total, 0.99), 1e3 * Pct(t_total, 1.0));
     std::printf("  final cost: p50 %.2f, p10 %.2f, p90 %.2f\n", Pct(cost, 0.5), Pct(cost, 0.1), Pct(cost, 0.9));
   }
+}
+
+// Runs 12 tasks x 25 replanning cycles; `make(k)` is the prediction at cycle k.
+void RunReplanning(const char* label, const Planner& replanner, const std::vector<Problem>& problems,
+                   int threads, int num_spheres, const std::function<collision::HumanPrediction(int)>& make,
+                   std::uint64_t* fingerprint) {
+  std::vector<double> cycle;
+  int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
+  const int cycles_per_task = 25;
+  for (std::size_t i = 0; i < problems.size() && tasks < 12; i += 5, ++tasks) {
+    PlanningRequest req;
+    req.start_q = problems[i].start;
+    req.goal = problems[i].goal;
+    PlanningResult prev;
+    bool task_ok = true;
+    for (int k = 0; k < cycles_per_task; ++k) {
+      const collision::HumanPrediction pred = make(k);
+      req.prediction = &pred;
+      req.prediction_dt = 0.1;
+      req.prediction_start = 0.0;
+      if (k > 0 && prev.positions.cols() > 1) {
+        req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
+        req.start_q = req.warm_start.col(0);
+        req.start_qdot = (prev.positions.col(2) - prev.positions.col(1)) / prev.dt;
+        req.num_frozen = 3;
+        req.goal = Goal::Joint(prev.goal_q);
+      }
+      const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
+      cycle.push_back(r.planning_time);
+      Fingerprint(r, fingerprint);
+      total_waits += r.num_waits;
+      if (!r.success) {
+        ++cycles_failed;
+        task_ok = false;
+        if (r.positions.cols() == 0) break;
+      }
+      prev = r;
+    }
+    tasks_ok += task_ok;
+  }
+  std::printf("replanning, %s (max_waits 1, max_iterations 30, early_stop_interval 3): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
+              label, tasks, cycles_per_task, threads, num_spheres);
+  std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
+              1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
+  std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
+              cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
+}
+
+int main(int argc, char** argv) {
+  const int num_problems = argc > 1 ? std::atoi(argv[1]) : 60;
+  const int threads = argc > 2 ? std::atoi(argv[2]) : 2;
+  const collision::RobotModel robot = testing::LoadPanda();
+  PlannerParams params = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml");
+  Planner planner(robot, testing::LoadCell(), params);
+  int ik_rejected = 0;
+  const std::vector<Problem> problems = MakeProblems(planner, num_problems, &ik_rejected);
+  std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
+              "%d worker threads, dt %.2f s, horizon %.1f s\n",
+              num_problems, ik_rejected, threads, params.dt, params.horizon);
+  std::uint64_t fingerprint = core::kStandardFnvSeed;
+  RunOneShot(planner, problems, threads, &fingerprint);
 
   // Replanning cycles with a moving person.
   const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
@@ -240,61 +295,20 @@ int main(int argc, char** argv) {
   replan_params.max_iterations = 30;
   replan_params.early_stop_interval = 3;
   Planner replanner(robot, testing::LoadCell(), replan_params);
-  // Runs 12 tasks x 25 replanning cycles; `make(k)` is the prediction at cycle k.
-  auto run_replanning = [&](const char* label,
-                            const std::function<collision::HumanPrediction(int)>& make) {
-    std::vector<double> cycle;
-    int tasks = 0, tasks_ok = 0, cycles_failed = 0, total_waits = 0;
-    const int cycles_per_task = 25;
-    for (std::size_t i = 0; i < problems.size() && tasks < 12; i += 5, ++tasks) {
-      PlanningRequest req;
-      req.start_q = problems[i].start;
-      req.goal = problems[i].goal;
-      PlanningResult prev;
-      bool task_ok = true;
-      for (int k = 0; k < cycles_per_task; ++k) {
-        const collision::HumanPrediction pred = make(k);
-        req.prediction = &pred;
-        req.prediction_dt = 0.1;
-        req.prediction_start = 0.0;
-        if (k > 0 && prev.positions.cols() > 1) {
-          req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
-          req.start_q = req.warm_start.col(0);
-          req.start_qdot = (prev.positions.col(2) - prev.positions.col(1)) / prev.dt;
-          req.num_frozen = 3;
-          req.goal = Goal::Joint(prev.goal_q);
-        }
-        const PlanningResult r = replanner.Plan(req, 8, threads, 77 + k);
-        cycle.push_back(r.planning_time);
-        Fingerprint(r, &fingerprint);
-        total_waits += r.num_waits;
-        if (!r.success) {
-          ++cycles_failed;
-          task_ok = false;
-          if (r.positions.cols() == 0) break;
-        }
-        prev = r;
-      }
-      tasks_ok += task_ok;
-    }
-    std::printf("replanning, %s (max_waits 1, max_iterations 30, early_stop_interval 3): %d tasks x %d cycles, 8 optimisers, %d threads, prediction 10 actions x 15 steps x %d spheres\n",
-                label, tasks, cycles_per_task, threads, body.num_spheres());
-    std::printf("  cycle time p50 %.1f ms, p90 %.1f ms, p99 %.1f ms, max %.1f ms (target p99 <= 100 ms)\n",
-                1e3 * Pct(cycle, 0.5), 1e3 * Pct(cycle, 0.9), 1e3 * Pct(cycle, 0.99), 1e3 * Pct(cycle, 1.0));
-    std::printf("  cycles without a safe trajectory: %d of %zu; waits inserted: %d; tasks with every cycle safe: %d/%d\n",
-                cycles_failed, cycle.size(), total_waits, tasks_ok, tasks);
-  };
-  run_replanning("synthesised reaching person", [&](int k) {
-    const double y = -0.5 + 1.0 * k / 24;
-    return testing::MakeReachingPrediction(body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
-  });
+  RunReplanning("synthesised reaching person", replanner, problems, threads, body.num_spheres(),
+                [&](int k) {
+                  const double y = -0.5 + 1.0 * k / 24;
+                  return testing::MakeReachingPrediction(body, targets, 15, 0.03, 0.06,
+                                                         Eigen::Vector3d(0.0, y, 0.0));
+                },
+                &fingerprint);
   // A recorded person: arm motion of assembly.csv (RealSense + OpenPose,
   // human1, task1 trial1) placed across the table and walking sideways.
   const RecordedPerson person = LoadRecordedPerson(std::string(IPLAN_SHARED_DIR) + "/data/assembly.csv",
                                                    "task1_human1_trial1");
-  run_replanning("recorded person (assembly.csv task1_human1_trial1)", [&](int k) {
-    return RecordedPrediction(body, person, k, -0.5 + 1.0 * k / 24);
-  });
+  RunReplanning("recorded person (assembly.csv task1_human1_trial1)", replanner, problems, threads,
+                body.num_spheres(), [&](int k) { return RecordedPrediction(body, person, k, -0.5 + 1.0 * k / 24); },
+                &fingerprint);
   std::printf("results fingerprint %016llx (same seeds and results => same value)\n",
               static_cast<unsigned long long>(fingerprint));
   return 0;
