@@ -3,7 +3,9 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
+#include "iplan/core/params.h"
 #include "iplan/collision/scene.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner_params.h"
@@ -93,11 +95,11 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // The supervisor: task graph and resume hysteresis.
   framework::ConfigSection vconf = framework::ConfigSection::Load(file("supervisor"));
   framework::ConfigSection vsec = vconf.Section("supervisor");
-  std::string graph_file = "tasks/table_top.yaml";
-  vsec.Read("task_graph", &graph_file);
-  vsec.Read("resume_delay", &c.loop.resume_delay, framework::NonNegative<double>());
+  supervisor::SupervisorSettings settings;
+  core::ReadParams(vsec, &settings);  // the service's keys and ranges
+  c.loop.resume_delay = settings.resume_delay;
   Check(vconf);
-  const supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(graph_file));
+  const supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
 
   // The sensor and the synthetic person.

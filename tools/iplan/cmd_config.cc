@@ -6,6 +6,7 @@
 #include <string>
 
 #include "command_registry.h"
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/core/params.h"
@@ -26,9 +27,9 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"replanner",
        {"config/trajopt.yaml, section trajopt; ReplannerParams",
         [] { return iplan::core::DescribeParams(iplan::trajopt::ReplannerParams{}); }}},
-      {"q-learning",
-       {"config/supervisor.yaml, section supervisor; QLearningParams",
-        [] { return iplan::core::DescribeParams(iplan::supervisor::QLearningParams{}); }}},
+      {"supervisor",
+       {"config/supervisor.yaml, section supervisor; SupervisorSettings (QLearningParams' keys inline)",
+        [] { return iplan::core::DescribeParams(iplan::supervisor::SupervisorSettings{}); }}},
       {"task-graph",
        {"config/tasks/*.yaml (top level); TaskGraph",
         [] { return iplan::core::DescribeParams(iplan::supervisor::TaskGraph{}); }}},

@@ -15,6 +15,7 @@
 #include "iplan/core/params.h"
 
 #include "core/safety_monitor.h"
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/core/checksum.h"
@@ -482,9 +483,19 @@ TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
   EXPECT_TRUE(changed);
 }
 
-TEST(QLearningParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+TEST(SupervisorSettings, TheDocumentedDefaultsAreTheDeclaredOnesAndValid) {
   const std::string doc = std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md";
-  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(QLearningParams{})), "");
+  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(SupervisorSettings{})), "");
+  EXPECT_EQ(SupervisorSettings{}.Validate(), "");
+  SupervisorSettings s;
+  s.learning.gamma = 1.0;  // the core's [0, 1): the service no longer has a range of its own
+  EXPECT_EQ(s.Validate(), "gamma must be in [0, 1)");
+  s = SupervisorSettings{};
+  s.learning.gamma = 0.9995;
+  EXPECT_EQ(s.Validate(), "");
+  s.mode = "deployment";
+  s.watch.clear();
+  EXPECT_NE(s.Validate().find("watch must name at least one topic in deployment"), std::string::npos);
   EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(TaskGraph{})), "");
 }
 
