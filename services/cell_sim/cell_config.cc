@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/robot_sim_settings.h"
 #include "core/supervisor_settings.h"
 #include "core/task_planner.h"
 #include "iplan/core/params.h"
@@ -86,10 +87,11 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // The simulated robot.
   framework::ConfigSection sconf = framework::ConfigSection::Load(file("robot_sim"));
   framework::ConfigSection ssec = sconf.Section("robot_sim");
-  ssec.Read("control_rate_hz", &c.loop.control_rate_hz, framework::InRange(10.0, 2000.0));
-  ssec.Read("publish_rate_hz", &c.loop.joint_state_rate_hz, framework::InRange(1.0, 1000.0));
-  ssec.Read("stopping_time", &c.simulator.stopping_time, framework::Positive<double>());
-  ssec.Read("contact_margin", &c.simulator.contact_margin, framework::NonNegative<double>());
+  robot_sim::RobotSimSettings sim;
+  core::ReadParams(ssec, &sim);  // the service's keys and ranges
+  c.loop.control_rate_hz = sim.control_rate_hz;
+  c.loop.joint_state_rate_hz = sim.publish_rate_hz;
+  c.simulator = sim.simulator;
   Check(sconf);
 
   // The supervisor: task graph and resume hysteresis.

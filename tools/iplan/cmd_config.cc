@@ -6,6 +6,7 @@
 #include <string>
 
 #include "command_registry.h"
+#include "core/robot_sim_settings.h"
 #include "core/supervisor_settings.h"
 #include "core/task_planner.h"
 #include "iplan/collision/human_model.h"
@@ -30,6 +31,9 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"supervisor",
        {"config/supervisor.yaml, section supervisor; SupervisorSettings (QLearningParams' keys inline)",
         [] { return iplan::core::DescribeParams(iplan::supervisor::SupervisorSettings{}); }}},
+      {"robot-sim",
+       {"config/robot_sim.yaml, section robot_sim; RobotSimSettings (SimulatorParams' keys inline)",
+        [] { return iplan::core::DescribeParams(iplan::robot_sim::RobotSimSettings{}); }}},
       {"task-graph",
        {"config/tasks/*.yaml (top level); TaskGraph",
         [] { return iplan::core::DescribeParams(iplan::supervisor::TaskGraph{}); }}},

@@ -62,7 +62,7 @@ bool Configure(const std::string& name, ConfigSection* config, Service* service,
   } catch (const ConfigError& e) {
     std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
     // A parameter file the service loaded failed too: say so as well.
-    if (!r.ok) std::cerr << "iplan-" << name << ": configure failed: " << r.reason << "\n";
+    if (!r.ok && std::string(e.what()).find(r.reason) == std::string::npos) std::cerr << "iplan-" << name << ": configure failed: " << r.reason << "\n";
     return false;
   }
   if (!r.ok) {
