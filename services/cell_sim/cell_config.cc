@@ -3,7 +3,10 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/robot_sim_settings.h"
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
+#include "iplan/core/params.h"
 #include "iplan/collision/scene.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner_params.h"
@@ -66,7 +69,10 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   Check(tconf);
   if (const std::string why = topt.replanner.Validate(); !why.empty()) throw std::runtime_error(file("trajopt") + ": " + why);
   c.replanner = topt.replanner;
-  planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file);
+  // Simulated time: a wall-clock budget would make the benchmark depend on
+  // the machine's load; it plans every cycle to the end.
+  c.replanner.cycle_budget = 0.0;
+  planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file, topt.planner_overrides);
   if (planner_threads > 0) pp.num_threads = planner_threads;
   c.planner = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(topt.robot_file),
                                                   collision::LoadSceneParams(topt.scene_file), pp);
@@ -84,20 +90,21 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // The simulated robot.
   framework::ConfigSection sconf = framework::ConfigSection::Load(file("robot_sim"));
   framework::ConfigSection ssec = sconf.Section("robot_sim");
-  ssec.Read("control_rate_hz", &c.loop.control_rate_hz, framework::InRange(10.0, 2000.0));
-  ssec.Read("publish_rate_hz", &c.loop.joint_state_rate_hz, framework::InRange(1.0, 1000.0));
-  ssec.Read("stopping_time", &c.simulator.stopping_time, framework::Positive<double>());
-  ssec.Read("contact_margin", &c.simulator.contact_margin, framework::NonNegative<double>());
+  robot_sim::RobotSimSettings sim;
+  core::ReadParams(ssec, &sim);  // the service's keys and ranges
+  c.loop.control_rate_hz = sim.control_rate_hz;
+  c.loop.joint_state_rate_hz = sim.publish_rate_hz;
+  c.simulator = sim.simulator;
   Check(sconf);
 
   // The supervisor: task graph and resume hysteresis.
   framework::ConfigSection vconf = framework::ConfigSection::Load(file("supervisor"));
   framework::ConfigSection vsec = vconf.Section("supervisor");
-  std::string graph_file = "tasks/table_top.yaml";
-  vsec.Read("task_graph", &graph_file);
-  vsec.Read("resume_delay", &c.loop.resume_delay, framework::NonNegative<double>());
+  supervisor::SupervisorSettings settings;
+  core::ReadParams(vsec, &settings);  // the service's keys and ranges
+  c.loop.resume_delay = settings.resume_delay;
   Check(vconf);
-  const supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(graph_file));
+  const supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
 
   // The sensor and the synthetic person.

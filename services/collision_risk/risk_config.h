@@ -18,9 +18,9 @@ struct RiskConfig {
   std::string human_body_file;
 };
 
-/// Reads `section` (collision_risk); problems with single keys are recorded
-/// in the configuration (reported by Finish()), cross-key ones are left to
-/// RiskParams::Validate(). Keys: robot, human_body, rate_hz,
+/// Reads `section` (collision_risk); every problem, RiskParams::Validate()'s
+/// (the only ranges of RiskParams) included, is recorded in the
+/// configuration (reported by Finish()). Keys: robot, human_body, rate_hz,
 /// delta_cl, stop_horizon, slow_down_fraction, slow_down_margin, stale_after,
 /// iso_ts_15066.{measure_human_speed, default_human_speed, speed_window,
 /// reaction_time, stopping_time, stopping_distance, intrusion_distance,

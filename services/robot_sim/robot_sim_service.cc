@@ -8,6 +8,8 @@
 
 #include "common/adapters.h"
 #include "core/robot_simulator.h"
+#include "core/robot_sim_settings.h"
+#include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 #include "iplan/safety/permit_gate.h"
 
@@ -21,23 +23,16 @@ using framework::Result;
 class RobotSimService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml";
-    std::vector<double> q0 = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
-    SimulatorParams params;
-    config.Read("robot", &robot_file);
-    config.Read("human_body", &body_file);
-    config.Read("initial_positions", &q0);
-    config.Read("control_rate_hz", &control_rate_hz_, framework::InRange(10.0, 2000.0));
-    config.Read("publish_rate_hz", &publish_rate_hz_, framework::InRange(1.0, 1000.0));
-    config.Read("stopping_time", &params.stopping_time, framework::Positive<double>());
-    config.Read("contact_margin", &params.contact_margin, framework::NonNegative<double>());
-    safety::PermitGateParams permits;
-    permits.monitors = {"iplan-supervisor", "iplan-collision_risk"};
-    ConfigSection pc = config.Section("permits");
-    pc.Read("monitors", &permits.monitors);
-    pc.Read("max_validity", &permits.max_validity, framework::InRange(1e-3, 10.0));
-    pc.Read("clock_tolerance", &permits.clock_tolerance, framework::InRange(0.0, 1.0));
-    if (const std::string why = permits.Validate(); !why.empty()) return Result::Fail(config.file() + ": " + why);
+    RobotSimSettings settings;
+    core::ReadParams(config, &settings);  // every range: RobotSimSettings::Validate
+    // Invalid settings are a configuration problem (recorded above), not something to build from.
+    if (const std::string why = settings.Validate(); !why.empty()) return Result::Fail(why);
+    control_rate_hz_ = settings.control_rate_hz;
+    publish_rate_hz_ = settings.publish_rate_hz;
+    const std::string robot_file = settings.robot, body_file = settings.human_body;
+    const std::vector<double>& q0 = settings.initial_positions;
+    const SimulatorParams& params = settings.simulator;
+    const safety::PermitGateParams& permits = settings.permits;
     gate_ = std::make_unique<safety::PermitGate>(permits);
     try {
       auto robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));

@@ -12,7 +12,9 @@
 
 #include "common/adapters.h"
 #include "core/safety_monitor.h"
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
+#include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 
 namespace iplan::supervisor {
@@ -25,42 +27,22 @@ using framework::Result;
 class SupervisorService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    std::string graph_file = "tasks/table_top.yaml", mode = "learning";
-    std::vector<std::string> watched = {"human_skeleton", "human_prediction", "joint_states", "robot_trajectory",
-                                        "collision_risk"};
-    QLearningParams q;
-    config.Read("task_graph", &graph_file);
-    config.Read("q_table", &q_table_);
-    config.Read("mode", &mode, framework::OneOf({"learning", "deployment"}));
-    config.Read("alpha", &q.alpha, framework::InRange(1e-6, 1.0));
-    config.Read("gamma", &q.gamma, framework::InRange(0.0, 0.999));
-    config.Read("epsilon", &q.epsilon, framework::InRange(0.0, 1.0));
-    config.Read("epsilon_decay", &q.epsilon_decay, framework::InRange(1e-6, 1.0));
-    config.Read("epsilon_min", &q.epsilon_min, framework::InRange(0.0, 1.0));
-    config.Read("delay_weight", &q.delay_weight, framework::NonNegative<double>());
-    int seed = 1;
-    config.Read("seed", &seed, framework::NonNegative<int>());
-    config.Read("watch", &watched);
-    config.Read("pause_between_tasks", &pause_, framework::NonNegative<double>());
-    double resume_delay = 0.5;
-    config.Read("resume_delay", &resume_delay, framework::InRange(0.0, 10.0));
-    config.Read("max_episodes", &max_episodes_, framework::NonNegative<int>());
-    config.Read("permit_period", &permit_period_, framework::InRange(0.005, 1.0));
-    config.Read("permit_validity", &permit_validity_, framework::InRange(0.01, 10.0));
-    config.Read("command_resend_period", &resend_period_, framework::InRange(0.1, 60.0));
-    if (permit_validity_ < 2 * permit_period_) {
-      config.AddError("permit_validity", "must be at least twice permit_period (one late permit must not stop the cell)");
+    SupervisorSettings settings;
+    core::ReadParams(config, &settings);  // every range: SupervisorSettings::Validate
+    if (settings.watch.empty()) {
+      node.log().warn("supervisor.watch is empty: the deadline / liveliness monitor watches nothing");
     }
-    if (watched.empty()) {
-      if (mode == "deployment") {
-        config.AddError("watch", "must name at least one topic in deployment (an empty list switches the deadline monitor off)");
-      } else {
-        node.log().warn("supervisor.watch is empty: the deadline / liveliness monitor watches nothing");
-      }
-    }
-    q.learning = mode == "learning";
-    q.seed = static_cast<uint64_t>(seed);
-    q_table_ = config.ResolvePath(q_table_);
+    QLearningParams q = settings.learning;
+    q.learning = settings.mode == "learning";
+    const std::vector<std::string>& watched = settings.watch;
+    const std::string graph_file = settings.task_graph;
+    const double resume_delay = settings.resume_delay;
+    q_table_ = config.ResolvePath(settings.q_table);
+    pause_ = settings.pause_between_tasks;
+    max_episodes_ = settings.max_episodes;
+    permit_period_ = settings.permit_period;
+    permit_validity_ = settings.permit_validity;
+    resend_period_ = settings.command_resend_period;
     try {
       planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph(config.ResolvePath(graph_file)), q);
       if (!q_table_.empty()) {

@@ -19,16 +19,20 @@ struct TrajoptConfig {
   std::string human_body_file;
   std::string scene_file;
   std::string planner_file;
+  /// --set trajopt.planner.KEY=VALUE overrides, for LoadPlannerParams.
+  core::Overrides planner_overrides;
   /// false: the planner ignores the person (no prediction enters the plan;
   /// only the collision-risk monitor protects), for ablations.
   bool use_prediction = true;
+  /// true: a cycle starts when a prediction arrives (and on the planning
+  /// step's tick when none does); false: only on the tick.
+  bool replan_on_prediction = true;
 };
 
-/// Reads `section` (trajopt); problems with single keys are recorded in the
-/// configuration (reported by Finish()), cross-key ones are left to
-/// ReplannerParams::Validate(). Keys: robot, human_body, scene, planner,
-/// planning_step, frozen_waypoints, goal_tolerance, settle_speed,
-/// stale_after, max_tracking_error, use_prediction.
+/// Reads `section` (trajopt); every problem, ReplannerParams::Validate()'s
+/// included, is recorded in the configuration (reported by Finish()). Keys:
+/// robot, human_body, scene, planner (file names, relative to the
+/// configuration file), use_prediction and ReplannerParams::Serialize's.
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& section);
 
 /// Loads the robot model, static scene and planner parameters named by

@@ -24,6 +24,7 @@ class TrajoptService : public framework::Service {
     const TrajoptConfig c = ReadTrajoptConfig(config);
     planning_step_ = c.replanner.planning_step;
     use_prediction_ = c.use_prediction;
+    replan_on_prediction_ = c.replan_on_prediction;
     if (!use_prediction_) node.log().warn("trajopt.use_prediction is false: plans ignore the person (ablation)");
     try {
       planner_ = MakePlanner(c);

@@ -94,9 +94,9 @@ INSTANTIATE_TEST_SUITE_P(
     Cases, RefusedSafetyConfig,
     ::testing::Values(
         SafetyConfig{"supervisor", "supervisor:\n  mode: deployment\n  watch: []\n",
-                     "key 'supervisor.watch': must name at least one topic in deployment"},
+                     "section 'supervisor': watch must name at least one topic in deployment"},
         SafetyConfig{"supervisor", "supervisor:\n  permit_period: 0.1\n  permit_validity: 0.15\n",
-                     "key 'supervisor.permit_validity': must be at least twice permit_period"},
+                     "section 'supervisor': permit_validity must be at least twice permit_period"},
         SafetyConfig{"supervisor", "supervisor:\n  alpha: 0.1\n  alpha: 0.2\n", "key 'supervisor.alpha': appears twice"},
         SafetyConfig{"supervisor", "# nothing but a comment\n", "the file is empty"},
         SafetyConfig{"robot-sim", "robot_sim:\n  permits:\n    monitors: []\n",

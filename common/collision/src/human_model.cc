@@ -6,9 +6,7 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
-#include "iplan/core/yaml.h"
+#include "iplan/core/params.h"
 
 #include "check.h"
 
@@ -76,47 +74,7 @@ HumanBodyParams HumanBodyParams::DefaultUpperBody() {
 }
 
 HumanBodyParams LoadHumanBodyParams(const std::string& path) {
-  auto fail = [&](const std::string& what) -> void {
-    throw std::runtime_error(path + ": " + what);
-  };
-  HumanBodyParams p;
-  try {
-    const YAML::Node root = core::LoadYamlFile(path);  // a key twice is an error
-    if (!root.IsMap()) fail("top level must be a map");
-    for (const auto& kv : root) {
-      const std::string key = kv.first.as<std::string>();
-      if (key != "joints" && key != "segments") fail("unknown key '" + key + "' at the top level");
-    }
-    if (!root["joints"] || !root["joints"].IsSequence()) fail("'joints' must be a list of names");
-    for (const auto& j : root["joints"]) p.joints.push_back(j.as<std::string>());
-    if (!root["segments"] || !root["segments"].IsSequence()) fail("'segments' must be a list");
-    for (size_t i = 0; i < root["segments"].size(); ++i) {
-      const YAML::Node n = root["segments"][i];
-      const std::string where = "segments[" + std::to_string(i) + "]";
-      if (!n.IsMap()) fail(where + " must be a map");
-      for (const auto& kv : n) {
-        const std::string key = kv.first.as<std::string>();
-        static const std::set<std::string> kAllowed = {"name",  "joint_a", "joint_b",
-                                                       "count", "radius",  "u"};
-        if (kAllowed.count(key) == 0) fail("unknown key '" + key + "' in " + where);
-      }
-      HumanSegmentParams s;
-      for (const char* key : {"name", "joint_a", "joint_b", "count", "radius"}) {
-        if (!n[key]) fail("missing key '" + std::string(key) + "' in " + where);
-      }
-      s.name = n["name"].as<std::string>();
-      s.joint_a = n["joint_a"].as<std::string>();
-      s.joint_b = n["joint_b"].as<std::string>();
-      s.count = n["count"].as<int>();
-      s.radius = n["radius"].as<double>();
-      if (n["u"]) s.u = n["u"].as<std::vector<double>>();
-      p.segments.push_back(s);
-    }
-  } catch (const YAML::Exception& e) {
-    fail(std::string("invalid YAML: ") + e.what());
-  }
-  if (const std::string why = p.Validate(); !why.empty()) fail(why);
-  return p;
+  return core::LoadParamsFile<HumanBodyParams>(path, {}, core::ConfigSection::EmptyFile::kError);
 }
 
 HumanBodyModel::HumanBodyModel(HumanBodyParams params) : params_(std::move(params)) {

@@ -1,17 +1,18 @@
 #include "iplan/collision/robot_model.h"
 
+#include <array>
 #include <cmath>
 #include <cstdio>
 #include <functional>
 #include <limits>
+#include <optional>
 #include <set>
 #include <sstream>
 #include <stdexcept>
 
 #include <urdf_parser/urdf_parser.h>
-#include <yaml-cpp/yaml.h>
 
-#include "iplan/core/yaml.h"
+#include "iplan/core/params.h"
 
 #include "check.h"
 
@@ -341,59 +342,124 @@ RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptio
 }
 
 // ---------------------------------------------------------------------------
-// YAML (modified DH).
+// YAML (modified DH). The file's keys are declared once below
+// (core/params.h); the model is built from what they read.
 namespace {
 
-void CheckKeys(const YAML::Node& node, const std::set<std::string>& allowed,
-               const std::string& where, const std::string& path) {
-  if (!node.IsMap()) Fail(path, where + " must be a map");
-  for (const auto& kv : node) {
-    const std::string key = kv.first.as<std::string>();
-    if (allowed.count(key) == 0) Fail(path, "unknown key '" + key + "' in " + where);
-  }
-}
+// A fixed frame: modified DH parameters of its joint from the parent link.
+struct DhFrameEntry {
+  std::optional<std::string> name;
+  std::string link;
+  std::optional<std::string> parent;
+  double a = 0.0;
+  double d = 0.0;
+  double alpha = 0.0;
+  double theta = 0.0;
 
-double GetDouble(const YAML::Node& node, const std::string& key, const std::string& where,
-                 const std::string& path, const double* fallback = nullptr) {
-  const YAML::Node v = node[key];
-  if (!v) {
-    if (fallback != nullptr) return *fallback;
-    Fail(path, "missing key '" + key + "' in " + where);
+  template <class Archive>
+  void VisitFrame(Archive* ar) {
+    ar->Visit(IPLAN_NVP(name, "joint name (default: LINK_fixed)"));
+    ar->Visit(IPLAN_NVP_REQUIRED(link, "child link name, new"));
+    ar->Visit(IPLAN_NVP(parent, "parent link (default: the previous one)"));
+    ar->Visit(IPLAN_NVP_REQUIRED(a, "m; modified DH a"));
+    ar->Visit(IPLAN_NVP_REQUIRED(d, "m; modified DH d"));
+    ar->Visit(IPLAN_NVP_REQUIRED(alpha, "rad; modified DH alpha"));
+    ar->Visit(IPLAN_NVP(theta, "rad; modified DH theta offset"));
   }
-  double x = 0.0;
-  try {
-    x = v.as<double>();
-  } catch (const YAML::Exception&) {
-    Fail(path, "key '" + key + "' in " + where + " is not a number: '" + v.as<std::string>("?") + "'");
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    VisitFrame(ar);
   }
-  if (!std::isfinite(x)) Fail(path, "key '" + key + "' in " + where + " is not finite");
-  return x;
-}
+};
 
-std::string GetString(const YAML::Node& node, const std::string& key, const std::string& where,
-                      const std::string& path) {
-  const YAML::Node v = node[key];
-  if (!v || !v.IsScalar()) Fail(path, "missing or non-scalar key '" + key + "' in " + where);
-  return v.as<std::string>();
-}
+// A movable joint: a frame with a type and limits.
+struct DhJointEntry : DhFrameEntry {
+  std::string type = "revolute";
+  double lower = 0.0;
+  double upper = 0.0;
+  double velocity = 0.0;
+  std::optional<double> acceleration;
+  std::optional<double> jerk;
 
-Eigen::Vector3d GetVector3(const YAML::Node& node, const std::string& key,
-                           const std::string& where, const std::string& path) {
-  const YAML::Node v = node[key];
-  if (!v || !v.IsSequence() || v.size() != 3) {
-    Fail(path, "key '" + key + "' in " + where + " must be a list of 3 numbers");
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    VisitFrame(ar);
+    ar->Visit(IPLAN_NVP(type, "revolute or prismatic"));
+    ar->Visit(IPLAN_NVP_REQUIRED(lower, "rad or m; lower position limit"));
+    ar->Visit(IPLAN_NVP_REQUIRED(upper, "rad or m; upper position limit"));
+    ar->Visit(IPLAN_NVP_REQUIRED(velocity, "rad/s or m/s; > 0"));
+    ar->Visit(IPLAN_NVP(acceleration, "rad/s^2 or m/s^2 (default: RobotModelOptions)"));
+    ar->Visit(IPLAN_NVP(jerk, "rad/s^3 or m/s^3 (default: RobotModelOptions)"));
   }
-  Eigen::Vector3d out;
-  for (int i = 0; i < 3; ++i) {
-    try {
-      out[i] = v[i].as<double>();
-    } catch (const YAML::Exception&) {
-      Fail(path, "key '" + key + "' in " + where + " must be a list of 3 numbers");
-    }
+};
+
+struct SphereEntry {
+  std::string link;
+  std::array<double, 3> centre = {0.0, 0.0, 0.0};
+  double radius = 0.0;
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    ar->Visit(IPLAN_NVP_REQUIRED(link, "link the sphere moves with"));
+    ar->Visit(IPLAN_NVP_REQUIRED(centre, "m; in the link frame"));
+    ar->Visit(IPLAN_NVP_REQUIRED(radius, "m; > 0"));
   }
-  if (!out.allFinite()) Fail(path, "key '" + key + "' in " + where + " is not finite");
-  return out;
-}
+};
+
+struct CapsuleEntry {
+  std::string link;
+  std::array<double, 3> p1 = {0.0, 0.0, 0.0};
+  std::array<double, 3> p2 = {0.0, 0.0, 0.0};
+  double radius = 0.0;
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    ar->Visit(IPLAN_NVP_REQUIRED(link, "link the capsule moves with"));
+    ar->Visit(IPLAN_NVP_REQUIRED(p1, "m; first end of the axis, link frame"));
+    ar->Visit(IPLAN_NVP_REQUIRED(p2, "m; second end of the axis, link frame"));
+    ar->Visit(IPLAN_NVP_REQUIRED(radius, "m; > 0"));
+  }
+};
+
+struct BoxEntry {
+  std::string link;
+  std::array<double, 3> centre = {0.0, 0.0, 0.0};
+  std::array<double, 3> half_extents = {0.0, 0.0, 0.0};
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    ar->Visit(IPLAN_NVP_REQUIRED(link, "link the box moves with"));
+    ar->Visit(IPLAN_NVP_REQUIRED(centre, "m; box centre, link frame (axes along the link's)"));
+    ar->Visit(IPLAN_NVP_REQUIRED(half_extents, "m; > 0"));
+  }
+};
+
+struct RobotFile {
+  std::string name;
+  std::string convention;
+  std::string base_link;
+  std::vector<DhJointEntry> joints;
+  std::vector<DhFrameEntry> fixed_frames;
+  std::vector<SphereEntry> spheres;
+  std::vector<CapsuleEntry> capsules;
+  std::vector<BoxEntry> boxes;
+
+  template <class Archive>
+  void Serialize(Archive* ar) {
+    ar->Visit(IPLAN_NVP_REQUIRED(name, "robot name"));
+    ar->Visit(IPLAN_NVP_REQUIRED(convention, "modified_dh (the only one)"));
+    ar->Visit(IPLAN_NVP_REQUIRED(base_link, "name of the base link"));
+    ar->Visit(IPLAN_NVP_REQUIRED(joints, "movable joints, base to tip"));
+    ar->Visit(IPLAN_NVP(fixed_frames, "fixed frames (flange, tool)"));
+    ar->Visit(IPLAN_NVP(spheres, "collision spheres"));
+    ar->Visit(IPLAN_NVP(capsules, "collision capsules, covered by spheres"));
+    ar->Visit(IPLAN_NVP(boxes, "collision boxes, covered by spheres"));
+  }
+  std::string Validate() const {
+    if (convention != "modified_dh") return "convention '" + convention + "' is not supported (only 'modified_dh')";
+    if (joints.empty()) return "'joints' must be a non-empty list";
+    return "";
+  }
+};
+
+Eigen::Vector3d ToVector(const std::array<double, 3>& v) { return Eigen::Vector3d(v[0], v[1], v[2]); }
 
 // Modified DH: RotX(alpha) TransX(a) RotZ(theta) TransZ(d).
 Eigen::Isometry3d ModifiedDh(double a, double d, double alpha, double theta) {
@@ -405,156 +471,117 @@ Eigen::Isometry3d ModifiedDh(double a, double d, double alpha, double theta) {
   return X;
 }
 
+// Appends the joint of `n` and its child link; `limits` is set for movable joints.
+void AddFrame(const DhFrameEntry& n, const DhJointEntry* movable, const std::string& where,
+              const RobotModelOptions& options, const std::string& path, RobotModel* model) {
+  Joint j;
+  if (model->FindLink(n.link) >= 0) Fail(path, "link '" + n.link + "' defined twice");
+  j.name = n.name ? *n.name : n.link + "_fixed";
+  if (n.parent) {
+    j.parent_link = model->FindLink(*n.parent);
+    if (j.parent_link < 0) Fail(path, "parent '" + *n.parent + "' of " + where + " is unknown");
+  } else {
+    j.parent_link = static_cast<int>(model->link_names.size()) - 1;
+  }
+  j.X_PJ = ModifiedDh(n.a, n.d, n.alpha, n.theta);
+  j.axis = Eigen::Vector3d::UnitZ();
+  if (movable) {
+    if (movable->type == "revolute") {
+      j.type = JointType::kRevolute;
+    } else if (movable->type == "prismatic") {
+      j.type = JointType::kPrismatic;  // DH prismatic joints translate along z after the offset d.
+    } else {
+      Fail(path, "type '" + movable->type + "' of " + where + " must be revolute or prismatic");
+    }
+    j.limits.lower = movable->lower;
+    j.limits.upper = movable->upper;
+    j.limits.velocity = movable->velocity;
+    j.limits.acceleration = movable->acceleration.value_or(options.default_acceleration);
+    j.limits.jerk = movable->jerk.value_or(options.default_jerk);
+    if (!(j.limits.lower < j.limits.upper) || !(j.limits.velocity > 0) || !(j.limits.acceleration > 0) ||
+        !(j.limits.jerk > 0)) {
+      std::ostringstream msg;
+      msg << where << ": invalid limits lower=" << j.limits.lower << " upper=" << j.limits.upper
+          << " velocity=" << j.limits.velocity << " acceleration=" << j.limits.acceleration
+          << " jerk=" << j.limits.jerk;
+      Fail(path, msg.str());
+    }
+  }
+  j.child_link = static_cast<int>(model->link_names.size());
+  model->link_names.push_back(n.link);
+  model->link_parent_joint.push_back(static_cast<int>(model->joints.size()));
+  model->joints.push_back(j);
+}
+
+// The spheres of the file's spheres, capsules and boxes, per link.
+std::vector<std::vector<Sphere>> CoverLinks(const RobotFile& f, const RobotModelOptions& options,
+                                            const std::string& path, RobotModel* model) {
+  std::vector<std::vector<Sphere>> per_link(model->link_names.size());
+  auto link_of = [&](const std::string& link, const std::string& where) {
+    const int l = model->FindLink(link);
+    if (l < 0) Fail(path, "link '" + link + "' of " + where + " is unknown");
+    return l;
+  };
+  auto add = [&](int link, std::vector<Sphere> cover, const CoverReport& report) {
+    per_link[link].insert(per_link[link].end(), cover.begin(), cover.end());
+    model->cover_report.push_back({model->link_names[link], report});
+  };
+  for (std::size_t i = 0; i < f.spheres.size(); ++i) {
+    const SphereEntry& s = f.spheres[i];
+    const std::string where = "spheres[" + std::to_string(i) + "]";
+    const int l = link_of(s.link, where);
+    if (!(s.radius > 0)) Fail(path, where + ": radius " + std::to_string(s.radius) + " must be positive");
+    CoverReport rep;
+    rep.shape = "sphere";
+    rep.num_spheres = 1;
+    rep.shape_volume = 4.0 / 3.0 * kPi * s.radius * s.radius * s.radius;
+    add(l, {{ToVector(s.centre), s.radius}}, rep);
+  }
+  for (std::size_t i = 0; i < f.capsules.size(); ++i) {
+    const CapsuleEntry& c = f.capsules[i];
+    const std::string where = "capsules[" + std::to_string(i) + "]";
+    const int l = link_of(c.link, where);
+    CoverReport rep;
+    try {
+      add(l, CoverCapsule(ToVector(c.p1), ToVector(c.p2), c.radius, options.cover, &rep), rep);
+    } catch (const std::invalid_argument& e) {
+      Fail(path, where + ": " + e.what());
+    }
+  }
+  for (std::size_t i = 0; i < f.boxes.size(); ++i) {
+    const BoxEntry& b = f.boxes[i];
+    const std::string where = "boxes[" + std::to_string(i) + "]";
+    const int l = link_of(b.link, where);
+    CoverReport rep;
+    Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
+    X_LB.translation() = ToVector(b.centre);
+    try {
+      add(l, CoverBox(ToVector(b.half_extents), X_LB, options.cover, &rep), rep);
+    } catch (const std::invalid_argument& e) {
+      Fail(path, where + ": " + e.what());
+    }
+  }
+  return per_link;
+}
+
 }  // namespace
 
 RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptions& options) {
   if (const std::string why = options.cover.Validate(); !why.empty()) Fail(path, why);
-  YAML::Node root;
-  try {
-    root = core::LoadYamlFile(path);  // a key twice is an error
-  } catch (const YAML::Exception& e) {
-    Fail(path, std::string("cannot read YAML: ") + e.what());
-  }
-  CheckKeys(root, {"name", "convention", "base_link", "joints", "fixed_frames", "spheres",
-                   "capsules", "boxes"},
-            "the top level", path);
-  if (GetString(root, "convention", "the top level", path) != "modified_dh") {
-    Fail(path, "convention '" + root["convention"].as<std::string>() +
-                   "' is not supported (only 'modified_dh')");
-  }
+  const RobotFile f = core::LoadParamsFile<RobotFile>(path, {}, core::ConfigSection::EmptyFile::kError);
   RobotModel model;
-  model.name = GetString(root, "name", "the top level", path);
-  model.link_names.push_back(GetString(root, "base_link", "the top level", path));
+  model.name = f.name;
+  model.link_names.push_back(f.base_link);
   model.link_parent_joint.push_back(-1);
-
-  auto add_frame = [&](const YAML::Node& n, const std::string& where, bool movable) {
-    Joint j;
-    const std::string link = GetString(n, "link", where, path);
-    if (model.FindLink(link) >= 0) Fail(path, "link '" + link + "' defined twice");
-    const double zero = 0.0;
-    j.name = n["name"] ? GetString(n, "name", where, path) : link + "_fixed";
-    if (n["parent"]) {
-      j.parent_link = model.FindLink(GetString(n, "parent", where, path));
-      if (j.parent_link < 0) {
-        Fail(path, "parent '" + n["parent"].as<std::string>() + "' of " + where + " is unknown");
-      }
-    } else {
-      j.parent_link = static_cast<int>(model.link_names.size()) - 1;
-    }
-    j.X_PJ = ModifiedDh(GetDouble(n, "a", where, path), GetDouble(n, "d", where, path),
-                        GetDouble(n, "alpha", where, path),
-                        GetDouble(n, "theta", where, path, &zero));
-    j.axis = Eigen::Vector3d::UnitZ();
-    if (movable) {
-      const std::string type = n["type"] ? GetString(n, "type", where, path) : "revolute";
-      if (type == "revolute") {
-        j.type = JointType::kRevolute;
-      } else if (type == "prismatic") {
-        j.type = JointType::kPrismatic;
-        // DH prismatic joints translate along z after the offset d.
-      } else {
-        Fail(path, "type '" + type + "' of " + where + " must be revolute or prismatic");
-      }
-      j.limits.lower = GetDouble(n, "lower", where, path);
-      j.limits.upper = GetDouble(n, "upper", where, path);
-      j.limits.velocity = GetDouble(n, "velocity", where, path);
-      j.limits.acceleration =
-          GetDouble(n, "acceleration", where, path, &options.default_acceleration);
-      j.limits.jerk = GetDouble(n, "jerk", where, path, &options.default_jerk);
-      if (!(j.limits.lower < j.limits.upper) || !(j.limits.velocity > 0) ||
-          !(j.limits.acceleration > 0) || !(j.limits.jerk > 0)) {
-        std::ostringstream msg;
-        msg << where << ": invalid limits lower=" << j.limits.lower
-            << " upper=" << j.limits.upper << " velocity=" << j.limits.velocity
-            << " acceleration=" << j.limits.acceleration << " jerk=" << j.limits.jerk;
-        Fail(path, msg.str());
-      }
-    }
-    j.child_link = static_cast<int>(model.link_names.size());
-    model.link_names.push_back(link);
-    model.link_parent_joint.push_back(static_cast<int>(model.joints.size()));
-    model.joints.push_back(j);
-  };
-
-  const YAML::Node joints = root["joints"];
-  if (!joints || !joints.IsSequence() || joints.size() == 0) {
-    Fail(path, "'joints' must be a non-empty list");
+  for (std::size_t i = 0; i < f.joints.size(); ++i) {
+    AddFrame(f.joints[i], &f.joints[i], "joints[" + std::to_string(i) + "]", options, path, &model);
   }
-  for (size_t i = 0; i < joints.size(); ++i) {
-    const std::string where = "joints[" + std::to_string(i) + "]";
-    CheckKeys(joints[i], {"name", "link", "parent", "type", "a", "d", "alpha", "theta",
-                          "lower", "upper", "velocity", "acceleration", "jerk"},
-              where, path);
-    add_frame(joints[i], where, true);
+  for (std::size_t i = 0; i < f.fixed_frames.size(); ++i) {
+    AddFrame(f.fixed_frames[i], nullptr, "fixed_frames[" + std::to_string(i) + "]", options, path, &model);
   }
-  if (const YAML::Node frames = root["fixed_frames"]) {
-    for (size_t i = 0; i < frames.size(); ++i) {
-      const std::string where = "fixed_frames[" + std::to_string(i) + "]";
-      CheckKeys(frames[i], {"name", "link", "parent", "a", "d", "alpha", "theta"}, where, path);
-      add_frame(frames[i], where, false);
-    }
-  }
-
-  std::vector<std::vector<Sphere>> per_link(model.link_names.size());
-  auto link_of = [&](const YAML::Node& n, const std::string& where) {
-    const int l = model.FindLink(GetString(n, "link", where, path));
-    if (l < 0) Fail(path, "link '" + n["link"].as<std::string>() + "' of " + where + " is unknown");
-    return l;
-  };
-  auto add_cover = [&](int link, std::vector<Sphere> cover, const CoverReport& report) {
-    per_link[link].insert(per_link[link].end(), cover.begin(), cover.end());
-    model.cover_report.push_back({model.link_names[link], report});
-  };
-  if (const YAML::Node list = root["spheres"]) {
-    for (size_t i = 0; i < list.size(); ++i) {
-      const std::string where = "spheres[" + std::to_string(i) + "]";
-      CheckKeys(list[i], {"link", "centre", "radius"}, where, path);
-      const int l = link_of(list[i], where);
-      const double r = GetDouble(list[i], "radius", where, path);
-      if (!(r > 0)) Fail(path, where + ": radius " + std::to_string(r) + " must be positive");
-      CoverReport rep;
-      rep.shape = "sphere";
-      rep.num_spheres = 1;
-      rep.shape_volume = 4.0 / 3.0 * kPi * r * r * r;
-      add_cover(l, {{GetVector3(list[i], "centre", where, path), r}}, rep);
-    }
-  }
-  if (const YAML::Node list = root["capsules"]) {
-    for (size_t i = 0; i < list.size(); ++i) {
-      const std::string where = "capsules[" + std::to_string(i) + "]";
-      CheckKeys(list[i], {"link", "p1", "p2", "radius"}, where, path);
-      const int l = link_of(list[i], where);
-      CoverReport rep;
-      try {
-        auto cover = CoverCapsule(GetVector3(list[i], "p1", where, path),
-                                  GetVector3(list[i], "p2", where, path),
-                                  GetDouble(list[i], "radius", where, path), options.cover, &rep);
-        add_cover(l, std::move(cover), rep);
-      } catch (const std::invalid_argument& e) {
-        Fail(path, where + ": " + e.what());
-      }
-    }
-  }
-  if (const YAML::Node list = root["boxes"]) {
-    for (size_t i = 0; i < list.size(); ++i) {
-      const std::string where = "boxes[" + std::to_string(i) + "]";
-      CheckKeys(list[i], {"link", "centre", "half_extents"}, where, path);
-      const int l = link_of(list[i], where);
-      CoverReport rep;
-      Eigen::Isometry3d X_LB = Eigen::Isometry3d::Identity();
-      X_LB.translation() = GetVector3(list[i], "centre", where, path);
-      try {
-        auto cover = CoverBox(GetVector3(list[i], "half_extents", where, path), X_LB,
-                              options.cover, &rep);
-        add_cover(l, std::move(cover), rep);
-      } catch (const std::invalid_argument& e) {
-        Fail(path, where + ": " + e.what());
-      }
-    }
-  }
-  for (size_t l = 0; l < per_link.size(); ++l) {
-    AddLinkSpheres(static_cast<int>(l), std::move(per_link[l]), options.remove_contained_spheres,
-                   &model);
+  std::vector<std::vector<Sphere>> per_link = CoverLinks(f, options, path, &model);
+  for (std::size_t l = 0; l < per_link.size(); ++l) {
+    AddLinkSpheres(static_cast<int>(l), std::move(per_link[l]), options.remove_contained_spheres, &model);
   }
   Finalize(options, path, &model);
   return model;

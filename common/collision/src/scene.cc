@@ -1,16 +1,15 @@
 #include "iplan/collision/scene.h"
 
+#include <array>
 #include <cmath>
 #include <limits>
-#include <set>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 
 #include <fcl/narrowphase/collision_object.h>
 #include <fcl/narrowphase/distance.h>
-#include <yaml-cpp/yaml.h>
-
-#include "iplan/core/yaml.h"
+#include "iplan/core/params.h"
 
 #include "check.h"
 
@@ -39,71 +38,90 @@ std::string SceneParams::Validate() const {
   return {};
 }
 
-SceneParams LoadSceneParams(const std::string& path) {
-  auto fail = [&](const std::string& what) { throw std::runtime_error(path + ": " + what); };
-  SceneParams p;
-  try {
-    const YAML::Node root = core::LoadYamlFile(path);  // a key twice is an error
-    if (!root.IsMap()) fail("top level must be a map");
-    for (const auto& kv : root) {
-      if (kv.first.as<std::string>() != "objects") {
-        fail("unknown key '" + kv.first.as<std::string>() + "' at the top level");
-      }
-    }
-    const YAML::Node objects = root["objects"];
-    if (!objects || !objects.IsSequence()) fail("'objects' must be a list");
-    for (size_t i = 0; i < objects.size(); ++i) {
-      const YAML::Node n = objects[i];
-      const std::string where = "objects[" + std::to_string(i) + "]";
-      if (!n.IsMap()) fail(where + " must be a map");
-      static const std::set<std::string> kAllowed = {"name", "type", "xyz", "rpy",
-                                                     "size", "radius", "length"};
-      for (const auto& kv : n) {
-        const std::string key = kv.first.as<std::string>();
-        if (kAllowed.count(key) == 0) fail("unknown key '" + key + "' in " + where);
-      }
-      auto vec3 = [&](const char* key, bool required) -> Eigen::Vector3d {
-        if (!n[key]) {
-          if (required) fail("missing key '" + std::string(key) + "' in " + where);
-          return Eigen::Vector3d::Zero();
-        }
-        const auto v = n[key].as<std::vector<double>>();
-        if (v.size() != 3) fail("'" + std::string(key) + "' in " + where + " must have 3 numbers");
-        return Eigen::Vector3d(v[0], v[1], v[2]);
-      };
-      SceneObject o;
-      if (!n["name"]) fail("missing key 'name' in " + where);
-      o.name = n["name"].as<std::string>();
-      if (!n["type"]) fail("missing key 'type' in " + where);
-      const std::string type = n["type"].as<std::string>();
-      const Eigen::Vector3d xyz = vec3("xyz", true);
-      const Eigen::Vector3d rpy = vec3("rpy", false);
-      o.X_WO.setIdentity();
-      o.X_WO.translation() = xyz;
-      o.X_WO.linear() = (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) *
-                         Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
-                         Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
-                            .toRotationMatrix();
-      if (type == "box") {
-        o.shape = SceneObject::Shape::kBox;
-        if (n["radius"] || n["length"]) fail(where + ": a box takes 'size', not radius/length");
-        o.size = vec3("size", true);
-      } else if (type == "cylinder") {
-        o.shape = SceneObject::Shape::kCylinder;
-        if (n["size"]) fail(where + ": a cylinder takes 'radius' and 'length', not 'size'");
-        if (!n["radius"] || !n["length"]) fail(where + ": a cylinder needs 'radius' and 'length'");
-        o.radius = n["radius"].as<double>();
-        o.length = n["length"].as<double>();
-      } else {
-        fail(where + ": type '" + type + "' must be 'box' or 'cylinder'");
-      }
-      p.objects.push_back(o);
-    }
-  } catch (const YAML::Exception& e) {
-    fail(std::string("invalid YAML: ") + e.what());
+namespace {
+
+// One entry of a scene file as written (the pose as xyz + rpy, the shape by
+// name); ToObject makes the SceneObject.
+struct SceneObjectEntry {
+  std::string name;
+  std::string type;
+  std::array<double, 3> xyz = {0.0, 0.0, 0.0};
+  std::array<double, 3> rpy = {0.0, 0.0, 0.0};
+  std::optional<std::array<double, 3>> size;
+  std::optional<double> radius;
+  std::optional<double> length;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(name, "object name (allowed_collisions refer to it)"));
+    a->Visit(IPLAN_NVP_REQUIRED(type, "box or cylinder"));
+    a->Visit(IPLAN_NVP_REQUIRED(xyz, "m; position of the object frame in the world"));
+    a->Visit(IPLAN_NVP(rpy, "rad; orientation, URDF convention R = Rz(y) Ry(p) Rx(r)"));
+    a->Visit(IPLAN_NVP(size, "m; box: full edge lengths"));
+    a->Visit(IPLAN_NVP(radius, "m; cylinder radius"));
+    a->Visit(IPLAN_NVP(length, "m; cylinder length along the local z"));
   }
-  if (const std::string why = p.Validate(); !why.empty()) fail(why);
-  return p;
+
+  // The keys a shape takes; "" when they fit.
+  std::string CheckShape(const std::string& where) const {
+    if (type == "box") {
+      if (radius || length) return where + ": a box takes 'size', not radius/length";
+      if (!size) return "missing key 'size' in " + where;
+    } else if (type == "cylinder") {
+      if (size) return where + ": a cylinder takes 'radius' and 'length', not 'size'";
+      if (!radius || !length) return where + ": a cylinder needs 'radius' and 'length'";
+    } else {
+      return where + ": type '" + type + "' must be 'box' or 'cylinder'";
+    }
+    return "";
+  }
+
+  SceneObject ToObject() const {
+    SceneObject o;
+    o.name = name;
+    o.X_WO.setIdentity();
+    o.X_WO.translation() = Eigen::Vector3d(xyz[0], xyz[1], xyz[2]);
+    o.X_WO.linear() = (Eigen::AngleAxisd(rpy[2], Eigen::Vector3d::UnitZ()) *
+                       Eigen::AngleAxisd(rpy[1], Eigen::Vector3d::UnitY()) *
+                       Eigen::AngleAxisd(rpy[0], Eigen::Vector3d::UnitX()))
+                          .toRotationMatrix();
+    if (type == "box") {
+      o.shape = SceneObject::Shape::kBox;
+      o.size = Eigen::Vector3d((*size)[0], (*size)[1], (*size)[2]);
+    } else {
+      o.shape = SceneObject::Shape::kCylinder;
+      o.radius = *radius;
+      o.length = *length;
+    }
+    return o;
+  }
+};
+
+// A scene file: `objects:`, a list of entries.
+struct SceneFile {
+  std::vector<SceneObjectEntry> objects;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(objects, "the static objects"));
+  }
+  std::string Validate() const {
+    for (std::size_t i = 0; i < objects.size(); ++i) {
+      if (std::string why = objects[i].CheckShape("objects[" + std::to_string(i) + "]"); !why.empty()) return why;
+    }
+    return ToParams().Validate();
+  }
+  SceneParams ToParams() const {
+    SceneParams p;
+    for (const SceneObjectEntry& e : objects) p.objects.push_back(e.ToObject());
+    return p;
+  }
+};
+
+}  // namespace
+
+SceneParams LoadSceneParams(const std::string& path) {
+  return core::LoadParamsFile<SceneFile>(path, {}, core::ConfigSection::EmptyFile::kError).ToParams();
 }
 
 struct StaticScene::Impl {

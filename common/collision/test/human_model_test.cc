@@ -7,6 +7,8 @@
 #include <Eigen/Cholesky>
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 namespace iplan::collision {
 namespace {
 
@@ -127,7 +129,7 @@ TEST(HumanModelTest, LoadsYamlStrictly) {
     LoadHumanBodyParams(bad);
     FAIL();
   } catch (const std::runtime_error& e) {
-    EXPECT_NE(std::string(e.what()).find("unknown key 'radus' in segments[0]"), std::string::npos)
+    EXPECT_NE(std::string(e.what()).find("unknown key 'segments[0].radus'"), std::string::npos)
         << e.what();
     EXPECT_NE(std::string(e.what()).find(bad), std::string::npos);
   }
@@ -165,6 +167,12 @@ TEST(HumanModelTest, ShippedConfigEqualsDefault) {
     EXPECT_DOUBLE_EQ(a.spheres()[i].u, b.spheres()[i].u);
     EXPECT_DOUBLE_EQ(a.spheres()[i].radius, b.spheres()[i].radius);
   }
+}
+
+TEST(HumanModelTest, TheDocumentedKeysAreTheDeclaredOnes) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(HumanBodyParams{})),
+            "");
 }
 
 }  // namespace

@@ -295,7 +295,7 @@ base_link: l0
 joints:
   - {name: j1, link: l1, a: 0, d: 0.1, alpha: 0, lower: -1, upper: 1, velocity: 1, acceleraton: 3}
 )");
-  ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_key); }, "unknown key 'acceleraton' in joints[0]");
+  ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_key); }, "unknown key 'joints[0].acceleraton'");
   ExpectThrowsWith([&] { LoadRobotModelFromYaml(bad_key); }, bad_key);
   const std::string bad_limits = WriteTemp("bad_limits.yaml", R"(
 name: x

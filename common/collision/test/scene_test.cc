@@ -114,7 +114,27 @@ TEST(SceneTest, LoadsShippedConfigAndRejectsBadFiles) {
               std::string::npos) << e.what();
   }
   std::ofstream(bad) << "objects:\n  - {name: t, type: box, xyz: [0, 0, 0], sise: [1, 1, 1]}\n";
-  EXPECT_THROW(LoadSceneParams(bad), std::runtime_error);
+  try {
+    LoadSceneParams(bad);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ": missing key 'size' in objects[0]\n" + bad +
+                                         ": unknown key 'objects[0].sise'");
+  }
+  std::ofstream(bad) << "objects:\n  - {name: c, type: cylinder, xyz: [0, 0, 0], radius: 0.1, length: 1, size: [1, 1, 1]}\n";
+  try {
+    LoadSceneParams(bad);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ": objects[0]: a cylinder takes 'radius' and 'length', not 'size'");
+  }
+  std::ofstream(bad) << "objects:\n  - {name: c, type: box, size: [1, 1, 1]}\n";
+  try {
+    LoadSceneParams(bad);
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), bad + ": key 'objects[0].xyz': is required but missing");
+  }
 }
 
 TEST(SceneTest, AKeyWrittenTwiceIsAnError) {

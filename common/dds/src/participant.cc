@@ -8,6 +8,7 @@
 #include <thread>
 
 #include "backend.h"
+#include "iplan/core/checksum.h"
 
 namespace iplan::dds {
 namespace internal {
@@ -30,12 +31,7 @@ std::string HexGuid(const unsigned char* bytes, int n) {
 }
 
 uint64_t HashBytes(const unsigned char* bytes, int n) {
-  uint64_t h = 1469598103934665603ULL;  // FNV-1a
-  for (int i = 0; i < n; ++i) {
-    h ^= bytes[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
+  return core::Fnv1a64(bytes, static_cast<std::size_t>(n), core::kIplanFnvSeed);
 }
 
 }  // namespace internal

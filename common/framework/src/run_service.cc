@@ -18,6 +18,100 @@ void OnSignal(int) { g_stop = 1; }
 
 bool FileExists(const std::string& p) { return std::ifstream(p).good(); }
 
+// The service's file with the --set overrides applied, and the framework's
+// `node` section read from it. False (the problems printed) on a bad one.
+bool LoadConfiguration(const std::string& name, const std::string& config_file,
+                       const std::vector<std::string>& overrides, std::unique_ptr<ConfigSection>* config,
+                       NodeOptions* nopts) {
+  try {
+    *config = std::make_unique<ConfigSection>(
+        config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
+                            : ConfigSection::Load(config_file));
+    for (const std::string& o : overrides) {
+      const auto [key, value] = core::ParseOverride(o);
+      (*config)->Override(key, value);
+    }
+    ConfigSection node_section = (*config)->Section("node");
+    node_section.Read("diagnostics_period", &nopts->diagnostics_period, NonNegative<double>());
+    node_section.Read("hardware_id", &nopts->hardware_id);
+    node_section.Read("max_stamp_ahead", &nopts->max_stamp_ahead, InRange(0.0, 60.0));
+    node_section.Read("frame_id", &nopts->frame_id, Check<std::string>([](const std::string& f) {
+      return f.empty() ? std::string("must not be empty") : std::string();
+    }));
+    // entitled_writers: {"/iplan/robot/trajectory": [iplan-trajopt], ...}
+    ConfigSection entitled = node_section.Section("entitled_writers");
+    for (const std::string& topic : entitled.Keys()) {
+      std::vector<std::string> names;
+      entitled.Read(topic, &names);
+      nopts->entitled_writers[topic] = names;
+    }
+  } catch (const ConfigError& e) {
+    std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
+    return false;
+  }
+  return true;
+}
+
+// OnConfigure, then every key of the file accounted for: false (the
+// problems printed) when the configuration is bad.
+bool Configure(const std::string& name, ConfigSection* config, Service* service, Node* node) {
+  ConfigSection section = config->Section(name);
+  const Result r = service->OnConfigure(section, *node);
+  try {
+    config->Finish();
+  } catch (const ConfigError& e) {
+    std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
+    // A parameter file the service loaded failed too: say so as well.
+    if (!r.ok && std::string(e.what()).find(r.reason) == std::string::npos) std::cerr << "iplan-" << name << ": configure failed: " << r.reason << "\n";
+    return false;
+  }
+  if (!r.ok) {
+    std::cerr << "iplan-" << name << ": configure failed: " << r.reason << "\n";
+    return false;
+  }
+  return true;
+}
+
+// --dds and --domain, or their environment defaults. False (printed) on a bad one.
+bool ParticipantOptionsFrom(const std::string& name, const std::string& vendor_text, int domain,
+                            dds::ParticipantOptions* popts) {
+  try {
+    popts->vendor = vendor_text.empty() ? dds::DefaultVendor() : dds::ParseVendor(vendor_text);
+    popts->domain_id = domain >= 0 ? domain : dds::DefaultDomain();
+  } catch (const std::exception& e) {
+    std::cerr << "iplan-" << name << ": " << e.what() << "\n";
+    return false;
+  }
+  popts->name = "iplan-" + name;
+  return true;
+}
+
+// Activate, spin until SIGINT/SIGTERM, deactivate, clean up. False when
+// activation failed (cleaned up, logged).
+bool RunActive(Service* service, Node* node) {
+  Result r = service->OnActivate(*node);
+  if (!r.ok) {
+    node->log().error("activate failed: {}", r.reason);
+    service->OnCleanup(*node);
+    return false;
+  }
+  node->SetState("active");
+  node->PublishDiagnostics();
+  systemd::NotifyReady("active");
+  node->log().info("active");
+  systemd::Watchdog watchdog;
+  node->SpinUntil([] { return g_stop != 0; }, [&watchdog] { watchdog.Tick(); });
+  systemd::NotifyStopping();
+  node->log().info("stopping");
+  r = service->OnDeactivate(*node);
+  if (!r.ok) node->log().warn("deactivate: {}", r.reason);
+  node->SetState("inactive");
+  node->PublishDiagnostics();
+  r = service->OnCleanup(*node);
+  if (!r.ok) node->log().warn("cleanup: {}", r.reason);
+  return true;
+}
+
 }  // namespace
 
 std::string DefaultConfigFile(const std::string& service_name) {
@@ -61,8 +155,13 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
       ->capture_default_str();
   app.add_option("--set", overrides,
                  "override a setting of the configuration file: KEY=VALUE with a dotted key from the "
-                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable)");
-  app.add_flag("--check-config", check_only, "validate the configuration file and exit");
+                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable); "
+                 "a key may continue into a parameter file the configuration names, e.g. "
+                 "--set trajopt.planner.max_iterations=30 (docs/configuration.md)");
+  app.add_flag("--check-config", check_only,
+               "read the configuration and every parameter file it names as the service would (all "
+               "keys, types and ranges, Validate() included), print the problems and exit: 0 valid, "
+               "2 not");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -73,44 +172,11 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
 
   dds::ParticipantOptions popts;
-  try {
-    popts.vendor = vendor_text.empty() ? dds::DefaultVendor() : dds::ParseVendor(vendor_text);
-    popts.domain_id = domain >= 0 ? domain : dds::DefaultDomain();
-  } catch (const std::exception& e) {
-    std::cerr << "iplan-" << info.name << ": " << e.what() << "\n";
-    return kExitConfigError;
-  }
-  popts.name = "iplan-" + info.name;
+  if (!ParticipantOptionsFrom(info.name, vendor_text, domain, &popts)) return kExitConfigError;
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
-  try {
-    config = std::make_unique<ConfigSection>(
-        config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
-                            : ConfigSection::Load(config_file));
-    for (const std::string& o : overrides) {
-      const size_t eq = o.find('=');
-      if (eq == std::string::npos || eq == 0) throw ConfigError("--set " + o + ": expected KEY=VALUE");
-      config->Override(o.substr(0, eq), o.substr(eq + 1));
-    }
-    ConfigSection node_section = config->Section("node");
-    node_section.Read("diagnostics_period", &nopts.diagnostics_period, NonNegative<double>());
-    node_section.Read("hardware_id", &nopts.hardware_id);
-    node_section.Read("max_stamp_ahead", &nopts.max_stamp_ahead, InRange(0.0, 60.0));
-    node_section.Read("frame_id", &nopts.frame_id, Check<std::string>([](const std::string& f) {
-      return f.empty() ? std::string("must not be empty") : std::string();
-    }));
-    // entitled_writers: {"/iplan/robot/trajectory": [iplan-trajopt], ...}
-    ConfigSection entitled = node_section.Section("entitled_writers");
-    for (const std::string& topic : entitled.Keys()) {
-      std::vector<std::string> names;
-      entitled.Read(topic, &names);
-      nopts.entitled_writers[topic] = names;
-    }
-  } catch (const ConfigError& e) {
-    std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
-    return kExitConfigError;
-  }
+  if (!LoadConfiguration(info.name, config_file, overrides, &config, &nopts)) return kExitConfigError;
 
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
@@ -124,43 +190,13 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     service = make();
     node->log().info("configuring from {} on {} domain {}", config_file.empty() ? "(defaults)" : config_file,
                      dds::ToString(popts.vendor), popts.domain_id);
-    ConfigSection section = config->Section(info.name);
-    Result r = service->OnConfigure(section, *node);
-    try {
-      config->Finish();
-    } catch (const ConfigError& e) {
-      std::cerr << "iplan-" << info.name << ": configuration error:\n" << e.what() << "\n";
-      return kExitConfigError;
-    }
-    if (!r.ok) {
-      std::cerr << "iplan-" << info.name << ": configure failed: " << r.reason << "\n";
-      return kExitConfigError;
-    }
+    if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
     node->SetState("configured");
     if (check_only) {
       std::cout << config_file << ": configuration is valid\n";
       return kExitOk;
     }
-    r = service->OnActivate(*node);
-    if (!r.ok) {
-      node->log().error("activate failed: {}", r.reason);
-      service->OnCleanup(*node);
-      return kExitRuntimeError;
-    }
-    node->SetState("active");
-    node->PublishDiagnostics();
-    systemd::NotifyReady("active");
-    node->log().info("active");
-    systemd::Watchdog watchdog;
-    node->SpinUntil([] { return g_stop != 0; }, [&watchdog] { watchdog.Tick(); });
-    systemd::NotifyStopping();
-    node->log().info("stopping");
-    r = service->OnDeactivate(*node);
-    if (!r.ok) node->log().warn("deactivate: {}", r.reason);
-    node->SetState("inactive");
-    node->PublishDiagnostics();
-    r = service->OnCleanup(*node);
-    if (!r.ok) node->log().warn("cleanup: {}", r.reason);
+    if (!RunActive(service.get(), node.get())) return kExitRuntimeError;
     service.reset();
     node.reset();
     participant.reset();

@@ -142,7 +142,7 @@ TEST(Config, OverridesReplaceAndCreateValuesAndAreCheckedLikeTheFile) {
   c.Override("svc.rate_hz", "15");
   c.Override("svc.sub.b", "[1, 2]");
   c.Override("svc.new.deep", "x");
-  EXPECT_THROW(c.Override("svc.rate_hz.x", "1"), ConfigError);  // a scalar is not a mapping
+  c.Override("svc.rate_hz.x", "1");  // kept for a parameter file named rate_hz: there is none
   EXPECT_THROW(c.Override("svc.sub.a", "[1,"), ConfigError);      // not YAML
   EXPECT_THROW(c.Override("svc..a", "1"), ConfigError);
   auto s = c.Section("svc");
@@ -158,8 +158,12 @@ TEST(Config, OverridesReplaceAndCreateValuesAndAreCheckedLikeTheFile) {
   EXPECT_EQ(rate, 15);
   EXPECT_EQ(a, 1);
   EXPECT_EQ(b, (std::vector<double>{1, 2}));
-  // An overridden key nobody reads is reported like a typo in the file.
+  // An overridden key nobody reads is reported like a typo in the file, and
+  // one into a value that names no parameter file likewise.
   EXPECT_NE(FinishError(c).find("svc.new"), std::string::npos);
+  EXPECT_NE(FinishError(c).find("--set svc.rate_hz.x=1: 'svc.rate_hz' is a value, not a mapping or a parameter file"),
+            std::string::npos)
+      << FinishError(c);
 }
 
 TEST(Config, PathsResolveAgainstTheFilesFolder) {

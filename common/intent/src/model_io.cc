@@ -1,29 +1,19 @@
 #include "iplan/intent/model_io.h"
 
-#include <fcntl.h>
-#include <unistd.h>
-
 #include <algorithm>
-#include <cerrno>
 #include <cmath>
 #include <cstring>
 #include <fstream>
 #include <sstream>
 #include <stdexcept>
 
+#include "iplan/core/atomic_file.h"
+#include "iplan/core/checksum.h"
+
 namespace iplan::intent {
 namespace {
 
 constexpr char kMagic[8] = {'I', 'P', 'L', 'A', 'N', 'I', 'N', 'T'};
-
-std::uint64_t Fnv1a64(const char* data, size_t size) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (size_t i = 0; i < size; ++i) {
-    h ^= static_cast<unsigned char>(data[i]);
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 class Writer {
  public:
@@ -146,10 +136,6 @@ std::string JointDifference(const std::vector<std::string>& model,
   return "a joint is listed twice";
 }
 
-void ThrowErrno(const std::string& what, const std::string& path) {
-  throw std::runtime_error(what + " '" + path + "': " + std::strerror(errno));
-}
-
 }  // namespace
 
 std::string SerializeIntentModel(const IntentModel& m) {
@@ -201,16 +187,18 @@ std::string SerializeIntentModel(const IntentModel& m) {
   w.F64(m.forecast.motion_offset);
   w.Vec(m.forecast.reference_speed);
   const std::string payload = std::move(w.bytes());
-  Writer file;
-  file.bytes().append(kMagic, sizeof(kMagic));
-  file.Pod<std::uint32_t>(kIntentModelFormatVersion);
-  file.U64(payload.size());
-  file.bytes() += payload;
-  file.U64(Fnv1a64(payload.data(), payload.size()));
-  return std::move(file.bytes());
+  Writer header;
+  header.bytes().append(kMagic, sizeof(kMagic));
+  header.Pod<std::uint32_t>(kIntentModelFormatVersion);
+  header.U64(payload.size());
+  return core::SealChecksummed(header.bytes(), payload, core::ChecksumAt::kAfterPayload);
 }
 
-IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& source) {
+namespace {
+
+// The checked payload of a model file and its format version: magic,
+// version range, declared size and checksum.
+std::uint32_t OpenPayload(const std::string& bytes, const std::string& source, std::size_t* size) {
   const size_t header = sizeof(kMagic) + 4 + 8;
   if (bytes.size() < header + 8 || std::memcmp(bytes.data(), kMagic, sizeof(kMagic)) != 0) {
     throw std::runtime_error(source + ": not an iplan intent model file (bad magic or too short)");
@@ -223,109 +211,131 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
                              std::to_string(kOldestReadableIntentModelFormatVersion) + " to " +
                              std::to_string(kIntentModelFormatVersion) + "; retrain the model");
   }
-  const std::uint64_t size = head.U64();
-  if (size != bytes.size() - header - 8) {
+  const std::uint64_t declared = head.U64();
+  if (declared != bytes.size() - header - 8) {
     throw std::runtime_error(source + ": intent model file is truncated or has trailing data (payload " +
-                             std::to_string(size) + " bytes declared, " +
+                             std::to_string(declared) + " bytes declared, " +
                              std::to_string(bytes.size() - std::min(bytes.size(), header + 8)) +
                              " present)");
   }
-  std::uint64_t stored;
-  std::memcpy(&stored, bytes.data() + header + size, 8);
-  if (stored != Fnv1a64(bytes.data() + header, size)) {
+  if (!core::OpenChecksummed(bytes, header, core::ChecksumAt::kAfterPayload)) {
     throw std::runtime_error(source + ": intent model checksum mismatch: the file is corrupt");
   }
-  Reader r(bytes.data() + header, size, source);
-  IntentModel m;
-  IntentModelConfig& c = m.config;
-  c.joints.joints = ReadStrings(&r);
-  c.joints.torso = ReadStrings(&r);
-  c.joints.hands = ReadStrings(&r);
-  const std::uint64_t num_objects = r.U64();
-  if (num_objects > 4096) r.Fail("implausible object count");
+  *size = declared;
+  return version;
+}
+
+void ReadConfig(Reader* r, IntentModelConfig* c) {
+  c->joints.joints = ReadStrings(r);
+  c->joints.torso = ReadStrings(r);
+  c->joints.hands = ReadStrings(r);
+  const std::uint64_t num_objects = r->U64();
+  if (num_objects > 4096) r->Fail("implausible object count");
   for (std::uint64_t i = 0; i < num_objects; ++i) {
-    const Eigen::VectorXd o = r.Vec();
-    if (o.size() != 3) r.Fail("object position is not 3-D");
-    c.joints.objects.push_back(o);
+    const Eigen::VectorXd o = r->Vec();
+    if (o.size() != 3) r->Fail("object position is not 3-D");
+    c->joints.objects.push_back(o);
   }
-  c.rate = r.F64();
-  c.window = static_cast<int>(r.I64());
-  c.horizon = static_cast<int>(r.I64());
-  c.velocity_frames = static_cast<int>(r.I64());
-  c.dtw_band = static_cast<int>(r.I64());
-  c.sensor_noise_std = r.F64();
-  c.features.torso_motion_weight = r.F64();
-  c.features.normalise_body_size = r.I64() != 0;
-  const std::string config_error = c.Validate();
-  if (!config_error.empty()) r.Fail("configuration: " + config_error);
-  m.actions = ReadStrings(&r);
-  m.classifier.sigma = r.F64();
-  const std::uint64_t q = r.U64();
-  if (q > (1u << 20)) r.Fail("implausible import-vector count");
-  for (std::uint64_t i = 0; i < q; ++i) m.classifier.import_windows.push_back(r.Mat());
-  m.classifier.ivm.import_index = r.Mat().col(0).cast<int>();
-  m.classifier.ivm.alpha = r.Mat();
-  m.classifier.ivm.bias = r.Vec();
-  m.classifier.belief.time_constant = r.F64();
-  m.classifier.belief.min_probability = r.F64();
-  m.classifier.belief.motion_weighted = r.I64() != 0;
-  if (const std::string why = m.classifier.belief.Validate(); !why.empty()) r.Fail("belief filter: " + why);
-  const std::uint64_t nf = r.U64();
-  const Eigen::Index C = static_cast<Eigen::Index>(m.actions.size());
-  const FeatureLayout layout(c.joints, c.features);
-  if (nf != m.actions.size() || m.classifier.ivm.bias.size() != C ||
-      m.classifier.ivm.alpha.rows() != static_cast<Eigen::Index>(q) ||
-      m.classifier.ivm.alpha.cols() != C) {
-    r.Fail("classifier sizes do not match the action count " + std::to_string(C));
+  c->rate = r->F64();
+  c->window = static_cast<int>(r->I64());
+  c->horizon = static_cast<int>(r->I64());
+  c->velocity_frames = static_cast<int>(r->I64());
+  c->dtw_band = static_cast<int>(r->I64());
+  c->sensor_noise_std = r->F64();
+  c->features.torso_motion_weight = r->F64();
+  c->features.normalise_body_size = r->I64() != 0;
+  const std::string config_error = c->Validate();
+  if (!config_error.empty()) r->Fail("configuration: " + config_error);
+}
+
+// The classifier; returns the number of forecasters that follow.
+std::uint64_t ReadClassifier(Reader* r, const FeatureLayout& layout, IntentModel* m) {
+  m->actions = ReadStrings(r);
+  m->classifier.sigma = r->F64();
+  const std::uint64_t q = r->U64();
+  if (q > (1u << 20)) r->Fail("implausible import-vector count");
+  for (std::uint64_t i = 0; i < q; ++i) m->classifier.import_windows.push_back(r->Mat());
+  m->classifier.ivm.import_index = r->Mat().col(0).cast<int>();
+  m->classifier.ivm.alpha = r->Mat();
+  m->classifier.ivm.bias = r->Vec();
+  m->classifier.belief.time_constant = r->F64();
+  m->classifier.belief.min_probability = r->F64();
+  m->classifier.belief.motion_weighted = r->I64() != 0;
+  if (const std::string why = m->classifier.belief.Validate(); !why.empty()) r->Fail("belief filter: " + why);
+  const std::uint64_t nf = r->U64();
+  const Eigen::Index C = static_cast<Eigen::Index>(m->actions.size());
+  if (nf != m->actions.size() || m->classifier.ivm.bias.size() != C ||
+      m->classifier.ivm.alpha.rows() != static_cast<Eigen::Index>(q) ||
+      m->classifier.ivm.alpha.cols() != C) {
+    r->Fail("classifier sizes do not match the action count " + std::to_string(C));
   }
-  for (const Eigen::MatrixXd& iw : m.classifier.import_windows) {
-    if (iw.rows() != layout.frame_feature_size() || iw.cols() != c.window) {
-      r.Fail("import window size does not match the configuration");
+  for (const Eigen::MatrixXd& iw : m->classifier.import_windows) {
+    if (iw.rows() != layout.frame_feature_size() || iw.cols() != m->config.window) {
+      r->Fail("import window size does not match the configuration");
     }
   }
-  const Eigen::Index P = static_cast<Eigen::Index>(c.horizon) * 3 * layout.num_joints();
-  for (std::uint64_t i = 0; i < nf; ++i) {
-    ActionForecaster f;
-    f.input_mean = r.Vec();
-    f.input_scale = r.Vec();
-    f.output_mean = r.Vec();
-    f.output_scale = r.Vec();
-    f.num_training_windows = static_cast<int>(r.I64());
-    SparseGpHyper h;
-    h.pseudo_inputs = r.Mat();
-    h.log_lengthscales = r.Vec();
-    h.log_signal_variance = r.F64();
-    h.log_noise_variance = r.F64();
-    Eigen::MatrixXd alpha = r.Mat();
-    Eigen::MatrixXd corr = r.Mat();
-    if (f.input_mean.size() != layout.forecast_input_size() ||
-        f.input_scale.size() != f.input_mean.size() || f.output_mean.size() != P ||
-        f.output_scale.size() != P || h.pseudo_inputs.cols() != f.input_mean.size() ||
-        alpha.cols() != P) {
-      r.Fail("forecaster " + std::to_string(i) + " sizes do not match the configuration");
-    }
-    try {
-      f.gp = SparseGp::FromParts(std::move(h), std::move(alpha), std::move(corr));
-    } catch (const std::invalid_argument& e) {
-      r.Fail(e.what());
-    }
-    m.forecasters.push_back(std::move(f));
+  return nf;
+}
+
+ActionForecaster ReadForecaster(Reader* r, const FeatureLayout& layout, Eigen::Index P, std::uint64_t i) {
+  ActionForecaster f;
+  f.input_mean = r->Vec();
+  f.input_scale = r->Vec();
+  f.output_mean = r->Vec();
+  f.output_scale = r->Vec();
+  f.num_training_windows = static_cast<int>(r->I64());
+  SparseGpHyper h;
+  h.pseudo_inputs = r->Mat();
+  h.log_lengthscales = r->Vec();
+  h.log_signal_variance = r->F64();
+  h.log_noise_variance = r->F64();
+  Eigen::MatrixXd alpha = r->Mat();
+  Eigen::MatrixXd corr = r->Mat();
+  if (f.input_mean.size() != layout.forecast_input_size() || f.input_scale.size() != f.input_mean.size() ||
+      f.output_mean.size() != P || f.output_scale.size() != P || h.pseudo_inputs.cols() != f.input_mean.size() ||
+      alpha.cols() != P) {
+    r->Fail("forecaster " + std::to_string(i) + " sizes do not match the configuration");
   }
+  try {
+    f.gp = SparseGp::FromParts(std::move(h), std::move(alpha), std::move(corr));
+  } catch (const std::invalid_argument& e) {
+    r->Fail(e.what());
+  }
+  return f;
+}
+
+void ReadForecastSettings(Reader* r, std::uint32_t version, ForecastSettings* s) {
   if (version >= 3) {
-    m.forecast.baseline.smoothing_frames = static_cast<int>(r.I64());
-    m.forecast.baseline.damping_time_constant = r.F64();
-    m.forecast.residual_weight = r.F64();
-    m.forecast.variance_scale = r.Vec();
-    m.forecast.motion_offset = r.F64();
-    m.forecast.reference_speed = r.Vec();
+    s->baseline.smoothing_frames = static_cast<int>(r->I64());
+    s->baseline.damping_time_constant = r->F64();
+    s->residual_weight = r->F64();
+    s->variance_scale = r->Vec();
+    s->motion_offset = r->F64();
+    s->reference_speed = r->Vec();
   } else {
     // Version 2 forecasters predict the displacement from the current pose,
     // uncalibrated: exactly L = 1 (the newest frame, no velocity), w = 1,
     // s = 1, no activity scaling.
-    m.forecast = ForecastSettings{};
-    m.forecast.baseline = KinematicBaseline{1, 0.0};
-    m.forecast.residual_weight = 1.0;
+    *s = ForecastSettings{};
+    s->baseline = KinematicBaseline{1, 0.0};
+    s->residual_weight = 1.0;
   }
+}
+
+}  // namespace
+
+IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& source) {
+  std::size_t size = 0;
+  const std::uint32_t version = OpenPayload(bytes, source, &size);
+  Reader r(bytes.data() + sizeof(kMagic) + 4 + 8, size, source);
+  IntentModel m;
+  ReadConfig(&r, &m.config);
+  const IntentModelConfig& c = m.config;
+  const FeatureLayout layout(c.joints, c.features);
+  const std::uint64_t nf = ReadClassifier(&r, layout, &m);
+  const Eigen::Index P = static_cast<Eigen::Index>(c.horizon) * 3 * layout.num_joints();
+  for (std::uint64_t i = 0; i < nf; ++i) m.forecasters.push_back(ReadForecaster(&r, layout, P, i));
+  ReadForecastSettings(&r, version, &m.forecast);
   if (const std::string why = m.forecast.Validate(c.horizon, layout.num_joints()); !why.empty()) {
     r.Fail("forecast settings: " + why);
   }
@@ -334,44 +344,7 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
 }
 
 void SaveIntentModel(const IntentModel& model, const std::string& path) {
-  const std::string bytes = SerializeIntentModel(model);
-  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
-  const int fd = ::open(tmp.c_str(), O_WRONLY | O_CREAT | O_TRUNC | O_CLOEXEC, 0644);
-  if (fd < 0) ThrowErrno("cannot create", tmp);
-  size_t done = 0;
-  while (done < bytes.size()) {
-    const ssize_t n = ::write(fd, bytes.data() + done, bytes.size() - done);
-    if (n < 0) {
-      if (errno == EINTR) continue;
-      const int e = errno;
-      ::close(fd);
-      ::unlink(tmp.c_str());
-      errno = e;
-      ThrowErrno("cannot write", tmp);
-    }
-    done += static_cast<size_t>(n);
-  }
-  if (::fsync(fd) != 0) {
-    const int e = errno;
-    ::close(fd);
-    ::unlink(tmp.c_str());
-    errno = e;
-    ThrowErrno("cannot fsync", tmp);
-  }
-  ::close(fd);
-  if (::rename(tmp.c_str(), path.c_str()) != 0) {
-    const int e = errno;
-    ::unlink(tmp.c_str());
-    errno = e;
-    ThrowErrno("cannot rename temporary file onto", path);
-  }
-  const size_t slash = path.find_last_of('/');
-  const std::string dir = slash == std::string::npos ? "." : (slash == 0 ? "/" : path.substr(0, slash));
-  const int dfd = ::open(dir.c_str(), O_RDONLY | O_DIRECTORY | O_CLOEXEC);
-  if (dfd >= 0) {
-    ::fsync(dfd);
-    ::close(dfd);
-  }
+  core::WriteFileAtomically(path, SerializeIntentModel(model));
 }
 
 IntentModel LoadIntentModel(const std::string& path, const ModelExpectation& expected) {

@@ -11,6 +11,7 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/checksum.h"
 #include "iplan/intent/evaluation.h"
 #include "iplan/intent/model_io.h"
 
@@ -197,15 +198,6 @@ TEST_F(IntentModelTest, EvalJsonHasTheDocumentedKeys) {
   }
 }
 
-std::uint64_t Fnv1a64(const std::string& s) {
-  std::uint64_t h = 1469598103934665603ULL;
-  for (unsigned char c : s) {
-    h ^= c;
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
-
 // The file a format-2 build wrote for `m`: format 3 without the forecast
 // settings that close the payload (model_io.h), version and checksum redone.
 std::string AsFormat2(const IntentModel& m) {
@@ -216,7 +208,7 @@ std::string AsFormat2(const IntentModel& m) {
   const std::string payload = v3.substr(header, v3.size() - header - 8 - settings);
   std::string out = v3.substr(0, 8);
   const std::uint32_t version = 2;
-  const std::uint64_t size = payload.size(), sum = Fnv1a64(payload);
+  const std::uint64_t size = payload.size(), sum = core::Fnv1a64(payload, core::kIplanFnvSeed);
   out.append(reinterpret_cast<const char*>(&version), 4);
   out.append(reinterpret_cast<const char*>(&size), 8);
   out += payload;

@@ -33,6 +33,7 @@
 #include "ompl_peer.h"
 #endif
 #include "iplan/planning/planner.h"
+#include "iplan/core/checksum.h"
 
 using namespace iplan;
 using namespace iplan::planning;
@@ -50,10 +51,7 @@ double Pct(std::vector<double> v, double p) {
 // fingerprint that changes only when results change (for checking that a
 // speed-up is output-preserving).
 void Fingerprint(const PlanningResult& r, std::uint64_t* h) {
-  auto mix = [h](const void* p, std::size_t n) {
-    const unsigned char* b = static_cast<const unsigned char*>(p);
-    for (std::size_t i = 0; i < n; ++i) *h = (*h ^ b[i]) * 1099511628211ULL;
-  };
+  auto mix = [h](const void* p, std::size_t n) { *h = core::Fnv1a64(p, n, *h); };
   mix(r.positions.data(), sizeof(double) * r.positions.size());
   mix(&r.cost, sizeof r.cost);
   mix(r.bounds.data(), sizeof(double) * r.bounds.size());

@@ -1,13 +1,10 @@
 #include "iplan/planning/planner_params.h"
 
+#include "iplan/core/params.h"
+
 #include <cmath>
-#include <set>
 #include <sstream>
 #include <stdexcept>
-
-#include <yaml-cpp/yaml.h>
-
-#include "iplan/core/yaml.h"
 
 namespace iplan::planning {
 namespace {
@@ -77,95 +74,8 @@ std::string PlannerParams::Validate() const {
   return "";
 }
 
-namespace {
-
-template <typename T>
-T Read(const YAML::Node& node, const std::string& key, const std::string& path) {
-  try {
-    return node.as<T>();
-  } catch (const YAML::Exception&) {
-    throw std::runtime_error(path + ": key '" + key + "' has a value of the wrong type: '" +
-                             YAML::Dump(node) + "'");
-  }
-}
-
-}  // namespace
-
-PlannerParams LoadPlannerParams(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = core::LoadYamlFile(path);  // a key twice is an error
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": cannot read planner params: " + e.what());
-  }
-  PlannerParams p;
-  if (!root || root.IsNull()) return p;
-  if (!root.IsMap()) throw std::runtime_error(path + ": planner params must be a map");
-  for (const auto& kv : root) {
-    const std::string key = kv.first.as<std::string>();
-    const YAML::Node& v = kv.second;
-    auto rd = [&](double* out) { *out = Read<double>(v, key, path); };
-    auto ri = [&](int* out) { *out = Read<int>(v, key, path); };
-    if (key == "dt") rd(&p.dt);
-    else if (key == "horizon") rd(&p.horizon);
-    else if (key == "delta_cl") rd(&p.delta_cl);
-    else if (key == "dynamic_activation") rd(&p.dynamic_activation);
-    else if (key == "num_optimizers") ri(&p.num_optimizers);
-    else if (key == "num_threads") ri(&p.num_threads);
-    else if (key == "seed") p.seed = Read<std::uint64_t>(v, key, path);
-    else if (key == "max_iterations") ri(&p.max_iterations);
-    else if (key == "convergence_tolerance") rd(&p.convergence_tolerance);
-    else if (key == "early_stop_interval") ri(&p.early_stop_interval);
-    else if (key == "step_size") rd(&p.step_size);
-    else if (key == "initial_perturbation") rd(&p.initial_perturbation);
-    else if (key == "obstacle_margin") rd(&p.obstacle_margin);
-    else if (key == "min_clearance") rd(&p.min_clearance);
-    else if (key == "collision_check_substeps") ri(&p.collision_check_substeps);
-    else if (key == "wait_duration") rd(&p.wait_duration);
-    else if (key == "max_waits") ri(&p.max_waits);
-    else if (key == "human_separation") rd(&p.human_separation);
-    else if (key == "position_margin") rd(&p.position_margin);
-    else if (key == "limit_scale") rd(&p.limit_scale);
-    else if (key == "end_effector_link") p.end_effector_link = Read<std::string>(v, key, path);
-    else if (key == "end_effector_offset") {
-      const auto xyz = Read<std::vector<double>>(v, key, path);
-      if (xyz.size() != 3)
-        throw std::runtime_error(path + ": end_effector_offset needs 3 numbers, got " +
-                                 std::to_string(xyz.size()));
-      p.end_effector_offset = {xyz[0], xyz[1], xyz[2]};
-    } else if (key == "ik_max_iterations") ri(&p.ik_max_iterations);
-    else if (key == "ik_damping") rd(&p.ik_damping);
-    else if (key == "ik_position_tolerance") rd(&p.ik_position_tolerance);
-    else if (key == "ik_orientation_tolerance") rd(&p.ik_orientation_tolerance);
-    else if (key == "ik_restarts") ri(&p.ik_restarts);
-    else if (key == "allowed_collisions") {
-      p.allowed_collisions.clear();
-      const auto pairs = Read<std::vector<std::vector<std::string>>>(v, key, path);
-      for (const auto& pr : pairs) {
-        if (pr.size() != 2)
-          throw std::runtime_error(path + ": allowed_collisions entries must be [link, object]");
-        p.allowed_collisions.emplace_back(pr[0], pr[1]);
-      }
-    } else if (key == "weights") {
-      if (!v.IsMap()) throw std::runtime_error(path + ": 'weights' must be a map");
-      for (const auto& w : v) {
-        const std::string wk = w.first.as<std::string>();
-        const double wv = Read<double>(w.second, "weights." + wk, path);
-        if (wk == "smoothness") p.weights.smoothness = wv;
-        else if (wk == "obstacle") p.weights.obstacle = wv;
-        else if (wk == "dynamic") p.weights.dynamic = wv;
-        else if (wk == "goal") p.weights.goal = wv;
-        else if (wk == "limits") p.weights.limits = wv;
-        else if (wk == "separation") p.weights.separation = wv;
-        else throw std::runtime_error(path + ": unknown key 'weights." + wk + "'");
-      }
-    } else {
-      throw std::runtime_error(path + ": unknown key '" + key + "'");
-    }
-  }
-  if (const std::string why = p.Validate(); !why.empty())
-    throw std::runtime_error(path + ": " + why);
-  return p;
+PlannerParams LoadPlannerParams(const std::string& path, const core::Overrides& overrides) {
+  return core::LoadParamsFile<PlannerParams>(path, overrides);
 }
 
 }  // namespace iplan::planning

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::planning {
@@ -87,6 +89,26 @@ TEST(PlannerParams, LoadsValuesAndRejectsUnknownKeys) {
     FAIL();
   } catch (const std::runtime_error& e) {
     EXPECT_NE(std::string(e.what()).find("horizon"), std::string::npos) << e.what();
+  }
+}
+
+TEST(PlannerParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(PlannerParams{})),
+            "");
+}
+
+TEST(PlannerParams, OverridesReachTheFileAndAreCheckedLikeIt) {
+  const auto path = Write("over.yaml", "dt: 0.05\n");
+  const PlannerParams p = LoadPlannerParams(path, {{"max_iterations", "30"}, {"weights.goal", "2"}});
+  EXPECT_EQ(p.max_iterations, 30);
+  EXPECT_DOUBLE_EQ(p.weights.goal, 2.0);
+  EXPECT_DOUBLE_EQ(p.dt, 0.05);
+  try {
+    LoadPlannerParams(path, {{"step_size", "1.5"}});
+    FAIL();
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": step_size must be in (0, 1], got 1.5");
   }
 }
 

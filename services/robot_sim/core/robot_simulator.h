@@ -18,11 +18,18 @@
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 
+#include "iplan/core/name_value.h"
+
 namespace iplan::robot_sim {
 
 struct SimulatorParams {
   double stopping_time = 0.3;  ///< s, T_s: a protective stop brings every joint to rest within it
   double contact_margin = 0.0; ///< m; spheres closer than this count as touching
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(stopping_time, "s; T_s, a protective stop brings every joint to rest within it, > 0"));
+    a->Visit(IPLAN_NVP(contact_margin, "m; spheres closer than this count as touching, >= 0"));
+  }
   /// Empty when valid, else the reason.
   std::string Validate() const;
 };

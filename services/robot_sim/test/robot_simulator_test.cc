@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "core/robot_sim_settings.h"
+#include "iplan/core/params.h"
+
 namespace iplan::robot_sim {
 namespace {
 
@@ -92,6 +95,18 @@ TEST_F(RobotSimulatorTest, CountsEachTouchOnce) {
   EXPECT_EQ(sim_.contacts(), 2);
   ASSERT_TRUE(sim_.min_separation_seen());
   EXPECT_LT(*sim_.min_separation_seen(), 0.0);
+}
+
+TEST(RobotSimSettings, TheDocumentedDefaultsAreTheDeclaredOnesAndValid) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(RobotSimSettings{})),
+            "");
+  RobotSimSettings s;
+  EXPECT_EQ(s.Validate(), "");
+  s.permits.max_validity = 5e-4;  // PermitGateParams' (0, 10]: the service no longer says [1e-3, 10]
+  EXPECT_EQ(s.Validate(), "");
+  s.simulator.stopping_time = 0;
+  EXPECT_EQ(s.Validate(), "stopping_time must be > 0");
 }
 
 }  // namespace

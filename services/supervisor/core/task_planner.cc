@@ -8,10 +8,9 @@
 #include <sstream>
 #include <stdexcept>
 
-#include <yaml-cpp/yaml.h>
-
 #include "iplan/core/atomic_file.h"
-#include "iplan/core/yaml.h"
+#include "iplan/core/checksum.h"
+#include "iplan/core/params.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -20,15 +19,6 @@ namespace {
 // version 1 tables (without it) still load, as 0 episodes.
 constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
 constexpr char kMagicV1[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
-
-uint64_t Fnv(const void* data, std::size_t n, uint64_t h = 1469598103934665603ULL) {
-  const auto* p = static_cast<const unsigned char*>(data);
-  for (std::size_t i = 0; i < n; ++i) {
-    h ^= p[i];
-    h *= 1099511628211ULL;
-  }
-  return h;
-}
 
 template <class T>
 void Put(std::string* out, const T& v) {
@@ -95,47 +85,7 @@ std::string TaskGraph::Validate() const {
 }
 
 TaskGraph LoadTaskGraph(const std::string& path) {
-  YAML::Node root;
-  try {
-    root = core::LoadYamlFile(path);  // a task written twice under one key is an error
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  auto fail = [&](const std::string& key, const std::string& why) {
-    throw std::runtime_error(path + ": key '" + key + "': " + why);
-  };
-  for (auto it = root.begin(); it != root.end(); ++it) {
-    const std::string k = it->first.as<std::string>();
-    if (k != "human_actions" && k != "robot_tasks") fail(k, "unknown key");
-  }
-  TaskGraph g;
-  try {
-    if (root["human_actions"]) g.human_actions = root["human_actions"].as<std::vector<std::string>>();
-    if (!root["robot_tasks"] || !root["robot_tasks"].IsSequence()) fail("robot_tasks", "a list of tasks is required");
-    for (std::size_t i = 0; i < root["robot_tasks"].size(); ++i) {
-      const YAML::Node n = root["robot_tasks"][i];
-      const std::string where = "robot_tasks[" + std::to_string(i) + "]";
-      for (auto it = n.begin(); it != n.end(); ++it) {
-        const std::string k = it->first.as<std::string>();
-        if (k != "name" && k != "goal" && k != "retreat" && k != "after" && k != "conflicts_with") {
-          fail(where + "." + k, "unknown key");
-        }
-      }
-      RobotTask t;
-      if (!n["name"]) fail(where + ".name", "is required");
-      t.name = n["name"].as<std::string>();
-      if (!n["goal"]) fail(where + ".goal", "is required");
-      t.goal = n["goal"].as<std::vector<double>>();
-      if (n["retreat"]) t.retreat = n["retreat"].as<std::vector<double>>();
-      if (n["after"]) t.after = n["after"].as<std::vector<std::string>>();
-      if (n["conflicts_with"]) t.conflicts_with = n["conflicts_with"].as<std::vector<std::string>>();
-      g.tasks.push_back(std::move(t));
-    }
-  } catch (const YAML::Exception& e) {
-    throw std::runtime_error(path + ": " + e.what());
-  }
-  if (const std::string why = g.Validate(); !why.empty()) throw std::runtime_error(path + ": " + why);
-  return g;
+  return core::LoadParamsFile<TaskGraph>(path, {}, core::ConfigSection::EmptyFile::kError);
 }
 
 std::string QLearningParams::Validate() const {
@@ -252,10 +202,10 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
 }
 
 uint64_t TaskPlanner::GraphHash() const {
-  uint64_t h = Fnv("graph", 5);
+  uint64_t h = core::Fnv1a64("graph", core::kIplanFnvSeed);
   for (const auto& t : graph_.tasks) {
-    h = Fnv(t.name.data(), t.name.size(), h);
-    for (const auto& a : t.after) h = Fnv(a.data(), a.size(), h);
+    h = core::Fnv1a64(t.name, h);
+    for (const auto& a : t.after) h = core::Fnv1a64(a, h);
   }
   return h;
 }
@@ -280,9 +230,6 @@ void TaskPlanner::Write(const std::string& path) const {
     Put(&body, s);
     for (double v : row) Put(&body, v);
   }
-  std::string file(kMagic, sizeof(kMagic));
-  Put(&file, Fnv(body.data(), body.size()));
-  file += body;
   // Keep the previous good table: if the new one is ever damaged, the
   // loader falls back to it. Only a file that passes Load's checks becomes
   // the backup: after Load refused a corrupt main file and used the backup,
@@ -293,7 +240,8 @@ void TaskPlanner::Write(const std::string& path) const {
     uint64_t unused_episodes = 0;
     if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
   }
-  core::WriteFileAtomically(path, file);
+  core::WriteChecksummedFileAtomically(path, std::string_view(kMagic, sizeof(kMagic)), body,
+                                      core::ChecksumAt::kBeforePayload);
 }
 
 std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
@@ -318,9 +266,11 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
   const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
   if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
   std::size_t pos = sizeof(kMagic);
-  uint64_t checksum = 0, hash = 0, ntasks = 0, nrows = 0;
-  Get(data, &pos, &checksum);
-  if (Fnv(data.data() + pos, data.size() - pos) != checksum) return path + " is corrupt (checksum mismatch)";
+  uint64_t hash = 0, ntasks = 0, nrows = 0;
+  if (!core::OpenChecksummed(data, sizeof(kMagic), core::ChecksumAt::kBeforePayload)) {
+    return path + " is corrupt (checksum mismatch)";
+  }
+  pos += sizeof(uint64_t);  // the checksum
   uint64_t episodes = 0;
   if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows) ||
       (!v1 && !Get(data, &pos, &episodes))) {

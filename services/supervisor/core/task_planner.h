@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "iplan/core/name_value.h"
+
 namespace iplan::supervisor {
 
 struct RobotTask {
@@ -29,18 +31,36 @@ struct RobotTask {
   /// counts as done (e.g. out of the person's space after a hand-over), so
   /// that the delay of leaving is charged to this task. Empty: none.
   std::vector<double> retreat = {};
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(name, "unique task name"));
+    a->Visit(IPLAN_NVP_REQUIRED(goal, "rad; joint goal, robot joint order"));
+    a->Visit(IPLAN_NVP(retreat, "rad; joint positions to withdraw to after the goal, [] = none"));
+    a->Visit(IPLAN_NVP(after, "tasks that must be finished first"));
+    a->Visit(IPLAN_NVP(conflicts_with, "human actions this task conflicts with"));
+  }
 };
 
 struct TaskGraph {
   std::vector<RobotTask> tasks;            ///< at most 63
   std::vector<std::string> human_actions;
+
+  /// The file's keys: human_actions and robot_tasks (the list of tasks).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(human_actions, "the human actions the belief is over"));
+    a->Visit(core::MakeNameValue("robot_tasks", &tasks, "the robot's tasks, at most 63", true));
+  }
   /// Empty when consistent (unique names, known predecessors and actions,
   /// no cycles), else the reason.
   std::string Validate() const;
 };
 
-/// Loads a task graph from YAML (strict: unknown keys and keys written twice
-/// in one mapping are errors). Throws std::runtime_error naming the file and key.
+/// Loads a task graph from YAML (core::LoadParamsFile: unknown keys, wrong
+/// types, missing required keys and keys written twice in one mapping are
+/// errors, and so is an empty file). Throws std::runtime_error naming the
+/// file and key.
 TaskGraph LoadTaskGraph(const std::string& path);
 
 struct QLearningParams {
@@ -54,6 +74,18 @@ struct QLearningParams {
   double delay_weight = 1.0;  ///< w_d, per second of delay
   bool learning = true;       ///< false: deployment, greedy, no updates
   uint64_t seed = 1;
+  /// The YAML keys (section supervisor); `learning` comes from the service's
+  /// `mode`. Ranges: Validate().
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(alpha, "learning rate, in (0, 1]"));
+    a->Visit(IPLAN_NVP(gamma, "discount, in [0, 1)"));
+    a->Visit(IPLAN_NVP(epsilon, "exploration in learning mode, in [0, 1]"));
+    a->Visit(IPLAN_NVP(epsilon_decay, "factor on epsilon per finished learning episode, in (0, 1]"));
+    a->Visit(IPLAN_NVP(epsilon_min, "floor of the decayed epsilon, in [0, 1]"));
+    a->Visit(IPLAN_NVP(delay_weight, "w_d, per second of delay, >= 0"));
+    a->Visit(IPLAN_NVP(seed, "seed of the exploration generator"));
+  }
   std::string Validate() const;
 };
 

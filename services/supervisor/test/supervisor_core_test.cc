@@ -12,9 +12,13 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 #include "core/safety_monitor.h"
+#include "core/supervisor_settings.h"
 #include "core/task_planner.h"
 #include "iplan/core/atomic_file.h"
+#include "iplan/core/checksum.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -211,11 +215,7 @@ TEST(TaskPlanner, TableOfTheFirstFormatStillLoads) {
   }
   ASSERT_EQ(v2.substr(0, 8), "IPLQTBL2");
   std::string body = v2.substr(16, 24) + v2.substr(48);  // without the episode count at 40..47
-  uint64_t sum = 1469598103934665603ULL;
-  for (unsigned char c : body) {
-    sum ^= c;
-    sum *= 1099511628211ULL;
-  }
+  const uint64_t sum = core::Fnv1a64(body, core::kIplanFnvSeed);
   std::string v1 = "IPLQTBL1";
   v1.append(reinterpret_cast<const char*>(&sum), 8);
   v1 += body;
@@ -382,11 +382,7 @@ TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
   ASSERT_EQ(data.size(), 48u + 8 + 3 * 8);
   const double inf = -std::numeric_limits<double>::infinity();
   std::memcpy(&data[48 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
-  uint64_t sum = 1469598103934665603ULL;
-  for (std::size_t i = 16; i < data.size(); ++i) {
-    sum ^= static_cast<unsigned char>(data[i]);
-    sum *= 1099511628211ULL;
-  }
+  const uint64_t sum = core::Fnv1a64(data.data() + 16, data.size() - 16, core::kIplanFnvSeed);
   std::memcpy(&data[8], &sum, 8);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << data;
 
@@ -485,6 +481,41 @@ TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
   d = m.Evaluate(&changed, 11 * s + 9 * s / 10);
   EXPECT_FALSE(d.stop);
   EXPECT_TRUE(changed);
+}
+
+TEST(SupervisorSettings, TheDocumentedDefaultsAreTheDeclaredOnesAndValid) {
+  const std::string doc = std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md";
+  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(SupervisorSettings{})), "");
+  EXPECT_EQ(SupervisorSettings{}.Validate(), "");
+  SupervisorSettings s;
+  s.learning.gamma = 1.0;  // the core's [0, 1): the service no longer has a range of its own
+  EXPECT_EQ(s.Validate(), "gamma must be in [0, 1)");
+  s = SupervisorSettings{};
+  s.learning.gamma = 0.9995;
+  EXPECT_EQ(s.Validate(), "");
+  s.mode = "deployment";
+  s.watch.clear();
+  EXPECT_NE(s.Validate().find("watch must name at least one topic in deployment"), std::string::npos);
+  EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(TaskGraph{})), "");
+}
+
+TEST(TaskGraph, MissingAndUnknownKeysNameTheFileAndTheKey) {
+  const std::string path = TempPath("missing.yaml");
+  std::ofstream(path) << "robot_tasks:\n  - {name: a, gaol: [0, 1]}\n";
+  try {
+    LoadTaskGraph(path);
+    FAIL() << "a task without a goal was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks[0].goal': is required but missing\n" + path +
+                                         ": unknown key 'robot_tasks[0].gaol'");
+  }
+  std::ofstream(path, std::ios::trunc) << "human_actions: [reach]\n";
+  try {
+    LoadTaskGraph(path);
+    FAIL() << "a graph without tasks was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks': is required but missing");
+  }
 }
 
 }  // namespace

@@ -18,6 +18,8 @@
 #include <string>
 #include <vector>
 
+#include "iplan/core/name_value.h"
+
 #include <Eigen/Core>
 
 #include "iplan/cell/joint_trajectory.h"
@@ -49,6 +51,19 @@ struct ReplannerParams {
   /// (or a wait), not late ones; the simulated-time benchmark plans without
   /// one so that it stays deterministic.
   double cycle_budget = 0.0;
+  /// The keys of section trajopt (config/trajopt.yaml); ranges: Validate().
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(planning_step, "s; one replanning cycle per step, > 0"));
+    a->Visit(IPLAN_NVP(frozen_waypoints, "executing prefix kept each cycle, >= 2"));
+    a->Visit(IPLAN_NVP(goal_tolerance, "rad; max joint error to count as arrived, > 0"));
+    a->Visit(IPLAN_NVP(settle_speed, "rad/s; max joint speed to count as arrived, > 0"));
+    a->Visit(IPLAN_NVP(stale_after, "s; older robot states and predictions are not used, > 0"));
+    a->Visit(IPLAN_NVP(max_tracking_error, "rad; further from the plan: replan from the measured state, > 0"));
+    a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a state further outside the limits is refused, >= 0"));
+    a->Visit(IPLAN_NVP(joint_velocity_factor, "a state faster than this x the velocity limit is refused, >= 1"));
+    a->Visit(IPLAN_NVP(cycle_budget, "s of wall time one cycle's planning may take, [0, planning_step); 0: none"));
+  }
   std::string Validate() const;
 };
 

@@ -8,6 +8,8 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::trajopt {
@@ -298,6 +300,12 @@ TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
   const auto cancelled = replanner_.CancelTask(11, t);
   ASSERT_TRUE(cancelled.has_value());
   EXPECT_EQ(cancelled->status, TaskStatus::kCancelled);
+}
+
+TEST(ReplannerParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(ReplannerParams{})),
+            "");
 }
 
 }  // namespace

@@ -9,6 +9,8 @@
 #include <string>
 #include <vector>
 
+#include "iplan/core/name_value.h"
+
 #include <Eigen/Core>
 
 #include "iplan/collision/trajectory_bound.h"
@@ -24,12 +26,28 @@ struct HumanSegmentParams {
   double radius = 0.08;  ///< sphere radius (m), > 0
   /// Positions u in [0, 1] of the spheres; empty = evenly at (k + 0.5)/count.
   std::vector<double> u;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(name, "segment name"));
+    a->Visit(IPLAN_NVP_REQUIRED(joint_a, "joint at u = 0"));
+    a->Visit(IPLAN_NVP_REQUIRED(joint_b, "joint at u = 1"));
+    a->Visit(IPLAN_NVP_REQUIRED(count, "number of spheres, >= 1"));
+    a->Visit(IPLAN_NVP_REQUIRED(radius, "m; sphere radius, > 0"));
+    a->Visit(IPLAN_NVP(u, "positions of the spheres in [0, 1], count of them; [] = evenly"));
+  }
 };
 
 /// The body: joint names (the order of the skeleton input) and segments.
 struct HumanBodyParams {
   std::vector<std::string> joints;
   std::vector<HumanSegmentParams> segments;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(joints, "joint names, in the order of the skeleton input"));
+    a->Visit(IPLAN_NVP_REQUIRED(segments, "the body's segments"));
+  }
 
   /// Empty string when valid, else the reason naming the offending entry.
   std::string Validate() const;
@@ -43,7 +61,9 @@ struct HumanBodyParams {
 };
 
 /// Loads HumanBodyParams from YAML (keys: joints: [names], segments: [{name,
-/// joint_a, joint_b, count, radius, u}]); unknown keys are errors.
+/// joint_a, joint_b, count, radius, u}], as Serialize declares them) with
+/// core::LoadParamsFile: unknown keys, wrong types, missing keys, an empty
+/// file and Validate() failures are errors.
 /// @throws std::runtime_error naming the file, key and value.
 HumanBodyParams LoadHumanBodyParams(const std::string& path);
 

@@ -35,8 +35,10 @@ struct SceneParams {
 ///   objects:
 ///     - {name: table, type: box, xyz: [x, y, z], rpy: [r, p, y], size: [sx, sy, sz]}
 ///     - {name: pillar, type: cylinder, xyz: [...], rpy: [...], radius: r, length: l}
-/// (m, rad; rpy optional, URDF convention R = Rz(y) Ry(p) Rx(r)). Unknown keys
-/// are errors. @throws std::runtime_error naming the file, object and key.
+/// (m, rad; rpy optional, URDF convention R = Rz(y) Ry(p) Rx(r)), read with
+/// core::LoadParamsFile (keys declared in scene.cc): unknown and missing keys,
+/// wrong types, keys of the other shape and an empty file are errors.
+/// @throws std::runtime_error naming the file, object and key.
 SceneParams LoadSceneParams(const std::string& path);
 
 /// Closest pair between robot spheres and the scene.

@@ -8,6 +8,8 @@
 #include <utility>
 #include <vector>
 
+#include "iplan/core/name_value.h"
+
 namespace iplan::planning {
 
 /// Weights of the cost terms (dimensionless multipliers of the terms defined
@@ -19,6 +21,16 @@ struct CostWeights {
   double goal = 0.5;         ///< x sum_i dt ||q_i - q_goal||^2 (rad^2 s)
   double limits = 50.0;      ///< x squared velocity/acceleration limit excess (normalised)
   double separation = 2000.0; ///< x sum max(0, human_separation - d)^2 (d in m), per robot/human sphere pair
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(smoothness, "x sum_i dt ||a_i||^2 (a in rad/s^2); > 0, it is the metric"));
+    a->Visit(IPLAN_NVP(obstacle, "x sum max(0, obstacle_margin - d)^2 (d in m), per sphere/object; >= 0"));
+    a->Visit(IPLAN_NVP(dynamic, "x sum_i max(0, P_i - threshold)^2; >= 0"));
+    a->Visit(IPLAN_NVP(goal, "x sum_i dt ||q_i - q_goal||^2 (rad^2 s); >= 0"));
+    a->Visit(IPLAN_NVP(limits, "x squared velocity/acceleration limit excess (normalised); >= 0"));
+    a->Visit(IPLAN_NVP(separation, "x sum max(0, human_separation - d)^2 (d in m), per robot/human sphere pair; >= 0"));
+  }
 };
 
 struct PlannerParams {
@@ -95,15 +107,55 @@ struct PlannerParams {
   int ik_restarts = 8;
   CostWeights weights;
 
+  /// The YAML keys (config/planner.yaml), one line of doc each; the ranges
+  /// are Validate()'s.
+  template <class Archive>
+  void Serialize(Archive* a);
+
   /// Empty string when valid, else the reason naming the field and value.
   std::string Validate() const;
 };
 
-/// Loads PlannerParams from YAML; keys are the field names above, weights under
-/// `weights:`, allowed_collisions as a list of [link, object] pairs. Missing
-/// keys keep their defaults; unknown or mistyped keys are errors.
-/// @throws std::runtime_error naming the file, key and value (also when the
-///         result fails Validate()). Thread-safe; allocates.
-PlannerParams LoadPlannerParams(const std::string& path);
+template <class Archive>
+void PlannerParams::Serialize(Archive* a) {
+  a->Visit(IPLAN_NVP(dt, "s; waypoint spacing, > 0"));
+  a->Visit(IPLAN_NVP(horizon, "s; n = round(horizon / dt) intervals, >= 2 dt"));
+  a->Visit(IPLAN_NVP(delta_cl, "safety level in (0, 1): a waypoint is safe when its bound P_i < 1 - delta_cl"));
+  a->Visit(IPLAN_NVP(dynamic_activation, "the dynamic cost starts at this x (1 - delta_cl), in (0, 1]"));
+  a->Visit(IPLAN_NVP(num_optimizers, "parallel optimisers N, >= 1"));
+  a->Visit(IPLAN_NVP(num_threads, "worker threads, >= 0 (0 = N, capped at N); results do not depend on it"));
+  a->Visit(IPLAN_NVP(seed, "seed of the optimisers' generators (optimiser o: from seed and o only)"));
+  a->Visit(IPLAN_NVP(max_iterations, "gradient iterations per optimiser and attempt, >= 1"));
+  a->Visit(IPLAN_NVP(convergence_tolerance, "stop when feasible and the relative cost decrease is below this, >= 0"));
+  a->Visit(IPLAN_NVP(early_stop_interval, "rounds of K iterations, all stop after one is feasible and safe; 0 = off"));
+  a->Visit(IPLAN_NVP(step_size, "step of the covariant update, in (0, 1]"));
+  a->Visit(IPLAN_NVP(initial_perturbation, "rad; std-dev of the via-point offset of optimisers 1..N-1, >= 0"));
+  a->Visit(IPLAN_NVP(obstacle_margin, "m; hinge margin of the obstacle cost, >= 0"));
+  a->Visit(IPLAN_NVP(min_clearance, "m; static clearance a feasible trajectory keeps, <= obstacle_margin"));
+  a->Visit(IPLAN_NVP(collision_check_substeps, "interpolated collision checks per interval, >= 1"));
+  a->Visit(IPLAN_NVP(allowed_collisions, "[robot link, scene object] pairs never checked"));
+  a->Visit(IPLAN_NVP(wait_duration, "s; one inserted wait, >= dt"));
+  a->Visit(IPLAN_NVP(max_waits, "waits inserted before giving up, >= 0"));
+  a->Visit(IPLAN_NVP(human_separation, "m; soft keep-out from the predicted person, >= 0 (0 = off)"));
+  a->Visit(IPLAN_NVP(position_margin, "rad; joint limits shrunk by this for the optimiser, >= 0"));
+  a->Visit(IPLAN_NVP(limit_scale, "velocity/acceleration limits x this in the penalty, in (0, 1]"));
+  a->Visit(IPLAN_NVP(end_effector_link, "link of pose goals, not empty"));
+  a->Visit(IPLAN_NVP(end_effector_offset, "m; [x, y, z] of the end effector in that link, finite"));
+  a->Visit(IPLAN_NVP(ik_max_iterations, "inverse kinematics iterations, >= 1"));
+  a->Visit(IPLAN_NVP(ik_damping, "m; damping of the damped least squares, > 0"));
+  a->Visit(IPLAN_NVP(ik_position_tolerance, "m; > 0"));
+  a->Visit(IPLAN_NVP(ik_orientation_tolerance, "rad; > 0"));
+  a->Visit(IPLAN_NVP(ik_restarts, "restarts from random seeds, >= 0"));
+  a->Visit(IPLAN_NVP(weights, "cost weights (dimensionless)"));
+}
+
+/// Loads PlannerParams from YAML (core::LoadParamsFile): keys as in
+/// Serialize, weights under `weights:`, allowed_collisions as a list of
+/// [link, object] pairs; `overrides` ({"weights.goal", "2"}, from --set) are
+/// applied first. Missing keys keep their defaults; an empty file is all
+/// defaults; unknown or mistyped keys are errors.
+/// @throws std::runtime_error (core::ConfigError) naming the file, key and
+///         value (also when the result fails Validate()). Thread-safe; allocates.
+PlannerParams LoadPlannerParams(const std::string& path, const core::Overrides& overrides = {});
 
 }  // namespace iplan::planning

@@ -29,6 +29,8 @@
 #include <string>
 #include <vector>
 
+#include "iplan/core/name_value.h"
+
 namespace iplan::safety {
 
 struct PermitGateParams {
@@ -40,6 +42,12 @@ struct PermitGateParams {
   /// s; permits stamped further ahead of this clock are refused, and a stamp
   /// older than reception by more than this counts against the validity.
   double clock_tolerance = 0.05;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(monitors, "monitors whose permits are all required (participant names), not empty"));
+    a->Visit(IPLAN_NVP(max_validity, "s; a permit's validity is capped at this, in (0, 10]"));
+    a->Visit(IPLAN_NVP(clock_tolerance, "s; permits stamped further ahead are refused, in [0, 1]"));
+  }
   /// Empty when valid, else the reason.
   std::string Validate() const;
 };
