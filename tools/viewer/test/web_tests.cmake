@@ -1,0 +1,1 @@
+# node-driven tests: filled below
