@@ -4,7 +4,7 @@
 // "world", z up, metres. Keeps a summary of every entity for tests.
 import * as THREE from "three";
 
-const sphereGeometry = new THREE.SphereGeometry(1, 18, 12);
+const sphereGeometry = new THREE.SphereGeometry(1, 12, 8);
 const boxGeometry = new THREE.BoxGeometry(1, 1, 1);
 const cylinderGeometry = new THREE.CylinderGeometry(0.5, 0.5, 1, 24).rotateX(Math.PI / 2);  // axis along z
 
@@ -149,14 +149,14 @@ function centroid(spheres) {
 
 export class SceneView {
   constructor(container) {
-    this.renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
-    this.renderer.setPixelRatio(window.devicePixelRatio);
+    this.renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: false });
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 1.5));
     container.appendChild(this.renderer.domElement);
     this.scene = new THREE.Scene();
     this.scene.background = new THREE.Color(0xeef0f3);
     this.camera = new THREE.PerspectiveCamera(45, 1, 0.05, 50);
     this.camera.up.set(0, 0, 1);
-    this.camera.position.set(1.2, -2.6, 1.7);
+    this.camera.position.set(2.0, 1.9, 1.5);
     this.scene.add(new THREE.HemisphereLight(0xffffff, 0x667788, 1.6));
     const sun = new THREE.DirectionalLight(0xffffff, 1.4);
     sun.position.set(2, -3, 4);

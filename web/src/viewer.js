@@ -32,17 +32,31 @@ const state = {
   fps: 0,
   replay: null,
 };
-const pending = new Map();  // entity id -> latest SceneUpdate held while paused
+// Scene updates wait here, the latest per entity, until the next animation
+// frame (or the end of a pause) applies them: the page does at most one
+// update per entity per frame however fast they come, and parses only those
+// (an update is a JSON text until then).
+const pending = new Map();  // entity id -> SceneUpdate (object or JSON text)
 let lastCellStatus = 0;
+
+function entityId(text) {
+  return /"id":"([^"]*)"/.exec(text.slice(0, 400))?.[1] ?? "";
+}
+
+function applyPending() {
+  for (const u of pending.values()) view.apply(typeof u === "string" ? JSON.parse(u) : u);
+  pending.clear();
+}
 
 function deliver(topic, m) {
   state.received[topic] = (state.received[topic] ?? 0) + 1;
   if (topic === SCENE) {
-    if (state.paused) {
-      for (const e of m.entities ?? []) pending.set(e.id, { deletions: [], entities: [e] });
-    } else {
-      view.apply(m);
-    }
+    if (typeof m === "string") pending.set(entityId(m), m);
+    else if ((m.entities ?? []).length === 1 && !(m.deletions ?? []).length) pending.set(m.entities[0].id, m);
+    else { applyPending(); view.apply(m); }
+  } else if (typeof m === "string") {
+    deliver(topic, JSON.parse(m));
+    state.received[topic] -= 1;
   } else if (topic === CELL) {
     state.cellAlive = !!m.alive;
     lastCellStatus = performance.now();
@@ -82,7 +96,7 @@ function connect() {
   });
   client.on("message", ({ subscriptionId, data }) => {
     const topic = bySubscription.get(subscriptionId);
-    if (topic) deliver(topic, JSON.parse(decoder.decode(data)));
+    if (topic) deliver(topic, decoder.decode(data));
   });
   client.on("close", () => {
     state.connected = false;
@@ -97,10 +111,7 @@ function connect() {
 function togglePause() {
   state.paused = !state.paused;
   document.getElementById("pause").textContent = state.paused ? "resume" : "pause";
-  if (!state.paused) {
-    for (const u of pending.values()) view.apply(u);
-    pending.clear();
-  }
+  if (!state.paused) applyPending();
 }
 document.getElementById("pause").addEventListener("click", togglePause);
 window.addEventListener("keydown", (e) => { if (e.code === "Space") togglePause(); });
@@ -141,6 +152,7 @@ function frame(now) {
   }
   if (replay?.state.loaded) showReplayTime();
   lastFrame = now;
+  if (!state.paused) applyPending();
   controls.update();
   view.render();
   state.frames += 1;

@@ -97,7 +97,7 @@ json SceneBuilder::Static(const msg::Time& stamp) const {
   for (const auto& o : model_.scene.objects) {
     const Eigen::Vector3d p = o.X_WO.translation();
     const Eigen::Quaterniond q(o.X_WO.rotation());
-    const Rgba c = o.name == "table" ? Rgba{0.62, 0.5, 0.38, 1.0} : Rgba{0.6, 0.62, 0.66, 0.9};
+    const Rgba c = o.name == "table" ? Rgba{0.62, 0.5, 0.38, 1.0} : Rgba{0.6, 0.62, 0.66, 0.45};
     if (o.shape == collision::SceneObject::Shape::kBox) {
       e["cubes"].push_back({{"pose", Pose(p, q)}, {"size", Point(o.size)}, {"color", Color(c)}});
     } else {
