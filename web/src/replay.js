@@ -56,6 +56,15 @@ export class Replay {
     this.state.finished = this.index >= this.messages.length;
   }
 
+  /** Back to the start, nothing delivered yet (delivery counts restart). */
+  restart() {
+    this.reset();
+    this.index = 0;
+    this.state.delivered = {};
+    this.state.t = 0;
+    this.state.finished = this.messages.length === 0;
+  }
+
   /** Jumps to `t` s: the state is rebuilt as it was then. */
   seek(t) {
     const until = this.t0 + BigInt(Math.round(t * 1e9));

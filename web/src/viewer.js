@@ -171,7 +171,7 @@ window.iplanViewer = {
   project: (p) => view.project(p),
   togglePause,
   /** Replay controls for tests: speed factor, play from the start. */
-  replayPlay: (speed = 1) => { replay.speed = speed; replay.seek(0); replay.playing = true; },
+  replayPlay: (speed = 1) => { replay.speed = speed; replay.restart(); replay.playing = true; },
 };
 
 if (state.mode === "replay") {

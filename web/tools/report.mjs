@@ -30,9 +30,9 @@ function learningPlots() {
     return;
   }
   const ep = curve.map((e) => e.episode);
-  plots.push({ id: "learning", title: "Learning curve: completion time per episode", x: "episode",
+  plots.push({ id: "learning", title: "Learning curve: completion time per episode", x: "episode", integerX: true,
     series: [{ label: "completion time (s)", data: curve.map((e) => e.completion_time_s), points: true }], xs: ep });
-  plots.push({ id: "waiting", title: "Robot waiting time per episode", x: "episode", bars: true,
+  plots.push({ id: "waiting", title: "Robot waiting time per episode", x: "episode", bars: true, integerX: true,
     series: [{ label: "waiting (s)", data: curve.map((e) => e.waiting_time_s) }], xs: ep });
 }
 
@@ -96,7 +96,8 @@ function servicePlots(msgs, t0) {
       const at = new Map(cycle[n]);
       return { label: `${n} p99 (ms)`, data: times.map((t) => at.get(t) ?? null), points: true, spanGaps: true };
     });
-    plots.push({ id: "cycle", title: "Cycle time per service (p99 over its diagnostics window)", x: "time (s)", xs: times, series });
+    plots.push({ id: "cycle", title: "Cycle time per service (p99 over its diagnostics window)", x: "time (s)",
+      y: "cycle time p99 (ms)", xs: times, series });
   }
   const mnames = Object.keys(misses).sort();
   if (!mnames.length) {
@@ -126,7 +127,7 @@ const uplotCss = readFileSync(req.resolve("uplot/dist/uPlot.min.css"), "utf8");
 const facts = [["episodes completed", `${summary.episodes_completed} / ${summary.episodes_requested}`],
   ["tasks completed", summary.tasks_completed], ["robot waiting time", `${(summary.robot_waiting_time_s ?? 0).toFixed(1)} s`],
   ["minimum separation (true body)", summary.min_separation_m >= 0 ? `${summary.min_separation_m.toFixed(3)} m` : "-"],
-  ["maximum collision bound", summary.max_collision_bound], ["protective stops", summary.protective_stops],
+  ["maximum collision bound", Number(summary.max_collision_bound ?? 0).toFixed(4)], ["protective stops", summary.protective_stops],
   ["true contacts", summary.true_contacts],
   ["end-to-end latency", summary.latency_ms ? `p50 ${summary.latency_ms.p50.toFixed(1)} ms, p99 ${summary.latency_ms.p99.toFixed(1)} ms` : "-"],
   ["run time", `${(summary.duration_s ?? 0).toFixed(0)} s`], ["failure", summary.failure || "none"]];

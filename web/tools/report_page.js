@@ -10,8 +10,14 @@
       width: 2, spanGaps: !!s.spanGaps, points: { show: !!s.points || !!p.bars },
       fill: p.bars ? colors[i % colors.length] + "88" : undefined,
       paths: p.bars ? uPlot.paths.bars({ size: [0.8, 60] }) : undefined }));
-    const axes = [{ label: p.x, values: p.xlabels ? (u, ticks) => ticks.map((t) => p.xlabels[Math.round(t) - 1] ?? "") : undefined },
-      { label: p.series[0].label }];
+    const x = { label: p.x };
+    if (p.xlabels) {
+      x.splits = () => p.xs;
+      x.values = (u, ticks) => ticks.map((t) => p.xlabels[Math.round(t) - 1] ?? "");
+    } else if (p.integerX) {
+      x.splits = () => p.xs;
+    }
+    const axes = [x, { label: p.y || p.series[0].label }];
     if (p.series.some((s) => s.scale === "p")) axes.push({ scale: "p", side: 1, label: "bound", grid: { show: false } });
     const marks = p.marks || [];
     const opts = { width: 940, height: 260, series, axes, scales: { x: { time: false } },
