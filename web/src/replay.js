@@ -28,8 +28,10 @@ export class Replay {
       const topic = topics.get(m.channelId);
       let entity = null;
       if (topic === "/iplan/viewer/scene") {
-        const head = decoder.decode(m.data.subarray(0, 400));
-        entity = /"id":"([^"]*)"/.exec(head)?.[1] ?? null;
+        // The entity id is the first "id" of the text (keys are sorted;
+        // no primitive has one); the static scene's comes after its cubes.
+        const id = /"id":"([^"]*)"/;
+        entity = id.exec(decoder.decode(m.data.subarray(0, 400)))?.[1] ?? id.exec(decoder.decode(m.data))?.[1] ?? null;
       }
       this.messages.push({ topic, t: m.logTime, data: m.data, entity });
       this.state.counts[topic] = (this.state.counts[topic] ?? 0) + 1;

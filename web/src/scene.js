@@ -5,6 +5,9 @@
 import * as THREE from "three";
 
 const sphereGeometry = new THREE.SphereGeometry(1, 12, 8);
+// Faint spheres (predictions, ghost poses) overlap by the hundred; fewer
+// triangles each keep software rendering (no GPU) affordable.
+const faintSphereGeometry = new THREE.SphereGeometry(1, 8, 6);
 const boxGeometry = new THREE.BoxGeometry(1, 1, 1);
 const cylinderGeometry = new THREE.CylinderGeometry(0.5, 0.5, 1, 24).rotateX(Math.PI / 2);  // axis along z
 
@@ -42,7 +45,7 @@ class EntityView {
       m = undefined;
     }
     if (!m) {
-      m = new THREE.InstancedMesh(sphereGeometry, material(alpha), Math.max(16, needed * 2));
+      m = new THREE.InstancedMesh(alpha < 0.3 ? faintSphereGeometry : sphereGeometry, material(alpha), Math.max(16, needed * 2));
       m.renderOrder = alpha < 0.999 ? 1 : 0;
       this.sphereMeshes.set(key, m);
       this.group.add(m);
@@ -172,6 +175,12 @@ export class SceneView {
     this.container = container;
     this.resize();
     window.addEventListener("resize", () => this.resize());
+  }
+
+  /** Renders `fraction` (0-1] of the device pixels in each direction. */
+  setResolution(fraction) {
+    this.renderer.setPixelRatio(Math.min(window.devicePixelRatio, 1.5) * fraction);
+    this.resize();
   }
 
   resize() {

@@ -39,8 +39,11 @@ const state = {
 const pending = new Map();  // entity id -> SceneUpdate (object or JSON text)
 let lastCellStatus = 0;
 
+// The entity id is the first "id" of the text (keys are sorted; no
+// primitive has one); the static scene's comes after its cubes.
 function entityId(text) {
-  return /"id":"([^"]*)"/.exec(text.slice(0, 400))?.[1] ?? "";
+  const id = /"id":"([^"]*)"/;
+  return id.exec(text.slice(0, 400))?.[1] ?? id.exec(text)?.[1] ?? "";
 }
 
 function applyPending() {
@@ -143,7 +146,20 @@ function showReplayTime() {
   document.getElementById("slider").value = s.duration > 0 ? Math.round(s.t / s.duration * 1000) : 0;
 }
 
-let fpsFrames = 0, fpsSince = performance.now();
+// Dynamic resolution: below 30 fps (software rendering, a busy machine) the
+// canvas renders fewer pixels, down to 40 % of the full resolution in each
+// direction; above 50 fps it goes back up. ?resolution=fixed turns it off.
+state.resolution = 1;
+function adaptResolution() {
+  if (params.get("resolution") === "fixed") return;
+  const r = state.fps < 30 ? Math.max(0.4, state.resolution * 0.8) : state.fps > 50 ? Math.min(1, state.resolution * 1.25) : state.resolution;
+  if (Math.abs(r - state.resolution) > 1e-3) {
+    state.resolution = r;
+    view.setResolution(r);
+  }
+}
+
+let fpsFrames = 0, fpsSince = performance.now(), workMs = 0;
 function frame(now) {
   requestAnimationFrame(frame);
   if (replay?.state.loaded && replay.playing && !state.paused) {
@@ -152,15 +168,21 @@ function frame(now) {
   }
   if (replay?.state.loaded) showReplayTime();
   lastFrame = now;
+  const t0 = performance.now();
   if (!state.paused) applyPending();
   controls.update();
   view.render();
+  workMs += performance.now() - t0;
   state.frames += 1;
   if (++fpsFrames && now - fpsSince >= 1000) {
     state.fps = fpsFrames * 1000 / (now - fpsSince);
+    state.frameWorkMs = workMs / fpsFrames;
+    workMs = 0;
     fpsFrames = 0;
     fpsSince = now;
-    document.getElementById("fps").textContent = `${state.fps.toFixed(0)} fps`;
+    adaptResolution();
+    document.getElementById("fps").textContent = `${state.fps.toFixed(0)} fps` +
+      (state.resolution < 0.99 ? ` (${Math.round(100 * state.resolution)} % res.)` : "");
   }
   state.entities = view.summaries();
   renderStrip(state.strip);

@@ -51,6 +51,7 @@ s = await state();
 check(Math.abs(s.replay.t - s.replay.duration / 2) < 0.01 * s.replay.duration + 0.1 && !s.replay.finished,
   `the slider seeks to ${s.replay.t.toFixed(1)} s`);
 check(s.entities.robot?.spheres > 20, "after the seek the robot is drawn as it was then");
+check(s.entities.scene?.cubes >= 3, "after the seek the table and scene objects are drawn");
 await browser.close();
 await viewer.proc.stop("SIGINT");
 process.exit(0);

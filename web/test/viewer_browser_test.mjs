@@ -22,7 +22,9 @@ const cell = new Proc([join(bin, "iplan"), "demo", "--episodes", "20", "--timeou
 
 const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
 page.on("pageerror", (e) => fail(`page error: ${e}`));
-await page.goto(viewer.url);
+// Fixed resolution: the pixel comparison must see motion, not the page's
+// dynamic resolution changing between screenshots.
+await page.goto(`${viewer.url}?resolution=fixed`);
 const state = () => page.evaluate(() => JSON.parse(JSON.stringify(window.iplanViewer.state)));
 
 await waitFor("the page to show the cell (connected, robot, person, prediction)", async () => {
@@ -91,6 +93,13 @@ for (const id of ["robot", "person"]) {
   const f = await changedFraction(r);
   check(f > 0.005, `${id} region (${Math.round(r.x1 - r.x0)} x ${Math.round(r.y1 - r.y0)} px) changed in ${(100 * f).toFixed(1)} % of its pixels`);
 }
+// A control region of static floor in front of the person (nothing moves
+// between it and the camera): unchanged, so the
+// change above is the robot's and the person's motion.
+const floor = await page.evaluate(() => { const p = window.iplanViewer.project([1.9, 0.6, -0.05]);
+  return { x0: p.x - 50, x1: p.x + 50, y0: p.y - 40, y1: p.y + 40 }; });
+const still = await changedFraction(floor);
+check(still < 0.002, `static floor region changed in ${(100 * still).toFixed(2)} % of its pixels`);
 s = await state();
 check(s.strip.action !== null, `strip shows the believed action (${s.strip.action})`);
 check(await page.textContent("#verdict") !== "-", `strip shows the verdict (${await page.textContent("#verdict")})`);
@@ -100,7 +109,13 @@ s = await state();
 check(true, `strip shows the current task (${s.strip.task})`);
 
 if (process.env.IPLAN_SCREENSHOT_DIR) {
-  writeFileSync(join(process.env.IPLAN_SCREENSHOT_DIR, "viewer-live.png"), await page.screenshot());
+  // For the docs: a second page at full resolution (no dynamic resolution).
+  const docs = await browser.newPage({ viewport: { width: 1280, height: 760 } });
+  await docs.goto(`${viewer.url}?resolution=fixed`);
+  await waitFor("the docs page", () => docs.evaluate(() => window.iplanViewer.state.entities.trajectory !== undefined), 30000);
+  await sleep(1500);
+  writeFileSync(join(process.env.IPLAN_SCREENSHOT_DIR, "viewer-live.png"), await docs.screenshot());
+  await docs.close();
   console.log(`screenshot written to ${process.env.IPLAN_SCREENSHOT_DIR}/viewer-live.png`);
 }
 

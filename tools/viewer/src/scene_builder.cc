@@ -61,7 +61,7 @@ json Update(json entity) { return {{"deletions", json::array()}, {"entities", js
 const Rgba kRobot{1.0, 0.55, 0.1, 0.55};
 const Rgba kRobotLink{0.25, 0.25, 0.25, 1.0};
 const Rgba kGhost{1.0, 0.55, 0.1, 0.12};
-const Rgba kPerson{0.2, 0.55, 1.0, 0.45};
+const Rgba kPerson{0.2, 0.55, 1.0, 0.75};
 const Rgba kBone{0.05, 0.2, 0.6, 1.0};
 const Rgba kPath{0.0, 0.8, 0.3, 1.0};
 const Rgba kOldPath{0.5, 0.5, 0.5, 0.6};
@@ -226,7 +226,7 @@ std::optional<json> SceneBuilder::Prediction(const msg::HumanPrediction& p) {
       return std::nullopt;
     }
     Rgba c = kActionColors[rank % 4];
-    c.a = 0.08 + 0.5 * std::clamp(a.probability, 0.0, 1.0);  // shaded by probability
+    c.a = 0.06 + 0.3 * std::clamp(a.probability, 0.0, 1.0);  // shaded by probability
     for (int k = 1; k <= drawn; ++k) {
       const int step = k * steps / drawn - 1;  // evenly spread, the last step included
       for (const auto& sp : model_.body.spheres()) {
