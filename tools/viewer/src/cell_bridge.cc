@@ -87,10 +87,13 @@ struct CellBridge::Impl {
     sink(channel, t_ns, text);
   }
 
-  void EmitScene(const std::optional<json>& update) {
+  // A scene input the model cannot use is counted and logged by the node
+  // (rejected_inputs/scene, first time and every 100th).
+  void EmitScene(const json* update) {
     if (!update) {
       stats.scene_rejected = scene->rejected();
       stats.last_scene_rejection = scene->last_rejection();
+      node->CountRejection("scene", scene->last_rejection());
       return;
     }
     Emit(scene_channel, NowNs(), *update);
@@ -117,7 +120,10 @@ struct CellBridge::Impl {
       EmitScene(scene->Prediction(m));
     });
     SceneInput(topics::RobotTrajectory(), [this](const msg::JointTrajectory& m) { EmitScene(scene->Trajectory(m)); });
-    SceneInput(topics::CollisionRisk(), [this](const msg::CollisionRisk& m) { EmitScene(scene->Safety(m)); });
+    SceneInput(topics::CollisionRisk(), [this](const msg::CollisionRisk& m) {
+      const json update = scene->Safety(m);
+      EmitScene(&update);
+    });
   }
 
   void AddRawTopics(dds::Participant& p) {

@@ -13,10 +13,6 @@ namespace {
 
 using nlohmann::json;
 
-struct Rgba {
-  double r, g, b, a;
-};
-
 json Color(const Rgba& c) { return {{"r", c.r}, {"g", c.g}, {"b", c.b}, {"a", c.a}}; }
 json Point(const Eigen::Vector3d& p) { return {{"x", p.x()}, {"y", p.y()}, {"z", p.z()}}; }
 json Pose(const Eigen::Vector3d& p, const Eigen::Quaterniond& q = Eigen::Quaterniond::Identity()) {
@@ -138,69 +134,113 @@ std::optional<Eigen::VectorXd> SceneBuilder::JointVector(const std::vector<std::
   return v;
 }
 
-json SceneBuilder::RobotSpheres(const Eigen::VectorXd& q, const double rgba[4]) {
-  collision::CalcForwardKinematics(model_.robot, q, &data_);
-  json spheres = json::array();
-  const Rgba c{rgba[0], rgba[1], rgba[2], rgba[3]};
-  for (std::size_t i = 0; i < model_.robot.spheres.size(); ++i) {
-    spheres.push_back(Sphere(data_.p_WS.col(static_cast<int>(i)), model_.robot.spheres[i].radius, c));
-  }
-  return spheres;
-}
-
 Eigen::Vector3d SceneBuilder::EndEffector(const Eigen::VectorXd& q) {
   collision::CalcForwardKinematics(model_.robot, q, &data_);
   return data_.X_WL.back().translation();
 }
 
-std::optional<json> SceneBuilder::Robot(const msg::JointState& js) {
+namespace {
+
+// In-place writers: once an array element exists, only its numbers change
+// (no allocation), so a steady stream of updates costs little.
+void PutPoint(json& array, std::size_t i, const Eigen::Vector3d& p) {
+  if (i >= array.size()) {
+    array.push_back(Point(p));
+    return;
+  }
+  json& q = array[i];
+  q["x"] = p.x();
+  q["y"] = p.y();
+  q["z"] = p.z();
+}
+
+void PutSphereAt(json& array, std::size_t i, const Eigen::Vector3d& c, double radius, const Rgba& color) {
+  if (i >= array.size()) {
+    array.push_back(Sphere(c, radius, color));
+    return;
+  }
+  json& s = array[i];
+  json& p = s["pose"]["position"];
+  p["x"] = c.x();
+  p["y"] = c.y();
+  p["z"] = c.z();
+  json& size = s["size"];
+  size["x"] = size["y"] = size["z"] = 2 * radius;
+  json& k = s["color"];
+  k["r"] = color.r;
+  k["g"] = color.g;
+  k["b"] = color.b;
+  k["a"] = color.a;
+}
+
+void Truncate(json& array, std::size_t n) {
+  while (array.size() > n) array.erase(array.size() - 1);
+}
+
+}  // namespace
+
+json& SceneBuilder::Persistent(const char* id, const msg::Time& stamp) {
+  auto it = updates_.find(id);
+  if (it == updates_.end()) it = updates_.emplace(id, Update(Entity(id, stamp))).first;
+  json& e = it->second["entities"][0];
+  e["timestamp"]["sec"] = stamp.sec;
+  e["timestamp"]["nsec"] = stamp.nanosec;
+  return e;
+}
+
+void SceneBuilder::PutRobotSpheres(json& array, std::size_t first, const Eigen::VectorXd& q, const Rgba& color) {
+  collision::CalcForwardKinematics(model_.robot, q, &data_);
+  for (std::size_t i = 0; i < model_.robot.spheres.size(); ++i) {
+    PutSphereAt(array, first + i, data_.p_WS.col(static_cast<int>(i)), model_.robot.spheres[i].radius, color);
+  }
+}
+
+const json* SceneBuilder::Robot(const msg::JointState& js) {
   const auto q = JointVector(js.name, js.position);
-  if (!q) return std::nullopt;
-  json e = Entity(entity::kRobot, js.header.stamp);
-  const double c[4] = {kRobot.r, kRobot.g, kRobot.b, kRobot.a};
-  e["spheres"] = RobotSpheres(*q, c);
+  if (!q) return nullptr;
+  json& e = Persistent(entity::kRobot, js.header.stamp);
+  PutRobotSpheres(e["spheres"], 0, *q, kRobot);
   // Links: a line from each link's parent link origin to its own origin.
-  json links = json::array();
+  if (e["lines"].empty()) e["lines"].push_back(Line(2, json::array(), 0.02, kRobotLink));
+  json& links = e["lines"][0]["points"];
+  std::size_t n = 0;
   for (std::size_t l = 1; l < model_.robot.link_names.size(); ++l) {
     const int j = model_.robot.link_parent_joint[l];
     if (j < 0) continue;
-    const int parent = model_.robot.joints[j].parent_link;
-    links.push_back(Point(data_.X_WL[parent].translation()));
-    links.push_back(Point(data_.X_WL[l].translation()));
+    PutPoint(links, n++, data_.X_WL[model_.robot.joints[j].parent_link].translation());
+    PutPoint(links, n++, data_.X_WL[l].translation());
   }
-  e["lines"].push_back(Line(2, std::move(links), 0.02, kRobotLink));
-  e["metadata"].push_back({{"key", "end_effector"}, {"value", model_.robot.link_names.back()}});
-  return Update(std::move(e));
+  if (e["metadata"].empty()) e["metadata"].push_back({{"key", "end_effector"}, {"value", model_.robot.link_names.back()}});
+  return &updates_[entity::kRobot];
 }
 
-std::optional<json> SceneBuilder::Person(const msg::HumanSkeleton& s) {
+const json* SceneBuilder::Person(const msg::HumanSkeleton& s) {
   const auto& params = model_.body.params();
-  std::map<std::string, Eigen::Vector3d> at;
-  for (const auto& j : s.joints) at[j.name] = {j.position.x, j.position.y, j.position.z};
   Eigen::Matrix3Xd means(3, model_.body.num_joints());
   for (int j = 0; j < model_.body.num_joints(); ++j) {
-    auto it = at.find(params.joints[j]);
-    if (it == at.end()) {
+    auto it = std::find_if(s.joints.begin(), s.joints.end(), [&](const auto& k) { return k.name == params.joints[j]; });
+    if (it == s.joints.end()) {
       Reject("skeleton lacks joint '" + params.joints[j] + "'");
-      return std::nullopt;
+      return nullptr;
     }
-    means.col(j) = it->second;
+    means.col(j) = Eigen::Vector3d(it->position.x, it->position.y, it->position.z);
   }
-  json e = Entity(entity::kPerson, s.header.stamp);
-  json bones = json::array();
+  json& e = Persistent(entity::kPerson, s.header.stamp);
+  if (e["lines"].empty()) e["lines"].push_back(Line(2, json::array(), 0.015, kBone));
+  json& bones = e["lines"][0]["points"];
+  std::size_t n = 0;
   for (const auto& seg : params.segments) {
-    bones.push_back(Point(at[seg.joint_a]));
-    bones.push_back(Point(at[seg.joint_b]));
+    PutPoint(bones, n++, means.col(std::find(params.joints.begin(), params.joints.end(), seg.joint_a) - params.joints.begin()));
+    PutPoint(bones, n++, means.col(std::find(params.joints.begin(), params.joints.end(), seg.joint_b) - params.joints.begin()));
   }
-  e["lines"].push_back(Line(2, std::move(bones), 0.015, kBone));
+  std::size_t i = 0;
   for (const auto& sp : model_.body.spheres()) {
-    const Eigen::Vector3d c = (1 - sp.u) * means.col(sp.joint_a) + sp.u * means.col(sp.joint_b);
-    e["spheres"].push_back(Sphere(c, sp.radius, kPerson));
+    PutSphereAt(e["spheres"], i++, (1 - sp.u) * means.col(sp.joint_a) + sp.u * means.col(sp.joint_b), sp.radius, kPerson);
   }
-  return Update(std::move(e));
+  return &updates_[entity::kPerson];
 }
 
-std::optional<json> SceneBuilder::Prediction(const msg::HumanPrediction& p) {
+const json* SceneBuilder::Prediction(const msg::HumanPrediction& p) {
   const auto& params = model_.body.params();
   const std::size_t nj = p.joint_names.size();
   std::vector<int> index(params.joints.size(), -1);
@@ -208,23 +248,27 @@ std::optional<json> SceneBuilder::Prediction(const msg::HumanPrediction& p) {
     auto it = std::find(p.joint_names.begin(), p.joint_names.end(), params.joints[j]);
     if (it == p.joint_names.end()) {
       Reject("prediction lacks joint '" + params.joints[j] + "'");
-      return std::nullopt;
+      return nullptr;
     }
     index[j] = static_cast<int>(it - p.joint_names.begin());
+  }
+  for (const auto& a : p.actions) {
+    if (a.joints.size() != nj * p.num_steps) {
+      Reject("prediction of '" + a.action + "' has " + std::to_string(a.joints.size()) + " Gaussians, not steps x joints");
+      return nullptr;
+    }
   }
   std::vector<std::size_t> order(p.actions.size());
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](auto a, auto b) { return p.actions[a].probability > p.actions[b].probability; });
   if (static_cast<int>(order.size()) > options_.prediction_actions) order.resize(options_.prediction_actions);
-  json e = Entity(entity::kPrediction, p.header.stamp);
+  json& e = Persistent(entity::kPrediction, p.header.stamp);
   const int steps = static_cast<int>(p.num_steps);
   const int drawn = std::min(options_.prediction_steps, steps);
+  std::size_t n = 0;
+  e["metadata"] = json::array();
   for (std::size_t rank = 0; rank < order.size(); ++rank) {
     const auto& a = p.actions[order[rank]];
-    if (a.joints.size() != nj * p.num_steps) {
-      Reject("prediction of '" + a.action + "' has " + std::to_string(a.joints.size()) + " Gaussians, not steps x joints");
-      return std::nullopt;
-    }
     Rgba c = kActionColors[rank % 4];
     c.a = 0.06 + 0.3 * std::clamp(a.probability, 0.0, 1.0);  // shaded by probability
     for (int k = 1; k <= drawn; ++k) {
@@ -233,35 +277,38 @@ std::optional<json> SceneBuilder::Prediction(const msg::HumanPrediction& p) {
         const auto& ga = a.joints[step * nj + index[sp.joint_a]].mean;
         const auto& gb = a.joints[step * nj + index[sp.joint_b]].mean;
         const Eigen::Vector3d c3 = (1 - sp.u) * Eigen::Vector3d(ga.x, ga.y, ga.z) + sp.u * Eigen::Vector3d(gb.x, gb.y, gb.z);
-        e["spheres"].push_back(Sphere(c3, sp.radius, c));
+        PutSphereAt(e["spheres"], n++, c3, sp.radius, c);
       }
     }
     e["metadata"].push_back({{"key", a.action}, {"value", std::to_string(a.probability)}});
   }
-  return Update(std::move(e));
+  Truncate(e["spheres"], n);
+  return &updates_[entity::kPrediction];
 }
 
-std::optional<json> SceneBuilder::Trajectory(const msg::JointTrajectory& t) {
-  json e = Entity(entity::kTrajectory, t.header.stamp);
-  json path = json::array();
+const json* SceneBuilder::Trajectory(const msg::JointTrajectory& t) {
   std::vector<Eigen::VectorXd> qs;
   for (const auto& pt : t.points) {
     const auto q = JointVector(t.joint_names, pt.positions);
-    if (!q) return std::nullopt;
+    if (!q) return nullptr;
     qs.push_back(*q);
-    path.push_back(Point(EndEffector(*q)));
   }
-  if (!previous_path_.empty()) e["lines"].push_back(Line(0, previous_path_, 0.006, kOldPath));
+  json& e = Persistent(entity::kTrajectory, t.header.stamp);
+  json path = json::array();
+  for (const auto& q : qs) path.push_back(Point(EndEffector(q)));
+  e["lines"] = json::array();
+  if (!previous_path_.empty()) e["lines"].push_back(Line(0, std::move(previous_path_), 0.006, kOldPath));
   e["lines"].push_back(Line(0, path, 0.012, kPath));
   const int n = static_cast<int>(qs.size());
-  const double g[4] = {kGhost.r, kGhost.g, kGhost.b, kGhost.a};
-  for (int k = 1; k <= options_.ghost_poses && n > 0; ++k) {
-    const json spheres = RobotSpheres(qs[k * (n - 1) / options_.ghost_poses], g);
-    e["spheres"].insert(e["spheres"].end(), spheres.begin(), spheres.end());
+  const std::size_t per_pose = model_.robot.spheres.size();
+  std::size_t drawn = 0;
+  for (int k = 1; k <= options_.ghost_poses && n > 0; ++k, ++drawn) {
+    PutRobotSpheres(e["spheres"], drawn * per_pose, qs[k * (n - 1) / options_.ghost_poses], kGhost);
   }
-  e["metadata"].push_back({{"key", "waypoints"}, {"value", std::to_string(n)}});
+  Truncate(e["spheres"], drawn * per_pose);
+  e["metadata"] = json::array({{{"key", "waypoints"}, {"value", std::to_string(n)}}});
   previous_path_ = std::move(path);
-  return Update(std::move(e));
+  return &updates_[entity::kTrajectory];
 }
 
 json SceneBuilder::Safety(const msg::CollisionRisk& r) const {

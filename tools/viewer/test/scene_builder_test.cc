@@ -32,7 +32,9 @@ Eigen::Vector3d At(const nlohmann::json& sphere) {
 
 TEST(SceneBuilder, RobotSpheresFollowTheJoints) {
   SceneBuilder b(Model());
-  const auto a = b.Robot(Joints(0.0)), c = b.Robot(Joints(1.0));
+  const nlohmann::json a0 = *b.Robot(Joints(0.0));
+  const auto* a = &a0;
+  const auto* c = b.Robot(Joints(1.0));
   ASSERT_TRUE(a && c);
   const auto& ea = (*a)["entities"][0];
   EXPECT_EQ(ea["id"], entity::kRobot);
@@ -127,6 +129,30 @@ TEST(SceneBuilder, TrajectoryPathEndsAtTheLastWaypoint) {
   EXPECT_EQ(e1["spheres"].size(), 2 * b.model().robot.spheres.size());  // two ghost poses
   const auto u2 = b.Trajectory(t);
   EXPECT_EQ((*u2)["entities"][0]["lines"].size(), 2u);  // the previous plan, faded, and the new one
+}
+
+// Updates are written in place into the builder's kept entity: the result
+// must equal what a fresh builder makes of the same input.
+TEST(SceneBuilder, InPlaceUpdatesEqualFreshOnes) {
+  SceneBuilder kept(Model()), fresh(Model());
+  kept.Robot(Joints(0.3));
+  EXPECT_EQ(*kept.Robot(Joints(-0.7)), *fresh.Robot(Joints(-0.7)));
+  msg::HumanPrediction p;
+  p.joint_names = kept.model().body.params().joints;
+  p.num_steps = 4;
+  for (double prob : {0.5, 0.3, 0.2}) {
+    msg::ActionPrediction a;
+    a.action = "a" + std::to_string(prob);
+    a.probability = prob;
+    a.joints.resize(p.num_steps * p.joint_names.size());
+    for (std::size_t i = 0; i < a.joints.size(); ++i) a.joints[i].mean.x = prob + 0.01 * i;
+    p.actions.push_back(a);
+  }
+  kept.Prediction(p);
+  p.actions.pop_back();  // fewer spheres than before
+  p.actions[0].probability = 0.1;  // order and shading change
+  SceneBuilder fresh2(Model());
+  EXPECT_EQ(*kept.Prediction(p), *fresh2.Prediction(p));
 }
 
 TEST(SceneBuilder, StaticSceneHasEveryObject) {

@@ -12,6 +12,7 @@
 #pragma once
 
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 
@@ -46,6 +47,11 @@ inline constexpr const char* kTrajectory = "trajectory";
 inline constexpr const char* kSafety = "safety";
 }  // namespace entity
 
+/// A colour, red, green, blue and opacity in [0, 1].
+struct Rgba {
+  double r, g, b, a;
+};
+
 struct SceneBuilderOptions {
   /// Prediction steps drawn (evenly spread over the horizon); bounds the
   /// number of spheres per update.
@@ -62,17 +68,21 @@ class SceneBuilder {
 
   /// The static objects (boxes, cylinders) as one SceneUpdate.
   nlohmann::json Static(const msg::Time& stamp) const;
-  /// Robot spheres and links at `js`. nullopt (counted in rejected()) when
-  /// the joint names or sizes do not fit the model.
-  std::optional<nlohmann::json> Robot(const msg::JointState& js);
-  /// Skeleton (bones as lines, joints as small spheres) and body spheres.
-  std::optional<nlohmann::json> Person(const msg::HumanSkeleton& s);
+  // The next four return the entity's update, kept by the builder and valid
+  // until the next call for the same entity (updated in place: a steady
+  // stream allocates little); nullptr (counted in rejected()) when the input
+  // does not fit the model: unknown joint names, inconsistent sizes.
+
+  /// Robot spheres and links at `js`.
+  const nlohmann::json* Robot(const msg::JointState& js);
+  /// Skeleton (bones as lines) and body spheres.
+  const nlohmann::json* Person(const msg::HumanSkeleton& s);
   /// Predicted body spheres at a few future steps for the most probable
   /// actions; colour per action, opacity from its probability.
-  std::optional<nlohmann::json> Prediction(const msg::HumanPrediction& p);
+  const nlohmann::json* Prediction(const msg::HumanPrediction& p);
   /// End-effector path of the newly planned trajectory, the previous plan's
   /// path faded, and ghost robot poses along the new one.
-  std::optional<nlohmann::json> Trajectory(const msg::JointTrajectory& t);
+  const nlohmann::json* Trajectory(const msg::JointTrajectory& t);
   /// Separation, S_p and verdict as text above the table, coloured by verdict.
   nlohmann::json Safety(const msg::CollisionRisk& r) const;
 
@@ -83,7 +93,8 @@ class SceneBuilder {
 
  private:
   std::optional<Eigen::VectorXd> JointVector(const std::vector<std::string>& names, const std::vector<double>& q);
-  nlohmann::json RobotSpheres(const Eigen::VectorXd& q, const double rgba[4]);
+  nlohmann::json& Persistent(const char* id, const msg::Time& stamp);
+  void PutRobotSpheres(nlohmann::json& array, std::size_t first, const Eigen::VectorXd& q, const Rgba& color);
   Eigen::Vector3d EndEffector(const Eigen::VectorXd& q);
   void Reject(const std::string& why);
 
@@ -91,6 +102,7 @@ class SceneBuilder {
   SceneBuilderOptions options_;
   collision::RobotData data_;
   nlohmann::json previous_path_ = nlohmann::json::array();
+  std::map<std::string, nlohmann::json> updates_;  // entity id -> its last SceneUpdate
   uint64_t rejected_ = 0;
   std::string last_rejection_;
 };
