@@ -5,8 +5,10 @@
 // command feeds one line per message through a pipe.
 #include <signal.h>
 #include <stdio.h>
+#include <sys/wait.h>
 
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <iomanip>
 #include <iostream>
@@ -45,6 +47,11 @@ int RunRecord(const RecordOptions& o) {
   const std::string web = viewer::WebDir(), node = viewer::NodeExecutable();
   if (web.empty() || node.empty()) {
     std::cerr << "iplan record: needs Node.js and the built web folder (run scripts/setup.sh)\n";
+    return 2;
+  }
+  const std::filesystem::path dir = std::filesystem::absolute(o.out).parent_path();
+  if (!std::filesystem::is_directory(dir)) {
+    std::cerr << "iplan record: no folder " << dir << " for " << o.out << "\n";
     return 2;
   }
   std::unique_ptr<dds::Participant> participant;
@@ -88,7 +95,8 @@ int RunRecord(const RecordOptions& o) {
   const auto end = o.duration > 0 ? start + std::chrono::milliseconds(static_cast<int64_t>(o.duration * 1e3))
                                   : Clock::time_point::max();
   while (!g_stop && Clock::now() < end) bridge->SpinOnce(std::chrono::milliseconds(50));
-  const int rc = pclose(pipe);
+  const int status = pclose(pipe);
+  const int rc = status == -1 ? -1 : WIFEXITED(status) ? WEXITSTATUS(status) : 128 + WTERMSIG(status);
   const double seconds = std::chrono::duration<double>(Clock::now() - start).count();
   nlohmann::json stats = {{"file", o.out}, {"duration_s", seconds}, {"messages", nlohmann::json::object()}};
   std::cout << "iplan record: " << std::fixed << std::setprecision(1) << seconds << " s\n";
@@ -97,7 +105,7 @@ int RunRecord(const RecordOptions& o) {
     std::cout << "  " << std::left << std::setw(34) << bridge->channels()[i].topic << bridge->counts()[i] << "\n";
   }
   if (rc != 0) {
-    std::cerr << "iplan record: the MCAP writer failed (exit status " << rc << "); " << o.out << " is incomplete\n";
+    std::cerr << "iplan record: the MCAP writer failed (exit code " << rc << "); " << o.out << " is incomplete\n";
     return 1;
   }
   if (!o.stats.empty()) core::WriteFileAtomically(o.stats, stats.dump(2) + "\n");

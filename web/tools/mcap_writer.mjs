@@ -18,7 +18,13 @@ if (!out) {
 process.on("SIGINT", () => {});
 process.on("SIGTERM", () => {});
 
-const file = await open(out, "w");
+let file;
+try {
+  file = await open(out, "w");
+} catch (e) {
+  console.error(`mcap_writer: cannot write ${out}: ${e.message}`);
+  process.exit(1);
+}
 let position = 0n;
 const writable = {
   async write(buffer) {
