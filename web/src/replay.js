@@ -1,9 +1,10 @@
 // Replay of an MCAP recording (iplan record) in the page: the whole file is
-// fetched from the viewer, read with @mcap/core, and its messages delivered
+// fetched from the viewer, read with @mcap/core (zstd chunks: fzstd), and its messages delivered
 // in log-time order through the same handler as live ones, with a time
 // slider. Seeking back rebuilds the state from the latest scene update per
 // entity and the strip topics up to the new time.
 import { McapIndexedReader } from "@mcap/core";
+import { decompress } from "fzstd";
 
 export class Replay {
   constructor(url, deliver, reset) {
@@ -21,7 +22,7 @@ export class Replay {
     const bytes = new Uint8Array(await (await fetch(this.url)).arrayBuffer());
     const readable = { size: async () => BigInt(bytes.byteLength),
       read: async (offset, size) => bytes.subarray(Number(offset), Number(offset + size)) };
-    const reader = await McapIndexedReader.Initialize({ readable });
+    const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers: { zstd: (data) => decompress(data) } });
     const topics = new Map([...reader.channelsById].map(([id, c]) => [id, c.topic]));
     const decoder = new TextDecoder();
     for await (const m of reader.readMessages()) {

@@ -1,6 +1,7 @@
 // Reads a whole MCAP file (as iplan record writes it) with @mcap/core:
 // messages in log-time order, each { topic, logTime (ns, bigint), data (parsed JSON) }.
 import { McapIndexedReader } from "@mcap/core";
+import { decompress } from "fzstd";
 import { readFile } from "node:fs/promises";
 
 export async function readMcap(path, { topics } = {}) {
@@ -9,7 +10,7 @@ export async function readMcap(path, { topics } = {}) {
     size: async () => BigInt(bytes.byteLength),
     read: async (offset, size) => new Uint8Array(bytes.buffer, bytes.byteOffset + Number(offset), Number(size)),
   };
-  const reader = await McapIndexedReader.Initialize({ readable });
+  const reader = await McapIndexedReader.Initialize({ readable, decompressHandlers: { zstd: (data) => decompress(data) } });
   const decoder = new TextDecoder();
   const byId = new Map([...reader.channelsById].map(([id, c]) => [id, c.topic]));
   const messages = [];

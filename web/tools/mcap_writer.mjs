@@ -4,9 +4,11 @@
 // statistics, so Foxglove and `iplan view --replay` seek in it).
 //   c {"id": n, "topic": "/x", "schemaName": "pkg/msg/T", "schema": "<JSON Schema>"}   a channel
 //   m <channel id> <log time ns> <JSON message>                                          a message
-// Ends (and completes the file) at the end of stdin; SIGINT is ignored so
+// Chunks are zstd-compressed (@foxglove/wasm-zstd; MCAP's own compression,
+// which Foxglove reads). Ends (and completes the file) at the end of stdin; SIGINT is ignored so
 // that Ctrl-C in a terminal lets `iplan record` close the pipe in order.
 import { McapWriter } from "@mcap/core";
+import zstd from "@foxglove/wasm-zstd";
 import { open } from "node:fs/promises";
 import { createInterface } from "node:readline";
 
@@ -33,8 +35,10 @@ const writable = {
   },
   position: () => position,
 };
+await zstd.isLoaded;
 const writer = new McapWriter({ writable, useChunks: true, useStatistics: true, useSummaryOffsets: true,
-  useMessageIndex: true, useChunkIndex: true, chunkSize: 1 << 20 });
+  useMessageIndex: true, useChunkIndex: true, chunkSize: 1 << 20,
+  compressChunk: (data) => ({ compression: "zstd", compressedData: zstd.compress(data, 3) }) });
 await writer.start({ profile: "", library: "iplan record (@mcap/core)" });
 
 const encoder = new TextEncoder();
