@@ -9,7 +9,9 @@
 //                        second: alive while some cell topic delivered within
 //                        `alive_after`.
 // The scene's inputs come through a framework Node, so they pass the same
-// boundary checks as in a service; a message the scene cannot use is counted.
+// writer and content checks as in a service (not the stamp order: a viewer
+// draws late and reordered messages too); a message the scene cannot use is
+// counted and logged by the node (rejected_inputs/scene).
 // The bridge never writes to the cell (no diagnostics, no commands).
 //
 // Threading: construct, then call SpinOnce from one thread; the sink is
