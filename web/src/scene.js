@@ -81,8 +81,9 @@ class EntityView {
   clearOthers() {
     for (const o of this.others) {
       this.group.remove(o);
-      o.geometry?.dispose?.();
+      if (o.geometry !== boxGeometry && o.geometry !== cylinderGeometry) o.geometry?.dispose?.();  // shared ones stay
       o.material?.dispose?.();
+      if (o.isInstancedMesh) o.dispose();
     }
     this.others = [];
   }
@@ -105,6 +106,19 @@ class EntityView {
   }
 
   setSolids(cubes, cylinders) {
+    if (cubes.length > 32) {  // a point cloud: one instanced mesh
+      const m = new THREE.InstancedMesh(boxGeometry, material(1), cubes.length);
+      const mat = new THREE.Matrix4(), p = new THREE.Vector3(), q = new THREE.Quaternion(), sc = new THREE.Vector3();
+      cubes.forEach((c, i) => {
+        p.set(c.pose.position.x, c.pose.position.y, c.pose.position.z);
+        q.set(c.pose.orientation.x, c.pose.orientation.y, c.pose.orientation.z, c.pose.orientation.w);
+        sc.set(c.size.x, c.size.y, c.size.z);
+        m.setMatrixAt(i, mat.compose(p, q, sc));
+        m.setColorAt(i, toColor(c.color));
+      });
+      this.addOther(m);
+      cubes = [];
+    }
     for (const [list, geometry] of [[cubes, boxGeometry], [cylinders, cylinderGeometry]]) {
       for (const c of list) {
         const mesh = new THREE.Mesh(geometry, material(c.color.a, toColor(c.color)));

@@ -3,7 +3,7 @@
 // catalogue topics plus the scene and cell-status channels, each with a JSON
 // schema; a skeleton and a joint state published with `iplan topic pub`
 // arrive and decode to what was published; the scene channel carries the
-// robot drawn at that joint state.
+// robot drawn at that joint state, and an obstacle cloud as cubes.
 import wsProtocol from "@foxglove/ws-protocol";
 import { join } from "node:path";
 import WebSocket from "ws";
@@ -23,7 +23,12 @@ const joints = { header: { frame_id: "world" }, name: [1, 2, 3, 4, 5, 6, 7].map(
   position: [0.1, -0.3, 0, -2.0, 0, 1.6, 0.7], velocity: Array(7).fill(0), effort: [] };
 const pub = (topic, m) => new Proc([join(bin, "iplan"), "topic", "pub", topic, JSON.stringify(m), ...dds, "-r", "20",
   "-n", "0", "--stamp-now", "--wait-readers", "0"], `iplan topic pub ${topic}`);
-const pubs = [pub("/iplan/human/skeleton", skeleton), pub("/joint_states", joints)];
+// An obstacle cloud: 40 points on a line, FLOAT32 x y z.
+const xyz = new Float32Array(40 * 3).map((_, i) => (i % 3 === 0 ? 0.5 + 0.01 * Math.floor(i / 3) : i % 3 === 1 ? -0.4 : 0.05));
+const cloud = { header: { frame_id: "world" }, height: 1, width: 40, is_bigendian: false, point_step: 12, row_step: 480,
+  is_dense: true, data: Array.from(new Uint8Array(xyz.buffer)),
+  fields: ["x", "y", "z"].map((name, i) => ({ name, offset: 4 * i, datatype: 7, count: 1 })) };
+const pubs = [pub("/iplan/human/skeleton", skeleton), pub("/joint_states", joints), pub("/iplan/obstacles", cloud)];
 
 const ws = new WebSocket(`ws://127.0.0.1:${viewer.port}/`, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
 ws.binaryType = "arraybuffer";
@@ -57,9 +62,9 @@ check(byTopic["/joint_states"].schemaName === "sensor_msgs/msg/JointState", "joi
 check(byTopic["/iplan/viewer/scene"].schemaName === "foxglove.SceneUpdate", "the scene is a foxglove.SceneUpdate");
 
 for (const t of ["/iplan/human/skeleton", "/joint_states", "/iplan/viewer/scene"]) subs.set(client.subscribe(byTopic[t].id), t);
-await waitFor("a skeleton, a joint state and a robot scene entity", () => got.get("/iplan/human/skeleton")?.length
-  && got.get("/joint_states")?.length
-  && got.get("/iplan/viewer/scene")?.some((u) => u.entities[0]?.id === "robot"), 20000);
+const sceneHas = (id) => got.get("/iplan/viewer/scene")?.some((u) => u.entities[0]?.id === id);
+await waitFor("a skeleton, a joint state, robot and obstacle scene entities", () => got.get("/iplan/human/skeleton")?.length
+  && got.get("/joint_states")?.length && sceneHas("robot") && sceneHas("obstacles"), 20000);
 
 const s = got.get("/iplan/human/skeleton")[0];
 check(s.body_id === 4 && s.joints.length === 9, `skeleton decodes: body ${s.body_id}, ${s.joints.length} joints`);
@@ -77,6 +82,10 @@ const robot = got.get("/iplan/viewer/scene").find((u) => u.entities[0]?.id === "
 check(robot.spheres.length > 20, `robot entity has ${robot.spheres.length} collision spheres`);
 const person = got.get("/iplan/viewer/scene").find((u) => u.entities[0]?.id === "person")?.entities[0];
 check(person && person.spheres.length === 16, `person entity has ${person?.spheres.length} body spheres`);
+
+const obstacles = got.get("/iplan/viewer/scene").find((u) => u.entities[0]?.id === "obstacles")?.entities[0];
+check(obstacles?.cubes.length === 40 && Math.abs(obstacles.cubes[39].pose.position.x - 0.89) < 1e-6,
+  `obstacle cloud drawn as ${obstacles?.cubes.length} cubes`);
 
 client.close();
 for (const p of pubs) await p.stop("SIGINT");

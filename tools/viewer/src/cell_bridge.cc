@@ -65,7 +65,7 @@ struct CellBridge::Impl {
   std::size_t scene_channel = 0, cell_channel = 0;
   BridgeStats stats;
   Clock::time_point last_message = Clock::time_point::min(), next_status = Clock::now(), next_static = Clock::now();
-  Clock::time_point next_robot = Clock::now(), next_prediction = Clock::now();
+  Clock::time_point next_robot = Clock::now(), next_prediction = Clock::now(), next_cloud = Clock::now();
   bool alive = false;
 
   ~Impl() {
@@ -120,6 +120,11 @@ struct CellBridge::Impl {
       EmitScene(scene->Prediction(m));
     });
     SceneInput(topics::RobotTrajectory(), [this](const msg::JointTrajectory& m) { EmitScene(scene->Trajectory(m)); });
+    SceneInput(topics::Obstacles(), [this](const msg::PointCloud2& m) {
+      if (Clock::now() < next_cloud) return;
+      next_cloud = Clock::now() + std::chrono::milliseconds(200);
+      EmitScene(scene->Obstacles(m));
+    });
     SceneInput(topics::CollisionRisk(), [this](const msg::CollisionRisk& m) {
       const json update = scene->Safety(m);
       EmitScene(&update);

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <map>
 #include <numeric>
 #include <stdexcept>
@@ -143,15 +144,15 @@ namespace {
 
 // In-place writers: once an array element exists, only its numbers change
 // (no allocation), so a steady stream of updates costs little.
-void PutPoint(json& array, std::size_t i, const Eigen::Vector3d& p) {
-  if (i >= array.size()) {
-    array.push_back(Point(p));
-    return;
-  }
-  json& q = array[i];
+void SetXyz(json& q, const Eigen::Vector3d& p) {
   q["x"] = p.x();
   q["y"] = p.y();
   q["z"] = p.z();
+}
+
+void PutPoint(json& array, std::size_t i, const Eigen::Vector3d& p) {
+  if (i >= array.size()) array.push_back(Point(p));
+  else SetXyz(array[i], p);
 }
 
 void PutSphereAt(json& array, std::size_t i, const Eigen::Vector3d& c, double radius, const Rgba& color) {
@@ -160,10 +161,7 @@ void PutSphereAt(json& array, std::size_t i, const Eigen::Vector3d& c, double ra
     return;
   }
   json& s = array[i];
-  json& p = s["pose"]["position"];
-  p["x"] = c.x();
-  p["y"] = c.y();
-  p["z"] = c.z();
+  SetXyz(s["pose"]["position"], c);
   json& size = s["size"];
   size["x"] = size["y"] = size["z"] = 2 * radius;
   json& k = s["color"];
@@ -309,6 +307,61 @@ const json* SceneBuilder::Trajectory(const msg::JointTrajectory& t) {
   e["metadata"] = json::array({{{"key", "waypoints"}, {"value", std::to_string(n)}}});
   previous_path_ = std::move(path);
   return &updates_[entity::kTrajectory];
+}
+
+namespace {
+
+// Offset of FLOAT32 field `name`, or -1.
+int FloatField(const msg::PointCloud2& c, const char* name) {
+  for (const auto& f : c.fields) {
+    if (f.name == name && f.datatype == msg::PointField::FLOAT32 && f.offset + 4 <= c.point_step) {
+      return static_cast<int>(f.offset);
+    }
+  }
+  return -1;
+}
+
+float ReadFloat(const uint8_t* p) {
+  float v;
+  std::memcpy(&v, p, sizeof v);  // little endian, as the host (checked by the caller)
+  return v;
+}
+
+}  // namespace
+
+const json* SceneBuilder::Obstacles(const msg::PointCloud2& c) {
+  const int ox = FloatField(c, "x"), oy = FloatField(c, "y"), oz = FloatField(c, "z");
+  const std::size_t n = static_cast<std::size_t>(c.width) * c.height;
+  if (ox < 0 || oy < 0 || oz < 0) {
+    Reject("obstacle cloud lacks FLOAT32 fields x, y, z");
+    return nullptr;
+  }
+  if (c.is_bigendian || c.header.frame_id != "world" || c.data.size() < n * c.point_step) {
+    Reject(c.is_bigendian ? "obstacle cloud is big endian" : c.header.frame_id != "world"
+           ? "obstacle cloud in frame '" + c.header.frame_id + "', not the cell frame 'world'"
+           : "obstacle cloud has fewer data bytes than width x height x point_step");
+    return nullptr;
+  }
+  json& e = Persistent(entity::kObstacles, c.header.stamp);
+  const std::size_t stride = std::max<std::size_t>(1, (n + options_.max_cloud_points - 1) / options_.max_cloud_points);
+  const Rgba color{0.85, 0.25, 0.2, 1.0};
+  json& cubes = e["cubes"];
+  std::size_t drawn = 0;
+  for (std::size_t i = 0; i < n; i += stride) {
+    const uint8_t* p = c.data.data() + i * c.point_step;
+    const Eigen::Vector3d v(ReadFloat(p + ox), ReadFloat(p + oy), ReadFloat(p + oz));
+    if (!v.allFinite()) continue;
+    if (drawn >= cubes.size()) {
+      const double d = options_.cloud_point_size;
+      cubes.push_back({{"pose", Pose(v)}, {"size", {{"x", d}, {"y", d}, {"z", d}}}, {"color", Color(color)}});
+    } else {
+      SetXyz(cubes[drawn]["pose"]["position"], v);
+    }
+    ++drawn;
+  }
+  Truncate(cubes, drawn);
+  e["metadata"] = json::array({{{"key", "points"}, {"value", std::to_string(n)}}, {{"key", "drawn"}, {"value", std::to_string(drawn)}}});
+  return &updates_[entity::kObstacles];
 }
 
 json SceneBuilder::Safety(const msg::CollisionRisk& r) const {

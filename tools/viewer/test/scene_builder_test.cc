@@ -3,6 +3,7 @@
 #include "iplan/viewer/scene_builder.h"
 
 #include <cmath>
+#include <cstring>
 
 #include <gtest/gtest.h>
 
@@ -153,6 +154,52 @@ TEST(SceneBuilder, InPlaceUpdatesEqualFreshOnes) {
   p.actions[0].probability = 0.1;  // order and shading change
   SceneBuilder fresh2(Model());
   EXPECT_EQ(*kept.Prediction(p), *fresh2.Prediction(p));
+}
+
+msg::PointCloud2 Cloud(const std::vector<Eigen::Vector3f>& points) {
+  msg::PointCloud2 c;
+  c.header.frame_id = "world";
+  c.height = 1;
+  c.width = static_cast<uint32_t>(points.size());
+  c.point_step = 16;  // x y z + 4 bytes of something else
+  c.row_step = c.point_step * c.width;
+  for (const char* n : {"x", "y", "z"}) {
+    msg::PointField f;
+    f.name = n;
+    f.offset = static_cast<uint32_t>(4 * c.fields.size());
+    f.datatype = msg::PointField::FLOAT32;
+    f.count = 1;
+    c.fields.push_back(f);
+  }
+  c.data.resize(c.row_step);
+  for (std::size_t i = 0; i < points.size(); ++i) std::memcpy(&c.data[i * 16], points[i].data(), 12);
+  return c;
+}
+
+TEST(SceneBuilder, ObstaclePointsBecomeCubes) {
+  SceneBuilderOptions o;
+  o.max_cloud_points = 2;
+  SceneBuilder b(Model(), o);
+  const float nan = std::nanf("");
+  // Four points, at most two drawn: every second one, points 0 and 2.
+  const auto* u = b.Obstacles(Cloud({{0.1f, 0.2f, 0.3f}, {9, 9, 9}, {1, 2, 3}, {4, 5, 6}}));
+  ASSERT_TRUE(u);
+  ASSERT_EQ((*u)["entities"][0]["cubes"].size(), 2u);
+  EXPECT_NEAR(At((*u)["entities"][0]["cubes"][0]).z(), 0.3, 1e-6);
+  EXPECT_NEAR(At((*u)["entities"][0]["cubes"][1]).x(), 1.0, 1e-6);
+  // A point that is not finite is skipped.
+  u = b.Obstacles(Cloud({{0.1f, 0.2f, 0.3f}, {9, 9, 9}, {nan, 0, 0}, {4, 5, 6}}));
+  ASSERT_EQ((*u)["entities"][0]["cubes"].size(), 1u);
+  msg::PointCloud2 bad = Cloud({{0, 0, 0}});
+  bad.fields[2].datatype = msg::PointField::FLOAT64;
+  EXPECT_FALSE(b.Obstacles(bad));
+  bad = Cloud({{0, 0, 0}});
+  bad.header.frame_id = "camera";
+  EXPECT_FALSE(b.Obstacles(bad));
+  bad = Cloud({{0, 0, 0}, {1, 1, 1}});
+  bad.data.resize(20);
+  EXPECT_FALSE(b.Obstacles(bad));
+  EXPECT_EQ(b.rejected(), 3u);
 }
 
 TEST(SceneBuilder, StaticSceneHasEveryObject) {

@@ -45,6 +45,7 @@ inline constexpr const char* kPerson = "person";
 inline constexpr const char* kPrediction = "prediction";
 inline constexpr const char* kTrajectory = "trajectory";
 inline constexpr const char* kSafety = "safety";
+inline constexpr const char* kObstacles = "obstacles";
 }  // namespace entity
 
 /// A colour, red, green, blue and opacity in [0, 1].
@@ -60,6 +61,9 @@ struct SceneBuilderOptions {
   int prediction_actions = 3;
   /// Ghost poses drawn along a trajectory (robot spheres at evenly spread waypoints).
   int ghost_poses = 3;
+  /// Obstacle points drawn at most (evenly subsampled), as cubes of this edge (m).
+  int max_cloud_points = 3000;
+  double cloud_point_size = 0.015;
 };
 
 class SceneBuilder {
@@ -83,6 +87,10 @@ class SceneBuilder {
   /// End-effector path of the newly planned trajectory, the previous plan's
   /// path faded, and ghost robot poses along the new one.
   const nlohmann::json* Trajectory(const msg::JointTrajectory& t);
+  /// Obstacle points (/iplan/obstacles: a PointCloud2 in the cell frame
+  /// "world" with FLOAT32 fields x, y, z, little endian) as small cubes;
+  /// non-finite points are skipped.
+  const nlohmann::json* Obstacles(const msg::PointCloud2& c);
   /// Separation, S_p and verdict as text above the table, coloured by verdict.
   nlohmann::json Safety(const msg::CollisionRisk& r) const;
 
