@@ -26,7 +26,7 @@ const browser = await launchBrowser();
 const viewer = await startViewer(bin, ["--replay", file]);
 const page = await browser.newPage({ viewport: { width: 1280, height: 760 } });
 page.on("pageerror", (e) => fail(`page error: ${e}`));
-await page.goto(viewer.url);
+await page.goto(`${viewer.url}&resolution=fixed`);  // sharp screenshots; no frame-rate judgement here
 const state = () => page.evaluate(() => JSON.parse(JSON.stringify(window.iplanViewer.state)));
 await waitFor("the recording to load", async () => (await state()).replay?.loaded, 60000);
 let s = await state();
