@@ -51,15 +51,18 @@ function applyPending() {
   pending.clear();
 }
 
+// `m`: the message, parsed or as JSON text. The viewer sends one entity per
+// scene update and no deletions; any other update is applied at once.
 function deliver(topic, m) {
   state.received[topic] = (state.received[topic] ?? 0) + 1;
+  if (topic === SCENE && typeof m === "string") {
+    pending.set(entityId(m), m);
+    return;
+  }
+  if (typeof m === "string") m = JSON.parse(m);
   if (topic === SCENE) {
-    if (typeof m === "string") pending.set(entityId(m), m);
-    else if ((m.entities ?? []).length === 1 && !(m.deletions ?? []).length) pending.set(m.entities[0].id, m);
+    if ((m.entities ?? []).length === 1 && !(m.deletions ?? []).length) pending.set(m.entities[0].id, m);
     else { applyPending(); view.apply(m); }
-  } else if (typeof m === "string") {
-    deliver(topic, JSON.parse(m));
-    state.received[topic] -= 1;
   } else if (topic === CELL) {
     state.cellAlive = !!m.alive;
     lastCellStatus = performance.now();
