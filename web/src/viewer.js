@@ -194,6 +194,7 @@ function frame(now) {
 window.iplanViewer = {
   state,
   project: (p) => view.project(p),
+  view,  // the SceneView (for debugging)
   togglePause,
   /** Replay controls for tests: speed factor, play from the start. */
   replayPlay: (speed = 1) => { replay.speed = speed; replay.restart(); replay.playing = true; },

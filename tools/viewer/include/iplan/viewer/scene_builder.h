@@ -54,9 +54,11 @@ struct Rgba {
 };
 
 struct SceneBuilderOptions {
-  /// Prediction steps drawn (evenly spread over the horizon); bounds the
-  /// number of spheres per update.
-  int prediction_steps = 4;
+  /// Prediction steps drawn (evenly spread over the horizon, the last one
+  /// included: 2 = half the horizon and its end); bounds the number of
+  /// spheres per update. Faint overlapping spheres are what software WebGL
+  /// draws slowest (docs/viewer.md, Measurements).
+  int prediction_steps = 2;
   /// Actions drawn: the most probable ones.
   int prediction_actions = 3;
   /// Ghost poses drawn along a trajectory (robot spheres at evenly spread waypoints).
