@@ -3,6 +3,9 @@
 // per-action shading), cubes, cylinders, line lists and strips. World frame
 // "world", z up, metres. Keeps a summary of every entity for tests.
 import * as THREE from "three";
+import { LineMaterial } from "three/examples/jsm/lines/LineMaterial.js";
+import { LineSegments2 } from "three/examples/jsm/lines/LineSegments2.js";
+import { LineSegmentsGeometry } from "three/examples/jsm/lines/LineSegmentsGeometry.js";
 
 const sphereGeometry = new THREE.SphereGeometry(1, 12, 8);
 // Faint spheres (predictions, ghost poses) overlap by the hundred; fewer
@@ -27,8 +30,9 @@ function poseInto(obj, pose) {
 }
 
 class EntityView {
-  constructor(root, id) {
+  constructor(root, id, resolution) {
     this.id = id;
+    this.resolution = resolution;  // canvas size in px (fat lines need it)
     this.group = new THREE.Group();
     this.group.name = id;
     root.add(this.group);
@@ -93,12 +97,20 @@ class EntityView {
     this.group.add(o);
   }
 
+  // Lines with their thickness (m, or px when scale_invariant), as Foxglove
+  // draws them: three.js "fat" lines (plain WebGL lines are one pixel wide).
   setLines(lines) {
     for (const l of lines) {
-      const pts = l.points.map((p) => new THREE.Vector3(p.x, p.y, p.z));
-      const g = new THREE.BufferGeometry().setFromPoints(pts);
-      const m = new THREE.LineBasicMaterial({ color: toColor(l.color), transparent: l.color.a < 0.999, opacity: l.color.a });
-      const obj = l.type === 2 ? new THREE.LineSegments(g, m) : l.type === 1 ? new THREE.LineLoop(g, m) : new THREE.Line(g, m);
+      if (l.points.length < 2) continue;
+      const flat = [];
+      const pts = l.type === 1 ? [...l.points, l.points[0]] : l.points;  // a loop closes
+      if (l.type === 2) for (const p of pts) flat.push(p.x, p.y, p.z);
+      else pts.forEach((p, i) => { if (i > 0) flat.push(pts[i - 1].x, pts[i - 1].y, pts[i - 1].z, p.x, p.y, p.z); });
+      const g = new LineSegmentsGeometry().setPositions(flat);
+      const m = new LineMaterial({ color: toColor(l.color), transparent: l.color.a < 0.999, opacity: l.color.a,
+        linewidth: l.thickness, worldUnits: !l.scale_invariant });
+      m.resolution.copy(this.resolution);
+      const obj = new LineSegments2(g, m);
       poseInto(obj, l.pose);
       obj.renderOrder = 2;
       this.addOther(obj);
@@ -187,6 +199,7 @@ export class SceneView {
     this.scene.add(this.root);
     this.entities = new Map();
     this.container = container;
+    this.lineResolution = new THREE.Vector2(1, 1);
     this.resize();
     window.addEventListener("resize", () => this.resize());
   }
@@ -200,6 +213,7 @@ export class SceneView {
   resize() {
     const w = this.container.clientWidth, h = this.container.clientHeight;
     this.renderer.setSize(w, h);
+    this.lineResolution.set(w, h);
     this.camera.aspect = w / Math.max(1, h);
     this.camera.updateProjectionMatrix();
   }
@@ -214,7 +228,7 @@ export class SceneView {
       }
     }
     for (const e of update.entities ?? []) {
-      if (!this.entities.has(e.id)) this.entities.set(e.id, new EntityView(this.root, e.id));
+      if (!this.entities.has(e.id)) this.entities.set(e.id, new EntityView(this.root, e.id, this.lineResolution));
       this.entities.get(e.id).update(e);
     }
   }
