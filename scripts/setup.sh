@@ -20,6 +20,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   # the planning benchmark's peer planner (benchmark only, no service links it)
   libompl-dev
+  # viewer (iplan view / record / report): HTTP + WebSocket server, Node.js for
+  # the page's npm dependencies, the MCAP writer and the report, Chromium for
+  # the browser tests
+  libwebsocketpp-dev libasio-dev nodejs npm chromium
 )
 
 missing=()
@@ -37,6 +41,12 @@ if ((${#missing[@]})); then
 else
   echo "setup: all Debian packages present"
 fi
+
+# The web part: npm packages exactly as locked (three.js, @foxglove/*,
+# @mcap/core, uPlot, esbuild, playwright-core), then the page bundle in
+# web/dist. Nothing is fetched at run time.
+echo "setup: installing the web part's npm packages (web/package-lock.json)"
+(cd web && npm ci --no-audit --no-fund && node build.mjs)
 
 jobs="${IPLAN_JOBS:-$(nproc)}"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release

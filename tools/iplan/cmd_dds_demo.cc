@@ -25,6 +25,7 @@
 #include "core/task_planner.h"
 #include "dds_cell_model.h"
 #include "dds_common.h"
+#include "dds_viewer_common.h"
 #include "iplan/core/process.h"
 #include "iplan/core/stats.h"
 #include "iplan/framework/config.h"
@@ -47,6 +48,7 @@ struct DemoOptions {
   int episodes = 6;
   double timeout = 170;
   std::string summary_file, config_dir, state_dir;
+  std::string record_file;  ///< MCAP recording of the run (iplan record); empty: none
   bool keep_learning = false, retrain = false, prepare_only = false;
   /// What the planner and monitor are given as the prediction: model,
   /// constant-position, constant-velocity (intent.predictor), or none (the
@@ -288,6 +290,18 @@ int RunDemo(const DemoOptions& o) {
     return 2;
   }
 
+  // The recorder first, so that it hears every service from its first message.
+  std::unique_ptr<core::Process> recorder;
+  if (!o.record_file.empty()) {
+    try {
+      recorder = StartRecorder(dds::ToString(vendor_a), domain, o.record_file, config_dir, state_dir + "/record");
+      std::cout << "  recording to " << o.record_file << "\n";
+    } catch (const std::exception& e) {
+      std::cerr << "iplan demo: " << e.what() << "\n";
+      return 1;
+    }
+  }
+
   // Start the services.
   const auto t0 = Clock::now();
   std::vector<std::unique_ptr<core::Process>> procs;
@@ -367,6 +381,9 @@ int RunDemo(const DemoOptions& o) {
     const auto rc = procs[i]->Wait(10s);
     exit_codes.push_back(rc ? *rc : -1);
     if (rc && *rc != 0 && failure.empty()) failure = "iplan-" + kServices[i].first + " exited with " + std::to_string(*rc);
+  }
+  if (recorder) {
+    if (auto err = StopRecorder(*recorder); err && failure.empty()) failure = *err;
   }
 
   // Summary.
@@ -449,8 +466,12 @@ int RunDemo(const DemoOptions& o) {
     j["intent_model"] = {{"path", model.path}, {"trained_now", model.trained}, {"training_s", model.seconds}};
     j["service_exit_codes"] = exit_codes;
     j["failure"] = failure;
+    if (!o.record_file.empty()) j["recording"] = fs::absolute(o.record_file).string();
     std::ofstream(o.summary_file) << j.dump(2) << "\n";
     std::cout << "\nsummary written to " << o.summary_file << "\n";
+    const std::string report = (fs::path(o.summary_file).parent_path() / fs::path(o.summary_file).stem()).string() + ".html";
+    if (auto err = WriteReport(o.summary_file, o.record_file, report)) std::cerr << "iplan demo: no report: " << *err << "\n";
+    else std::cout << "report written to " << report << " (iplan report " << o.summary_file << ")\n";
   }
   if (!failure.empty()) {
     std::cerr << "\niplan demo: " << failure << "\n";
@@ -477,7 +498,8 @@ void Register(CLI::App& app) {
   d->add_option("--timeout", o.timeout, "give up after this many seconds")->capture_default_str()->check(CLI::PositiveNumber);
   d->add_option("--domain", o.domain, "DDS domain (default: 100 + pid % 100, to stay apart from a running cell)")
       ->check(CLI::Range(0, 232));
-  d->add_option("--summary", o.summary_file, "write the summary as JSON to this file");
+  d->add_option("--summary", o.summary_file, "write the summary as JSON to this file, and its HTML report beside it");
+  d->add_option("--record", o.record_file, "record the run's topics to this MCAP file (iplan record; replay: iplan view --replay)");
   d->add_option("--config-dir", o.config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
   d->add_option("--state-dir", o.state_dir, "folder for the Q-table and a fallback model (default: a new temporary folder)");
   d->add_flag("--keep-learning", o.keep_learning,

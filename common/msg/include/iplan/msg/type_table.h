@@ -20,6 +20,7 @@ struct TypeEntry {
   void (*from_json)(const nlohmann::json&, void*);  ///< throws std::invalid_argument
   void (*randomize)(void*, uint64_t seed);          ///< FillRandom with a seeded generator
   std::optional<std::string> (*first_difference)(const void*, const void*);
+  nlohmann::json (*json_schema)();  ///< JSON Schema of to_json's output (iplan/msg/json_schema.h)
 };
 
 /// Every generated type. Thread-safe.

@@ -1,0 +1,55 @@
+#include "dds_viewer_common.h"
+
+#include <signal.h>
+
+#include <chrono>
+#include <stdexcept>
+
+#include "iplan/framework/config.h"
+
+namespace iplan::cli {
+
+viewer::CellModel LoadViewerCellModel(const std::string& config_dir, const std::string& robot, const std::string& scene,
+                                      const std::string& body) {
+  const std::string file = config_dir + "/trajopt.yaml";
+  framework::ConfigSection cfg = framework::ConfigSection::Load(file);
+  framework::ConfigSection t = cfg.Section("trajopt");
+  std::string r = "robots/panda.yaml", s = "scenes/cell.yaml", b = "humans/upper_body.yaml";
+  t.Read("robot", &r);
+  t.Read("scene", &s);
+  t.Read("human_body", &b);
+  return viewer::LoadCellModel(robot.empty() ? t.ResolvePath(r) : robot, scene.empty() ? t.ResolvePath(s) : scene,
+                               body.empty() ? t.ResolvePath(b) : body);
+}
+
+std::unique_ptr<core::Process> StartRecorder(const std::string& vendor, int domain, const std::string& out,
+                                             const std::string& config_dir, const std::string& log_base) {
+  auto p = std::make_unique<core::Process>(
+      std::vector<std::string>{core::ExecutableDir() + "/iplan", "record", "--dds", vendor, "--domain",
+                               std::to_string(domain), "--out", out, "--stats", out + ".stats.json", "--config-dir",
+                               config_dir},
+      std::map<std::string, std::string>{}, false, log_base);
+  if (!p->WaitForOutput("recording", std::chrono::seconds(20))) {
+    throw std::runtime_error("iplan record did not start:\n" + p->Stdout() + p->Stderr());
+  }
+  return p;
+}
+
+std::optional<std::string> StopRecorder(core::Process& recorder) {
+  recorder.Signal(SIGTERM);
+  const auto rc = recorder.Wait(std::chrono::seconds(60));
+  if (!rc) return "iplan record did not finish within 60 s";
+  if (*rc != 0) return "iplan record exited with " + std::to_string(*rc) + ":\n" + recorder.Stderr();
+  return std::nullopt;
+}
+
+std::optional<std::string> WriteReport(const std::string& summary, const std::string& recording, const std::string& out) {
+  std::vector<std::string> argv = {core::ExecutableDir() + "/iplan", "report", summary, "--out", out};
+  if (!recording.empty()) argv.insert(argv.end(), {"--recording", recording});
+  core::Process p(argv);
+  const auto rc = p.Wait(std::chrono::seconds(120));
+  if (!rc || *rc != 0) return "iplan report failed:\n" + p.Stdout() + p.Stderr();
+  return std::nullopt;
+}
+
+}  // namespace iplan::cli
