@@ -68,8 +68,7 @@ const std::map<std::string, Setter>& Setters() {
       Field("cluster_distance", &CloudParams::cluster_distance),
       Field("cluster_distance_per_m2", &CloudParams::cluster_distance_per_m2),
       Field("min_obstacle_points", &CloudParams::min_obstacle_points),
-      Field("max_colour_step", &CloudParams::max_colour_step),
-      Field("min_colour_region", &CloudParams::min_colour_region),
+      Field("min_part_points", &CloudParams::min_part_points),
       Field("flat_angle_deg", &CloudParams::flat_angle_deg),
       Field("coplanar_distance", &CloudParams::coplanar_distance),
       Field("convex_margin", &CloudParams::convex_margin),
@@ -108,9 +107,8 @@ std::string CloudParams::Validate() const {
     return "cluster_distance_per_m2 must be >= 0, got " + Num(cluster_distance_per_m2);
   if (min_obstacle_points < 1)
     return "min_obstacle_points must be >= 1, got " + std::to_string(min_obstacle_points);
-  if (!positive(max_colour_step)) return "max_colour_step must be > 0, got " + Num(max_colour_step);
-  if (min_colour_region < 1)
-    return "min_colour_region must be >= 1, got " + std::to_string(min_colour_region);
+  if (min_part_points < 1)
+    return "min_part_points must be >= 1, got " + std::to_string(min_part_points);
   if (!(flat_angle_deg >= 0 && flat_angle_deg <= 90))
     return "flat_angle_deg must be in 0..90, got " + Num(flat_angle_deg);
   if (!positive(coplanar_distance)) return "coplanar_distance must be > 0, got " + Num(coplanar_distance);

@@ -7,7 +7,11 @@
 //     strided by `stride`, neighbours joined when close in 3D (a depth
 //     discontinuity separates objects), PCL's
 //     OrganizedConnectedComponentSegmentation with our comparator;
-//  5. each full-resolution candidate takes the segment of the closest of the
+//  5. parts: the same components with concave creases (from PCL's
+//     integral-image normals) also cutting; large parts of one segment stay
+//     apart unless they meet convexly or are coplanar (LCCP's criterion on
+//     the parts), small ones join their neighbours;
+//  6. each full-resolution candidate takes the segment of the closest of the
 //     strided pixels around it.
 #include <pcl/features/integral_image_normal.h>
 #include <pcl/segmentation/comparator.h>
@@ -33,14 +37,11 @@ using PointCloud = pcl::PointCloud<pcl::PointXYZ>;
 
 /// Joins two neighbouring pixels when their points are closer than
 /// cluster_distance + cluster_distance_per_m2 * z^2 (z of the first point)
-/// and, when given, their colours differ by at most a step and neither lies
-/// on a concave crease (where one object stands on or leans against
-/// another). Non-candidate pixels are NaN in the input, so they never join.
+/// and, when given creases, neither lies on a concave crease (where one
+/// object stands on or leans against another). Non-candidate pixels are NaN in the input, so they never join.
 class SegmentComparator : public pcl::Comparator<pcl::PointXYZ> {
  public:
   struct Cues {
-    const std::vector<std::uint32_t>* rgba = nullptr;  // null: no colour cue
-    float colour_step = 0;
     const std::vector<std::uint8_t>* crease = nullptr;  // null: no concavity cue
   };
   SegmentComparator(float distance, float per_m2, const Cues& cues)
@@ -52,21 +53,11 @@ class SegmentComparator : public pcl::Comparator<pcl::PointXYZ> {
     const float limit = distance_ + per_m2_ * z * z;
     const float gap2 = (pa - pb).squaredNorm();
     if (!(gap2 < limit * limit)) return false;
-    if (cues_.rgba && ColourStep2((*cues_.rgba)[a], (*cues_.rgba)[b]) > cues_.colour_step * cues_.colour_step)
-      return false;
     if (cues_.crease && ((*cues_.crease)[a] || (*cues_.crease)[b])) return false;
     return true;
   }
 
  private:
-  static float ColourStep2(std::uint32_t u, std::uint32_t v) {
-    float sum = 0;
-    for (int shift = 0; shift <= 16; shift += 8) {
-      const float d = static_cast<float>((u >> shift) & 0xff) - static_cast<float>((v >> shift) & 0xff);
-      sum += d * d;
-    }
-    return sum;
-  }
   float distance_, per_m2_;
   Cues cues_;
 };
@@ -91,7 +82,6 @@ struct ObstaclePipeline::Impl {
   std::vector<pcl::PointIndices> small_segments;
   std::vector<int> small_segment;  // strided pixel -> segment or kSegNone
   std::vector<Eigen::Vector3f> small_points;  // the strided image's points
-  std::vector<std::uint32_t> small_rgba;  // colour of the strided pixels (empty: no colour)
 
   bool FindTable(const Cloud& cloud, Eigen::Vector4f* plane);
   void MarkTableAndCandidates(const Cloud& cloud, const Eigen::Vector4f& plane, bool table_found);
@@ -247,36 +237,23 @@ void ObstaclePipeline::Impl::SegmentCandidates(const Cloud& cloud) {
   const int s = params.stride;
   const int sw = (cloud.width + s - 1) / s, sh = (cloud.height + s - 1) / s;
   FillSmall(cloud, 0);
-  const bool colour = !cloud.rgba.empty() && params.max_colour_step < 442.0f;
-  small_rgba.resize(colour ? small->size() : 0);
-  for (int r = 0; r < sh; ++r)
-    for (int c = 0; c < sw; ++c) {
-      const std::size_t i = static_cast<std::size_t>(r * s) * cloud.width + c * s;
-      if (colour) small_rgba[static_cast<std::size_t>(r) * sw + c] = cloud.rgba[i];
-    }
   const std::vector<int> geometric = Components({});
-  SegmentComparator::Cues cues;
-  if (colour) {
-    cues.rgba = &small_rgba;
-    cues.colour_step = params.max_colour_step;
-  }
-  if (params.concave_margin < 2.0f) {
-    EstimateNormals();
-    MarkCreases();
-    cues.crease = &small_crease;
-  }
-  if (!cues.rgba && !cues.crease) {
+  if (params.concave_margin >= 2.0f) {
     small_segment = geometric;
     return;
   }
+  EstimateNormals();
+  MarkCreases();
+  SegmentComparator::Cues cues;
+  cues.crease = &small_crease;
   const std::vector<int> fragments = Components(cues);
   const int s2 = params.stride * params.stride;
   small_points.resize(small->size());
   for (std::size_t j = 0; j < small->size(); ++j) small_points[j] = (*small)[j].getVector3fMap();
   small_segment = internal::SplitSegments(sw, sh, small_points, geometric, fragments,
-                                          (params.min_colour_region + s2 - 1) / s2,
+                                          (params.min_part_points + s2 - 1) / s2,
                                           Convexity(params));
-  if (cues.crease) FillCreases(geometric);
+  FillCreases(geometric);
 }
 
 // A candidate at full resolution joins the segment of the closest strided

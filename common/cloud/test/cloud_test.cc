@@ -283,6 +283,18 @@ TEST(LoadPcd, ReadsFieldsAndRejectsBadFiles) {
     EXPECT_EQ(std::string(e.what()), no_xyz + ": PCD file has no x y z fields");
   }
   EXPECT_THROW(LoadPcd(WriteTemp("garbage.pcd", "not a pcd\n")), std::runtime_error);
+  const std::string header =
+      "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100\nHEIGHT 1\n"
+      "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100\n";
+  const std::string truncated = WriteTemp("truncated.pcd", header + "DATA binary\nabcdefgh");
+  try {
+    LoadPcd(truncated);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), truncated + ": cannot read PCD file");
+  }
+  EXPECT_THROW(LoadPcd(WriteTemp("truncated2.pcd", header + "DATA binary_compressed\nabcdefgh")),
+               std::runtime_error);
   EXPECT_THROW(LoadPcd("/nonexistent/x.pcd"), std::runtime_error);
 }
 
@@ -298,10 +310,10 @@ void ExpectLoadError(const std::string& yaml, const std::string& message) {
 
 TEST(LoadCloudParams, StrictKeysTypesAndValues) {
   const CloudParams p =
-      LoadCloudParams(WriteTemp("good.yaml", "stride: 3\ncrop_min: [-1, -1, 0.5]\nmax_colour_step: 40\n"));
+      LoadCloudParams(WriteTemp("good.yaml", "stride: 3\ncrop_min: [-1, -1, 0.5]\nconcave_margin: 0.3\n"));
   EXPECT_EQ(p.stride, 3);
   EXPECT_FLOAT_EQ(p.crop_min.z(), 0.5f);
-  EXPECT_FLOAT_EQ(p.max_colour_step, 40.0f);
+  EXPECT_FLOAT_EQ(p.concave_margin, 0.3f);
   EXPECT_FLOAT_EQ(p.voxel_size, CloudParams{}.voxel_size);  // left out: default
   EXPECT_EQ(LoadCloudParams(WriteTemp("empty.yaml", "")).stride, CloudParams{}.stride);
   ExpectLoadError("strid: 2\n", "unknown key 'strid'");
@@ -319,7 +331,36 @@ TEST(LoadCloudParams, StrictKeysTypesAndValues) {
   }
 }
 
-TEST(CloudParams, DefaultsAreValid) { EXPECT_EQ(CloudParams{}.Validate(), ""); }
+TEST(CloudParams, DefaultsAreValidAndConfigFileWritesThemOut) {
+  EXPECT_EQ(CloudParams{}.Validate(), "");
+  // config/cloud.yaml documents the defaults: every key, every value.
+  const CloudParams file = LoadCloudParams(std::string(IPLAN_SOURCE_DIR) + "/config/cloud.yaml");
+  const CloudParams d;
+  EXPECT_EQ(file.crop_min, d.crop_min);
+  EXPECT_EQ(file.crop_max, d.crop_max);
+  EXPECT_FLOAT_EQ(file.self_filter_margin, d.self_filter_margin);
+  EXPECT_EQ(file.plane_sample_stride, d.plane_sample_stride);
+  EXPECT_EQ(file.plane_max_iterations, d.plane_max_iterations);
+  EXPECT_FLOAT_EQ(file.plane_fit_distance, d.plane_fit_distance);
+  EXPECT_FLOAT_EQ(file.table_distance, d.table_distance);
+  EXPECT_FLOAT_EQ(file.table_distance_per_m2, d.table_distance_per_m2);
+  EXPECT_EQ(file.min_table_points, d.min_table_points);
+  EXPECT_FLOAT_EQ(file.max_object_height, d.max_object_height);
+  EXPECT_EQ(file.stride, d.stride);
+  EXPECT_FLOAT_EQ(file.cluster_distance, d.cluster_distance);
+  EXPECT_FLOAT_EQ(file.cluster_distance_per_m2, d.cluster_distance_per_m2);
+  EXPECT_EQ(file.min_obstacle_points, d.min_obstacle_points);
+  EXPECT_FLOAT_EQ(file.concave_margin, d.concave_margin);
+  EXPECT_EQ(file.crease_offset_px, d.crease_offset_px);
+  EXPECT_FLOAT_EQ(file.normal_smoothing_px, d.normal_smoothing_px);
+  EXPECT_EQ(file.min_part_points, d.min_part_points);
+  EXPECT_FLOAT_EQ(file.flat_angle_deg, d.flat_angle_deg);
+  EXPECT_FLOAT_EQ(file.coplanar_distance, d.coplanar_distance);
+  EXPECT_FLOAT_EQ(file.convex_margin, d.convex_margin);
+  EXPECT_FLOAT_EQ(file.voxel_size, d.voxel_size);
+  EXPECT_FLOAT_EQ(file.euclidean_tolerance, d.euclidean_tolerance);
+  EXPECT_EQ(file.textbook_min_cluster, d.textbook_min_cluster);
+}
 
 }  // namespace
 }  // namespace iplan::cloud

@@ -81,11 +81,6 @@ struct CloudParams {
   float cluster_distance = 0.015f;     ///< metres between neighbouring pixels at 1 m depth
   float cluster_distance_per_m2 = 0.0f;  ///< metres per m^2 of depth added
   int min_obstacle_points = 400;       ///< input points; smaller segments are removed
-  /// Largest RGB step (Euclidean, 0..441) between neighbouring pixels of one
-  /// part; >= 442 (the default) ignores colour, as when the cloud has none.
-  /// Off by default: on the mOSD scans it splits printed boxes more often
-  /// than it separates objects (docs/perception-clouds.md).
-  float max_colour_step = 442.0f;
   /// Concave creases split segments: a pixel whose neighbours
   /// crease_offset_px to either side (strided pixels, along a row or a
   /// column) have normals meeting with d . (n_b - n_a) < -concave_margin
@@ -93,10 +88,10 @@ struct CloudParams {
   float concave_margin = 0.1f;
   int crease_offset_px = 2;
   float normal_smoothing_px = 5.0f;  ///< normal window, strided pixels
-  /// A segment is split along colour steps and concave creases only into
-  /// parts of at least this many input points (smaller parts join the
-  /// neighbour they border most).
-  int min_colour_region = 800;
+  /// A segment is split along concave creases only into parts of at least
+  /// this many input points (smaller parts join the neighbour they border
+  /// most).
+  int min_part_points = 800;
   /// Parts of one segment are merged back (faces of one object)
   /// when coplanar: normals within flat_angle_deg (degrees) and each
   /// centroid within coplanar_distance (metres) of the other's plane; or
