@@ -33,7 +33,9 @@ void KeepMask(const Cloud& cloud, const CloudParams& params, const std::vector<S
 bool FitPlane(const pcl::PointCloud<pcl::PointXYZ>& sample, int max_iterations, float distance,
               Eigen::Vector4f* plane) {
   if (sample.size() < 3) return false;
-  pcl::SACSegmentation<pcl::PointXYZ> sac;
+  // random = false: PCL seeds RANSAC's generator with a fixed value, so a
+  // cloud gives the same plane every run.
+  pcl::SACSegmentation<pcl::PointXYZ> sac(/*random=*/false);
   sac.setModelType(pcl::SACMODEL_PLANE);
   sac.setMethodType(pcl::SAC_RANSAC);
   sac.setOptimizeCoefficients(true);

@@ -126,8 +126,9 @@ TEST(ObstaclePipeline, SelfFilterRemovesThePointsInsideTheRobotSpheres) {
   ASSERT_EQ(r.obstacles.size(), 1u);
   const float r2 = std::pow(sphere.radius + CloudParams{}.self_filter_margin, 2.0f);
   for (std::size_t i = 0; i < s.cloud.size(); ++i)
-    if (s.cloud.points[i].allFinite() && (s.cloud.points[i] - sphere.centre).squaredNorm() <= r2)
+    if (s.cloud.points[i].allFinite() && (s.cloud.points[i] - sphere.centre).squaredNorm() <= r2) {
       EXPECT_EQ(r.labels[i], kLabelRemoved) << i;
+    }
 }
 
 TEST(ObstaclePipeline, CropBoxRemovesWhatLiesOutside) {
@@ -139,7 +140,9 @@ TEST(ObstaclePipeline, CropBoxRemovesWhatLiesOutside) {
   ASSERT_EQ(r.obstacles.size(), 1u);
   for (const int i : r.obstacles[0].indices) EXPECT_EQ(s.truth[i], 20u);
   for (std::size_t i = 0; i < s.cloud.size(); ++i)
-    if (s.cloud.points[i].allFinite() && s.cloud.points[i].x() > 0.0f) EXPECT_EQ(r.labels[i], kLabelRemoved);
+    if (s.cloud.points[i].allFinite() && s.cloud.points[i].x() > 0.0f) {
+      EXPECT_EQ(r.labels[i], kLabelRemoved);
+    }
 }
 
 TEST(ObstaclePipeline, SplitsABoxStandingOnAnother) {
