@@ -48,6 +48,11 @@ TEST_F(CloudCli, JsonLineAndLabelsAgree) {
   ASSERT_EQ(Run({"obstacles", "--pcd", kScan, "--json", "--labels-out", labels_path}, &out, &err), 0) << err;
   ASSERT_FALSE(out.empty());
   EXPECT_EQ(out.find('\n'), out.size() - 1) << "more than one line: " << out;
+  EXPECT_EQ(out.rfind("{\"table\":{\"normal\":[", 0), 0u) << out;  // keys in the documented order
+  EXPECT_NE(out.find("],\"offset\":"), std::string::npos) << out;
+  EXPECT_NE(out.find("},\"obstacles\":[{\"id\":1,\"centre\":["), std::string::npos) << out;
+  EXPECT_NE(out.find("],\"half_extents\":["), std::string::npos) << out;
+  EXPECT_NE(out.find("}],\"time_s\":"), std::string::npos) << out;
   const auto j = nlohmann::json::parse(out);
   EXPECT_EQ(j.size(), 3u) << out;
   ASSERT_TRUE(j.contains("table") && j.contains("obstacles") && j.contains("time_s")) << out;

@@ -31,12 +31,15 @@ struct EvalOptions {
   std::string dir, config;
 };
 
-nlohmann::json Vec(const Eigen::Vector3f& v) { return nlohmann::json::array({v.x(), v.y(), v.z()}); }
+// ordered_json: the keys in the documented order.
+using Json = nlohmann::ordered_json;
+
+Json Vec(const Eigen::Vector3f& v) { return Json::array({v.x(), v.y(), v.z()}); }
 
 std::string ResultJson(const Result& r, double seconds) {
-  nlohmann::json j;
+  Json j;
   j["table"] = {{"normal", Vec(r.table.normal)}, {"offset", r.table.offset}, {"points", r.table.points}};
-  j["obstacles"] = nlohmann::json::array();
+  j["obstacles"] = Json::array();
   for (const auto& o : r.obstacles)
     j["obstacles"].push_back({{"id", o.id},
                               {"centre", Vec(o.centre)},

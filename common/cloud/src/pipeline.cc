@@ -238,11 +238,18 @@ void ObstaclePipeline::Impl::SegmentCandidates(const Cloud& cloud) {
   const int sw = (cloud.width + s - 1) / s, sh = (cloud.height + s - 1) / s;
   FillSmall(cloud, 0);
   const std::vector<int> geometric = Components({});
-  if (params.concave_margin >= 2.0f) {
+  // Creases need normals from an image: none for an unorganised cloud (one
+  // row) or an image too small for the integral-image window.
+  const bool image = sw > 2 * params.crease_offset_px && sh > 2 * params.crease_offset_px;
+  if (params.concave_margin >= 2.0f || !image) {
     small_segment = geometric;
     return;
   }
   EstimateNormals();
+  if (small_normals->size() != small->size()) {  // PCL refused the input
+    small_segment = geometric;
+    return;
+  }
   MarkCreases();
   SegmentComparator::Cues cues;
   cues.crease = &small_crease;

@@ -185,6 +185,26 @@ TEST(ObstaclePipeline, BadCloudsGiveEmptyResultsOrAClearError) {
     EXPECT_NE(std::string(e.what()).find("width * height (640 * 480) != 307199 points"), std::string::npos)
         << e.what();
   }
+  // Unorganised (one row) and tiny clouds: no image neighbours beyond the
+  // row, no normals; processed without crashing.
+  Cloud row;
+  row.width = 2000;
+  row.height = 1;
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<float> u(-0.5f, 0.5f);
+  for (int i = 0; i < row.width; ++i) row.points.emplace_back(u(rng), 0.4f, 1.0f + u(rng));
+  r = pipeline.Process(row);
+  EXPECT_EQ(r.labels.size(), row.size());
+  Cloud one;
+  one.width = one.height = 1;
+  one.points = {{0.0f, 0.0f, 1.0f}};
+  r = pipeline.Process(one);
+  EXPECT_EQ(r.labels, std::vector<int>{kLabelRemoved});
+  Cloud small = Render(TwoBoxes(), 6).cloud;
+  small.width = 4;
+  small.height = 3;
+  small.points.resize(12);
+  EXPECT_EQ(pipeline.Process(small).labels.size(), 12u);
   CloudParams bad;
   bad.stride = 0;
   EXPECT_THROW(ObstaclePipeline{bad}, std::invalid_argument);
