@@ -17,6 +17,20 @@ bool HasField(const pcl::PCLPointCloud2& blob, const std::string& name) {
   return pcl::getFieldIndex(blob, name) >= 0;
 }
 
+// The field layout the typed conversions below assume: x y z float32, one
+// value each; rgb/rgba and label four bytes. Empty when it holds.
+std::string CheckLayout(const pcl::PCLPointCloud2& header) {
+  for (const auto& f : header.fields) {
+    const bool xyz = f.name == "x" || f.name == "y" || f.name == "z";
+    if (xyz && (f.datatype != pcl::PCLPointField::FLOAT32 || f.count != 1))
+      return "field '" + f.name + "' must be one float32 (F 4 1)";
+    const bool four = f.name == "rgb" || f.name == "rgba" || f.name == "label";
+    if (four && (pcl::getFieldSize(f.datatype) != 4 || f.count != 1))
+      return "field '" + f.name + "' must be one 4-byte value";
+  }
+  return "";
+}
+
 }  // namespace
 
 Cloud LoadPcd(const std::string& path) {
@@ -34,6 +48,7 @@ Cloud LoadPcd(const std::string& path) {
       throw std::runtime_error(path + ": cannot read PCD file");
     if (!HasField(header, "x") || !HasField(header, "y") || !HasField(header, "z"))
       throw std::runtime_error(path + ": PCD file has no x y z fields");
+    if (const std::string why = CheckLayout(header); !why.empty()) throw std::runtime_error(path + ": " + why);
     if (static_cast<std::size_t>(header.width) * header.height == 0)
       throw std::runtime_error(path + ": PCD file has no points");
   }

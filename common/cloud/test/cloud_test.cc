@@ -306,6 +306,15 @@ TEST(LoadPcd, ReadsFieldsAndRejectsBadFiles) {
     EXPECT_EQ(std::string(e.what()), no_xyz + ": PCD file has no x y z fields");
   }
   EXPECT_THROW(LoadPcd(WriteTemp("garbage.pcd", "not a pcd\n")), std::runtime_error);
+  const std::string doubles = WriteTemp("doubles.pcd",
+                                        "VERSION 0.7\nFIELDS x y z\nSIZE 8 8 8\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 1\n"
+                                        "HEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 1\nDATA ascii\n1 2 3\n");
+  try {
+    LoadPcd(doubles);
+    FAIL() << "no exception";
+  } catch (const std::runtime_error& e) {
+    EXPECT_EQ(std::string(e.what()), doubles + ": field 'x' must be one float32 (F 4 1)");
+  }
   const std::string header =
       "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 100\nHEIGHT 1\n"
       "VIEWPOINT 0 0 0 1 0 0 0\nPOINTS 100\n";

@@ -35,7 +35,8 @@ struct Cloud {
 /// Reads a PCD file (any PCD encoding PCL reads: ascii, binary,
 /// binary_compressed) with fields x y z and optionally rgb/rgba and label.
 /// Throws std::runtime_error naming the file when it cannot be read, has no
-/// x y z fields, or its width * height does not match its point count.
+/// x y z fields (or they are not float32), has no points, or its width *
+/// height does not match its point count.
 /// Allocates; thread-safe.
 Cloud LoadPcd(const std::string& path);
 
