@@ -14,6 +14,8 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools cyclonedds-dev cyclonedds-tools
   # algorithms
   libeigen3-dev libfcl-dev libccd-dev libceres-dev liburdfdom-dev
+  # point clouds (found through its pkg-config files, see common/cloud/CMakeLists.txt)
+  libpcl-dev
   # infrastructure
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libsystemd-dev systemd
   # tests and benchmarks

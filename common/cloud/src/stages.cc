@@ -1,0 +1,114 @@
+#include "stages.h"
+
+#include <pcl/ModelCoefficients.h>
+#include <pcl/PointIndices.h>
+#include <pcl/sample_consensus/method_types.h>
+#include <pcl/sample_consensus/model_types.h>
+#include <pcl/segmentation/sac_segmentation.h>
+
+#include <algorithm>
+#include <numeric>
+
+namespace iplan::cloud::internal {
+
+void KeepMask(const Cloud& cloud, const CloudParams& params, const std::vector<Sphere>& robot_spheres,
+              std::vector<std::uint8_t>* keep) {
+  keep->assign(cloud.size(), 0);
+  std::vector<float> r2(robot_spheres.size());
+  for (std::size_t s = 0; s < robot_spheres.size(); ++s) {
+    const float r = robot_spheres[s].radius + params.self_filter_margin;
+    r2[s] = r * r;
+  }
+  for (std::size_t i = 0; i < cloud.size(); ++i) {
+    const Eigen::Vector3f& p = cloud.points[i];
+    if (!p.allFinite()) continue;
+    if ((p.array() < params.crop_min.array()).any() || (p.array() > params.crop_max.array()).any()) continue;
+    bool robot = false;
+    for (std::size_t s = 0; s < robot_spheres.size() && !robot; ++s)
+      robot = (p - robot_spheres[s].centre).squaredNorm() <= r2[s];
+    (*keep)[i] = robot ? 0 : 1;
+  }
+}
+
+bool FitPlane(const pcl::PointCloud<pcl::PointXYZ>& sample, int max_iterations, float distance,
+              Eigen::Vector4f* plane) {
+  if (sample.size() < 3) return false;
+  // random = false: PCL seeds RANSAC's generator with a fixed value, so a
+  // cloud gives the same plane every run.
+  pcl::SACSegmentation<pcl::PointXYZ> sac(/*random=*/false);
+  sac.setModelType(pcl::SACMODEL_PLANE);
+  sac.setMethodType(pcl::SAC_RANSAC);
+  sac.setOptimizeCoefficients(true);
+  sac.setMaxIterations(max_iterations);
+  sac.setDistanceThreshold(distance);
+  // Shared pointer without ownership: the sample outlives the call.
+  sac.setInputCloud(pcl::PointCloud<pcl::PointXYZ>::ConstPtr(&sample, [](const void*) {}));
+  pcl::PointIndices inliers;
+  pcl::ModelCoefficients coefficients;
+  sac.segment(inliers, coefficients);
+  if (inliers.indices.size() < 3 || coefficients.values.size() != 4) return false;
+  Eigen::Vector4f c(coefficients.values[0], coefficients.values[1], coefficients.values[2],
+                    coefficients.values[3]);
+  const float norm = c.head<3>().norm();
+  if (!(norm > 0) || !c.allFinite()) return false;
+  c /= norm;
+  if (c[3] < 0) c = -c;  // the sensor origin on the positive side
+  *plane = c;
+  return true;
+}
+
+Result BuildResult(const Cloud& cloud, const std::vector<int>& segment, int min_points, bool table_found,
+                   const Eigen::Vector4f& plane) {
+  Result result;
+  result.labels.assign(cloud.size(), kLabelRemoved);
+  int segments = 0;
+  for (const int s : segment) segments = std::max(segments, s + 1);
+  std::vector<int> count(segments, 0), first(segments, -1);
+  for (std::size_t i = 0; i < segment.size(); ++i) {
+    const int s = segment[i];
+    if (s == kSegTable) {
+      result.labels[i] = kLabelTable;
+      ++result.table.points;
+    } else if (s >= 0) {
+      if (count[s]++ == 0) first[s] = static_cast<int>(i);
+    }
+  }
+  std::vector<int> order(segments);
+  std::iota(order.begin(), order.end(), 0);
+  order.erase(std::remove_if(order.begin(), order.end(), [&](int s) { return count[s] < min_points; }),
+              order.end());
+  std::sort(order.begin(), order.end(), [&](int a, int b) {
+    return count[a] != count[b] ? count[a] > count[b] : first[a] < first[b];
+  });
+  std::vector<int> id_of(segments, 0);
+  result.obstacles.resize(order.size());
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    id_of[order[k]] = static_cast<int>(k) + 1;
+    result.obstacles[k].id = static_cast<int>(k) + 1;
+    result.obstacles[k].indices.reserve(count[order[k]]);
+  }
+  for (std::size_t i = 0; i < segment.size(); ++i) {
+    const int s = segment[i];
+    if (s < 0 || id_of[s] == 0) continue;
+    result.labels[i] = LabelOfObstacle(id_of[s]);
+    result.obstacles[id_of[s] - 1].indices.push_back(static_cast<int>(i));
+  }
+  for (Obstacle& o : result.obstacles) {
+    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
+    Eigen::Vector3f hi = -lo;
+    for (const int i : o.indices) {
+      lo = lo.cwiseMin(cloud.points[i]);
+      hi = hi.cwiseMax(cloud.points[i]);
+    }
+    o.centre = 0.5f * (lo + hi);
+    o.half_extents = 0.5f * (hi - lo);
+  }
+  if (table_found) {
+    result.table.found = true;
+    result.table.normal = plane.head<3>();
+    result.table.offset = plane[3];
+  }
+  return result;
+}
+
+}  // namespace iplan::cloud::internal

@@ -1,0 +1,43 @@
+// Stages both pipelines share (internal: PCL types allowed here).
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include <pcl/point_cloud.h>
+#include <pcl/point_types.h>
+
+#include "iplan/cloud/pipeline.h"
+
+namespace iplan::cloud::internal {
+
+/// keep[i] = 1 when point i is finite, inside the crop box and outside every
+/// robot sphere grown by params.self_filter_margin; else 0. Resizes *keep.
+void KeepMask(const Cloud& cloud, const CloudParams& params, const std::vector<Sphere>& robot_spheres,
+              std::vector<std::uint8_t>* keep);
+
+/// RANSAC plane fit (PCL SACSegmentation, coefficients refined on the
+/// inliers) on `sample`. On success, *plane = (n, d) with |n| = 1 and the
+/// sensor origin on the positive side (d > 0). False when there is no plane
+/// with at least 3 inliers. `sample` must be non-empty for success.
+bool FitPlane(const pcl::PointCloud<pcl::PointXYZ>& sample, int max_iterations, float distance,
+              Eigen::Vector4f* plane);
+
+/// Table band half-width at depth z (metres).
+inline float TableDistance(const CloudParams& p, float z) {
+  return p.table_distance + p.table_distance_per_m2 * (z * z - 1.0f > 0 ? z * z - 1.0f : 0.0f);
+}
+
+/// Segment ids per input point: kSegTable, kSegNone or a segment >= 0.
+constexpr int kSegNone = -1;
+constexpr int kSegTable = -2;
+
+/// Turns per-point segment ids into a Result: segments with fewer than
+/// `min_points` points are removed; the others become obstacles numbered
+/// 1, 2, ... by decreasing size (ties by first index), each with the
+/// axis-aligned box of its points. `plane` is written to the table when
+/// `table_found`. Allocates.
+Result BuildResult(const Cloud& cloud, const std::vector<int>& segment, int min_points, bool table_found,
+                   const Eigen::Vector4f& plane);
+
+}  // namespace iplan::cloud::internal
