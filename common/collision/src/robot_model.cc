@@ -207,6 +207,96 @@ void CalcForwardKinematics(const RobotModel& model, const Eigen::Ref<const Eigen
   }
 }
 
+namespace {
+
+// A URDF joint as ours; `mimic_master` gets the joint it mimics, if any.
+Joint UrdfJoint(const std::string& path, const RobotModel& model, const urdf::Joint& uj, int child,
+                const RobotModelOptions& options, std::string* mimic_master) {
+  Joint j;
+  j.name = uj.name;
+  j.parent_link = model.FindLink(uj.parent_link_name);
+  j.child_link = child;
+  j.X_PJ = ToIsometry(uj.parent_to_joint_origin_transform);
+  j.axis = Eigen::Vector3d(uj.axis.x, uj.axis.y, uj.axis.z);
+  switch (uj.type) {
+    case urdf::Joint::FIXED:
+      j.type = JointType::kFixed;
+      break;
+    case urdf::Joint::REVOLUTE:
+    case urdf::Joint::CONTINUOUS:
+      j.type = JointType::kRevolute;
+      break;
+    case urdf::Joint::PRISMATIC:
+      j.type = JointType::kPrismatic;
+      break;
+    default:
+      Fail(path, "joint '" + j.name + "' has an unsupported type (" + std::to_string(static_cast<int>(uj.type)) +
+                     "); only fixed, revolute, continuous and prismatic are supported");
+  }
+  if (j.type == JointType::kFixed) return j;
+  const double n = j.axis.norm();
+  if (!(n > 0.0)) Fail(path, "joint '" + j.name + "' has a zero axis");
+  j.axis /= n;
+  j.limits.acceleration = options.default_acceleration;
+  j.limits.jerk = options.default_jerk;
+  if (uj.type == urdf::Joint::CONTINUOUS || !uj.limits) {
+    j.limits.lower = -std::numeric_limits<double>::infinity();
+    j.limits.upper = std::numeric_limits<double>::infinity();
+  } else {
+    j.limits.lower = uj.limits->lower;
+    j.limits.upper = uj.limits->upper;
+  }
+  j.limits.velocity = uj.limits ? uj.limits->velocity : std::numeric_limits<double>::infinity();
+  if (uj.mimic) {
+    j.mimic_multiplier = uj.mimic->multiplier;
+    j.mimic_offset = uj.mimic->offset;
+    *mimic_master = uj.mimic->joint_name;
+  }
+  return j;
+}
+
+// The spheres covering one URDF collision shape (in the link's frame), and
+// its entry of the cover report; empty for an ignored mesh.
+std::vector<Sphere> CoverShape(const std::string& path, const std::string& link, const urdf::Collision& col,
+                               const RobotModelOptions& options, ShapeCoverEntry* entry) {
+  const Eigen::Isometry3d X_LG = ToIsometry(col.origin);
+  entry->link = link;
+  std::vector<Sphere> cover;
+  try {
+    switch (col.geometry->type) {
+      case urdf::Geometry::SPHERE: {
+        const double r = static_cast<const urdf::Sphere&>(*col.geometry).radius;
+        if (!(r > 0.0)) Fail(path, "link '" + link + "': sphere radius " + std::to_string(r));
+        cover.push_back({X_LG.translation(), r});
+        entry->cover.shape = "sphere";
+        entry->cover.num_spheres = 1;
+        entry->cover.shape_volume = 4.0 / 3.0 * kPi * r * r * r;
+        break;
+      }
+      case urdf::Geometry::CYLINDER: {
+        const auto& c = static_cast<const urdf::Cylinder&>(*col.geometry);
+        cover = CoverCylinder(c.radius, c.length, X_LG, options.cover, &entry->cover);
+        break;
+      }
+      case urdf::Geometry::BOX: {
+        const auto& b = static_cast<const urdf::Box&>(*col.geometry);
+        cover = CoverBox(0.5 * Eigen::Vector3d(b.dim.x, b.dim.y, b.dim.z), X_LG, options.cover, &entry->cover);
+        break;
+      }
+      case urdf::Geometry::MESH:
+        if (options.ignore_mesh_collisions) return {};
+        Fail(path, "link '" + link +
+                       "' has a mesh collision shape; meshes are not supported "
+                       "(replace by primitives or set ignore_mesh_collisions)");
+    }
+  } catch (const std::invalid_argument& e) {
+    Fail(path, "link '" + link + "': " + e.what());
+  }
+  return cover;
+}
+
+}  // namespace
+
 RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptions& options) {
   if (const std::string why = options.cover.Validate(); !why.empty()) Fail(path, why);
   const urdf::ModelInterfaceSharedPtr urdf = urdf::parseURDFFile(path);
@@ -218,61 +308,17 @@ RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptio
   model.name = urdf->getName();
   // Depth-first, parents before children; joint j's child is link j + 1.
   std::vector<urdf::LinkConstSharedPtr> links;
-  std::function<void(const urdf::LinkConstSharedPtr&)> visit =
-      [&](const urdf::LinkConstSharedPtr& link) {
-        links.push_back(link);
-        for (const urdf::LinkSharedPtr& child : link->child_links) visit(child);
-      };
+  std::function<void(const urdf::LinkConstSharedPtr&)> visit = [&](const urdf::LinkConstSharedPtr& link) {
+    links.push_back(link);
+    for (const urdf::LinkSharedPtr& child : link->child_links) visit(child);
+  };
   visit(root);
   for (const auto& link : links) model.link_names.push_back(link->name);
   model.link_parent_joint.assign(links.size(), -1);
 
   std::vector<std::string> mimic_master(links.size());
   for (size_t i = 1; i < links.size(); ++i) {
-    const urdf::JointConstSharedPtr uj = links[i]->parent_joint;
-    Joint j;
-    j.name = uj->name;
-    j.parent_link = model.FindLink(uj->parent_link_name);
-    j.child_link = static_cast<int>(i);
-    j.X_PJ = ToIsometry(uj->parent_to_joint_origin_transform);
-    j.axis = Eigen::Vector3d(uj->axis.x, uj->axis.y, uj->axis.z);
-    switch (uj->type) {
-      case urdf::Joint::FIXED:
-        j.type = JointType::kFixed;
-        break;
-      case urdf::Joint::REVOLUTE:
-      case urdf::Joint::CONTINUOUS:
-        j.type = JointType::kRevolute;
-        break;
-      case urdf::Joint::PRISMATIC:
-        j.type = JointType::kPrismatic;
-        break;
-      default:
-        Fail(path, "joint '" + j.name + "' has an unsupported type (" +
-                       std::to_string(static_cast<int>(uj->type)) +
-                       "); only fixed, revolute, continuous and prismatic are supported");
-    }
-    if (j.type != JointType::kFixed) {
-      const double n = j.axis.norm();
-      if (!(n > 0.0)) Fail(path, "joint '" + j.name + "' has a zero axis");
-      j.axis /= n;
-      j.limits.acceleration = options.default_acceleration;
-      j.limits.jerk = options.default_jerk;
-      if (uj->type == urdf::Joint::CONTINUOUS || !uj->limits) {
-        j.limits.lower = -std::numeric_limits<double>::infinity();
-        j.limits.upper = std::numeric_limits<double>::infinity();
-      } else {
-        j.limits.lower = uj->limits->lower;
-        j.limits.upper = uj->limits->upper;
-      }
-      j.limits.velocity = uj->limits ? uj->limits->velocity
-                                     : std::numeric_limits<double>::infinity();
-      if (uj->mimic) {
-        j.mimic_multiplier = uj->mimic->multiplier;
-        j.mimic_offset = uj->mimic->offset;
-        mimic_master[i] = uj->mimic->joint_name;
-      }
-    }
+    const Joint j = UrdfJoint(path, model, *links[i]->parent_joint, static_cast<int>(i), options, &mimic_master[i]);
     model.link_parent_joint[i] = static_cast<int>(model.joints.size());
     model.joints.push_back(j);
   }
@@ -290,52 +336,14 @@ RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptio
     std::vector<Sphere> spheres;
     for (const urdf::CollisionSharedPtr& col : links[i]->collision_array) {
       if (!col || !col->geometry) continue;
-      const Eigen::Isometry3d X_LG = ToIsometry(col->origin);
       ShapeCoverEntry entry;
-      entry.link = links[i]->name;
-      std::vector<Sphere> cover;
-      switch (col->geometry->type) {
-        case urdf::Geometry::SPHERE: {
-          const double r = static_cast<const urdf::Sphere&>(*col->geometry).radius;
-          if (!(r > 0.0)) {
-            Fail(path, "link '" + entry.link + "': sphere radius " + std::to_string(r));
-          }
-          cover.push_back({X_LG.translation(), r});
-          entry.cover.shape = "sphere";
-          entry.cover.num_spheres = 1;
-          entry.cover.shape_volume = 4.0 / 3.0 * kPi * r * r * r;
-          break;
-        }
-        case urdf::Geometry::CYLINDER: {
-          const auto& c = static_cast<const urdf::Cylinder&>(*col->geometry);
-          try {
-            cover = CoverCylinder(c.radius, c.length, X_LG, options.cover, &entry.cover);
-          } catch (const std::invalid_argument& e) {
-            Fail(path, "link '" + entry.link + "': " + e.what());
-          }
-          break;
-        }
-        case urdf::Geometry::BOX: {
-          const auto& b = static_cast<const urdf::Box&>(*col->geometry);
-          try {
-            cover = CoverBox(0.5 * Eigen::Vector3d(b.dim.x, b.dim.y, b.dim.z), X_LG,
-                             options.cover, &entry.cover);
-          } catch (const std::invalid_argument& e) {
-            Fail(path, "link '" + entry.link + "': " + e.what());
-          }
-          break;
-        }
-        case urdf::Geometry::MESH:
-          if (options.ignore_mesh_collisions) continue;
-          Fail(path, "link '" + entry.link +
-                         "' has a mesh collision shape; meshes are not supported "
-                         "(replace by primitives or set ignore_mesh_collisions)");
-      }
+      const bool ignored_mesh = col->geometry->type == urdf::Geometry::MESH && options.ignore_mesh_collisions;
+      const std::vector<Sphere> cover = CoverShape(path, links[i]->name, *col, options, &entry);
+      if (ignored_mesh) continue;
       spheres.insert(spheres.end(), cover.begin(), cover.end());
       model.cover_report.push_back(entry);
     }
-    AddLinkSpheres(static_cast<int>(i), std::move(spheres), options.remove_contained_spheres,
-                   &model);
+    AddLinkSpheres(static_cast<int>(i), std::move(spheres), options.remove_contained_spheres, &model);
   }
   Finalize(options, path, &model);
   return model;
