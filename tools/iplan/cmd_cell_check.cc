@@ -111,89 +111,125 @@ PairResult Evaluate(const collision_risk::RiskMonitor& fresh, const collision_ri
   return worst;
 }
 
-int RunCellCheck(const CheckOptions& o) {
-  const std::string dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
-  if (dir.empty()) {
-    std::cerr << "iplan cell-check: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
-    return 2;
-  }
-  auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
+// What the check reads from the cell's configuration folder.
+struct CellInputs {
   perception::SyntheticPersonParams person;
   collision_risk::RiskConfig risk;
   supervisor::TaskGraph graph;
   std::unique_ptr<planning::Planner> planner;
   std::optional<collision_risk::RiskMonitor> monitor;
-  // Tools read part of each service's file: its values are checked, its other
-  // keys are the services' business.
+};
+
+// Tools read part of each service's file: its values are checked, its other
+// keys are the services' business. Throws std::runtime_error.
+void LoadCellInputs(const std::string& dir, CellInputs* in) {
+  auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
   auto check = [](const framework::ConfigSection& c) {
     if (c.Problems().empty()) return;
     std::string msg;
     for (const auto& p : c.Problems()) msg += (msg.empty() ? "" : "\n") + p;
     throw std::runtime_error(msg);
   };
+  framework::ConfigSection pconf = framework::ConfigSection::Load(cfg("perception"));
+  framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
+  perception::ScriptStart start;
+  in->person = perception::ReadSyntheticPerson(syn, &start);
+  check(pconf);
+  if (const std::string why = in->person.Validate(); !why.empty()) {
+    throw std::runtime_error(cfg("perception") + ": key 'perception.synthetic': " + why);
+  }
+  framework::ConfigSection rconf = framework::ConfigSection::Load(cfg("collision_risk"));
+  framework::ConfigSection rsec = rconf.Section("collision_risk");
+  in->risk = collision_risk::ReadRiskConfig(rsec);
+  check(rconf);
+  if (const std::string why = in->risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
+  // The check asks about the working cell, where predictions flow: the
+  // separation layer with the person's measured speed, not the degraded
+  // mode the monitor falls back to when intent is gone.
+  in->risk.params.ssm.degrade_without_prediction = false;
+  in->monitor = collision_risk::MakeRiskMonitor(in->risk);
+  framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
+  framework::ConfigSection ssec = sconf.Section("supervisor");
+  std::string graph_file = "tasks/table_top.yaml";
+  ssec.Read("task_graph", &graph_file);
+  check(sconf);
+  in->graph = supervisor::LoadTaskGraph(sconf.ResolvePath(graph_file));
+  // The static scene, as the trajectory optimiser sees it.
+  framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
+  framework::ConfigSection tsec = tconf.Section("trajopt");
+  const trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
+  check(tconf);
+  in->planner = trajopt::MakePlanner(topt);
+}
+
+// One row per place the robot rests at: every task's goal and, for tasks
+// with one, the retreat it withdraws to (where it waits for the next task,
+// so it must be harmless during every action).
+struct Row {
+  std::string name;
+  const std::vector<double>* pose;
+  std::vector<std::string> conflicts_with;
+  bool retreat;
+};
+
+// One cell of the table: the margin printed, and what it means for the
+// graph (a problem when a harmless task or a retreat is not clear, a note
+// when a declared conflict stays clear).
+void JudgePair(const Row& task, const std::string& action, const PairResult& r, double margin,
+               std::vector<std::string>* problems, std::vector<std::string>* notes) {
+  const bool declared =
+      std::find(task.conflicts_with.begin(), task.conflicts_with.end(), action) != task.conflicts_with.end();
+  std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(action.size(), 8) + 2))
+            << Fixed(r.margin, 2, true) << (declared ? "*" : " ");
+  const std::string detail = "separation " + Fixed(r.separation, 2) + " m (" + r.robot_link + " / " + r.human_segment +
+                             "), S_p " + Fixed(r.protective, 2) + " m at v_h " + Fixed(r.human_speed, 2) + " m/s, " +
+                             Fixed(r.time, 1) + " s into the action";
+  if (!declared && r.margin < margin) {
+    const std::string within =
+        " the person comes within " +
+        std::string(r.margin < 0 ? "the protective separation: the monitor would stop the robot there ("
+                                 : "the required margin of it (") +
+        detail;
+    problems->push_back(task.retreat ? "'" + task.name + "': during '" + action + "'" + within +
+                                           "). A retreat must be clear of every action: move it out of the "
+                                           "person's space."
+                                     : "'" + task.name + "' is declared harmless during '" + action + "' but" + within +
+                                           "). Declare conflicts_with: [" + action + "] or move the goal.");
+  } else if (declared && r.margin >= margin) {
+    notes->push_back("'" + task.name + "' is declared to conflict with '" + action + "' but stays clear (" + detail +
+                     "); only the reward's harmony term keeps them apart.");
+  }
+}
+
+int RunCellCheck(const CheckOptions& o) {
+  const std::string dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
+  if (dir.empty()) {
+    std::cerr << "iplan cell-check: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+    return 2;
+  }
+  CellInputs in;
   try {
-    framework::ConfigSection pconf = framework::ConfigSection::Load(cfg("perception"));
-    framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
-    perception::ScriptStart start;
-    person = perception::ReadSyntheticPerson(syn, &start);
-    check(pconf);
-    if (const std::string why = person.Validate(); !why.empty()) {
-      throw std::runtime_error(cfg("perception") + ": key 'perception.synthetic': " + why);
-    }
-    framework::ConfigSection rconf = framework::ConfigSection::Load(cfg("collision_risk"));
-    framework::ConfigSection rsec = rconf.Section("collision_risk");
-    risk = collision_risk::ReadRiskConfig(rsec);
-    check(rconf);
-    if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
-    // The check asks about the working cell, where predictions flow: the
-    // separation layer with the person's measured speed, not the degraded
-    // mode the monitor falls back to when intent is gone.
-    risk.params.ssm.degrade_without_prediction = false;
-    monitor = collision_risk::MakeRiskMonitor(risk);
-    framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
-    framework::ConfigSection ssec = sconf.Section("supervisor");
-    std::string graph_file = "tasks/table_top.yaml";
-    ssec.Read("task_graph", &graph_file);
-    check(sconf);
-    graph = supervisor::LoadTaskGraph(sconf.ResolvePath(graph_file));
-    // The static scene, as the trajectory optimiser sees it.
-    framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
-    framework::ConfigSection tsec = tconf.Section("trajopt");
-    const trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
-    check(tconf);
-    planner = trajopt::MakePlanner(topt);
+    LoadCellInputs(dir, &in);
   } catch (const std::exception& e) {
     std::cerr << "iplan cell-check: " << e.what() << "\n";
     return 2;
   }
-
   // The graph's human actions must be actions the person can do.
-  std::vector<std::string> problems;
-  std::vector<std::string> actions;
-  for (const auto& a : graph.human_actions) {
-    if (std::any_of(person.actions.begin(), person.actions.end(), [&](const auto& m) { return m.name == a; })) {
+  std::vector<std::string> problems, notes, actions;
+  for (const auto& a : in.graph.human_actions) {
+    if (std::any_of(in.person.actions.begin(), in.person.actions.end(), [&](const auto& m) { return m.name == a; })) {
       actions.push_back(a);
     } else {
       problems.push_back("human action '" + a + "' of the task graph is not an action of the synthetic person (perception.yaml)");
     }
   }
-
+  const double min_clearance = in.planner->params().min_clearance;
   std::cout << "ISO/TS 15066 margin (separation - protective separation, m) with the robot at each task's goal\n"
             << "and retreat and the person doing each action (worst of " << o.repetitions
             << " repetitions, sensor noise included;\n* = declared conflict), and the pose's clearance from "
-            << "the static scene (m; the trajectory optimiser\nneeds at least " << Fixed(planner->params().min_clearance, 3)
-            << "):\n\n";
-  // One row per place the robot rests at: every task's goal and, for tasks
-  // with one, the retreat it withdraws to (where it waits for the next task,
-  // so it must be harmless during every action).
-  struct Row {
-    std::string name;
-    const std::vector<double>* pose;
-    std::vector<std::string> conflicts_with;
-    bool retreat;
-  };
+            << "the static scene (m; the trajectory optimiser\nneeds at least " << Fixed(min_clearance, 3) << "):\n\n";
   std::vector<Row> rows;
-  for (const auto& t : graph.tasks) {
+  for (const auto& t : in.graph.tasks) {
     rows.push_back({t.name, &t.goal, t.conflicts_with, false});
     if (!t.retreat.empty()) rows.push_back({t.name + " (retreat)", &t.retreat, {}, true});
   }
@@ -202,47 +238,23 @@ int RunCellCheck(const CheckOptions& o) {
   std::cout << std::left << std::setw(static_cast<int>(w)) << "task";
   for (const auto& a : actions) std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(a.size(), 8) + 3)) << a;
   std::cout << std::right << std::setw(12) << "clearance" << "\n";
-  std::vector<std::string> notes;
   for (const Row& task : rows) {
     std::cout << std::left << std::setw(static_cast<int>(w)) << task.name;
     for (const auto& a : actions) {
-      PairResult r;
       try {
-        r = Evaluate(*monitor, risk.params, person, a, *task.pose, o.repetitions);
+        JudgePair(task, a, Evaluate(*in.monitor, in.risk.params, in.person, a, *task.pose, o.repetitions), o.margin,
+                  &problems, &notes);
       } catch (const std::exception& e) {
         std::cerr << "\niplan cell-check: task '" << task.name << "': " << e.what() << "\n";
         return 2;
       }
-      const bool declared =
-          std::find(task.conflicts_with.begin(), task.conflicts_with.end(), a) != task.conflicts_with.end();
-      std::cout << std::right << std::setw(static_cast<int>(std::max<std::size_t>(a.size(), 8) + 2))
-                << Fixed(r.margin, 2, true) << (declared ? "*" : " ");
-      const std::string detail = "separation " + Fixed(r.separation, 2) + " m (" + r.robot_link + " / " +
-                                 r.human_segment + "), S_p " + Fixed(r.protective, 2) + " m at v_h " +
-                                 Fixed(r.human_speed, 2) + " m/s, " + Fixed(r.time, 1) + " s into the action";
-      if (!declared && r.margin < o.margin) {
-        const std::string within =
-            " the person comes within " +
-            std::string(r.margin < 0 ? "the protective separation: the monitor would stop the robot there ("
-                                     : "the required margin of it (") +
-            detail;
-        problems.push_back(task.retreat ? "'" + task.name + "': during '" + a + "'" + within +
-                                              "). A retreat must be clear of every action: move it out of the "
-                                              "person's space."
-                                        : "'" + task.name + "' is declared harmless during '" + a + "' but" + within +
-                                              "). Declare conflicts_with: [" + a + "] or move the goal.");
-      } else if (declared && r.margin >= o.margin) {
-        notes.push_back("'" + task.name + "' is declared to conflict with '" + a + "' but stays clear (" + detail +
-                        "); only the reward's harmony term keeps them apart.");
-      }
     }
-    const double clearance = planner->CalcClearance(
+    const double clearance = in.planner->CalcClearance(
         Eigen::Map<const Eigen::VectorXd>(task.pose->data(), static_cast<Eigen::Index>(task.pose->size())));
     std::cout << std::right << std::setw(11) << Fixed(clearance, 3) << "\n";
-    if (clearance < planner->params().min_clearance) {
-      problems.push_back("'" + task.name + "' rests in the static scene (clearance " + Fixed(clearance, 3) +
-                         " m < " + Fixed(planner->params().min_clearance, 3) +
-                         " m): the trajectory optimiser will refuse it every time.");
+    if (clearance < min_clearance) {
+      problems.push_back("'" + task.name + "' rests in the static scene (clearance " + Fixed(clearance, 3) + " m < " +
+                         Fixed(min_clearance, 3) + " m): the trajectory optimiser will refuse it every time.");
     }
   }
   std::cout << "\n";
