@@ -70,13 +70,14 @@ class TrajoptService : public framework::Service {
   }
 
   // Cycles run when a prediction arrives (replan_on_prediction) and, when
-  // none arrives within a planning step (nobody seen, intent down, ablation),
-  // every planning step.
+  // none has arrived for 1.5 planning steps (nobody seen, intent down,
+  // ablation), on the planning step's tick. The margin keeps a tick from
+  // planning with an old prediction just before a late one arrives.
   Result OnActivate(Node& node) override {
     active_ = true;
     timer_ = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(planning_step_ * 1e9)), [this, &node] {
       const auto since = std::chrono::steady_clock::now() - last_cycle_;
-      if (!replan_on_prediction_ || since >= std::chrono::duration<double>(0.9 * planning_step_)) Step(node);
+      if (!replan_on_prediction_ || since >= std::chrono::duration<double>(1.5 * planning_step_)) Step(node);
     });
     return Result::Ok();
   }

@@ -238,209 +238,250 @@ std::string Tail(const std::string& text, size_t lines) {
   return text.substr(pos + 1);
 }
 
-int RunDemo(const DemoOptions& o) {
-  const dds::Vendor vendor_a = o.vendor.empty() ? dds::DefaultVendor() : dds::ParseVendor(o.vendor);
-  const dds::Vendor vendor_b = vendor_a == dds::Vendor::kCyclone ? dds::Vendor::kFastDds : dds::Vendor::kCyclone;
-  // A domain of its own so that the demo never talks to a running cell.
-  const int domain = o.domain >= 0 ? o.domain : 100 + static_cast<int>(getpid() % 100);
-  const std::string config_dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
-  if (config_dir.empty()) {
-    std::cerr << "iplan demo: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
-    return 2;
-  }
-  std::string state_dir = o.state_dir;
-  if (state_dir.empty()) {
-    std::string tmpl = (fs::temp_directory_path() / "iplan-demo-XXXXXX").string();
-    if (!mkdtemp(tmpl.data())) {
-      std::cerr << "iplan demo: cannot create a state folder in " << fs::temp_directory_path() << "\n";
+// One run of the demo: the processes, their vendors and what came of it.
+class DemoRun {
+ public:
+  explicit DemoRun(const DemoOptions& o)
+      : o_(o),
+        vendor_a_(o.vendor.empty() ? dds::DefaultVendor() : dds::ParseVendor(o.vendor)),
+        vendor_b_(vendor_a_ == dds::Vendor::kCyclone ? dds::Vendor::kFastDds : dds::Vendor::kCyclone),
+        // A domain of its own so that the demo never talks to a running cell.
+        domain_(o.domain >= 0 ? o.domain : 100 + static_cast<int>(getpid() % 100)),
+        config_dir_(o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir) {}
+
+  int Run() {
+    if (const std::optional<int> rc = Prepare()) return *rc;
+    if (const std::optional<int> rc = StartServices()) return *rc;
+    dds::ParticipantOptions popts;
+    popts.vendor = vendor_a_;
+    popts.domain_id = domain_;
+    popts.name = "iplan-demo";
+    auto participant = dds::Participant::Create(popts);
+    spdlog::set_level(spdlog::level::warn);  // the progress lines say what matters
+    framework::NodeOptions nopts;
+    nopts.diagnostics_period = 0;
+    framework::Node node("demo", *participant, nopts);
+    CellMonitor mon(node, static_cast<int>(graph_.tasks.size()), t0_);
+    Watch(node, mon);
+    Stop(node, mon);
+    const double contacts = mon.DiagNumber("robot_sim", "true_contacts", -1);
+    PrintSummary(mon, contacts);
+    if (!o_.summary_file.empty()) WriteSummary(mon, contacts);
+    if (!failure_.empty()) {
+      std::cerr << "\niplan demo: " << failure_ << "\n";
       return 1;
     }
-    state_dir = tmpl;
+    if (contacts != 0) {
+      std::cerr << "\niplan demo: the robot touched the person (" << contacts << " true contacts)\n";
+      return 1;
+    }
+    std::cout << std::flush;
+    return 0;
   }
-  fs::create_directories(state_dir);
+
+ private:
   // --mixed: perception, collision risk and the supervisor on one vendor,
   // intent, trajectory optimisation and the simulator on the other.
-  auto vendor_of = [&](const std::string& name) {
-    return o.mixed && (name == "intent" || name == "trajopt" || name == "robot_sim") ? vendor_b : vendor_a;
-  };
-  auto cfg = [&](const std::string& name) { return (fs::path(config_dir) / (name + ".yaml")).string(); };
-
-  std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain << "\n"
-            << "  configuration " << config_dir << "\n  state and service logs (<service>.err) " << state_dir << "\n";
-  if (o.predictor != "model") std::cout << "  predictor: " << o.predictor << " (ablation)\n";
-
-  // The intent model: trained from the synthetic person's demonstrations once.
-  CellModelResult model;
-  supervisor::TaskGraph graph;
-  try {
-    if (!fs::exists(fs::path(config_dir) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir);
-    std::cout << "  intent model: checking ..." << std::flush;
-    model = EnsureCellModel(cfg("perception"), cfg("intent"), state_dir, o.retrain);
-    std::cout << "\r  " << model.summary << "\n";
-    if (o.prepare_only) {
-      std::cout << "  model path: " << model.path << "\n";
-      return 0;
-    }
-    framework::ConfigSection sup = framework::ConfigSection::Load(cfg("supervisor"));
-    std::string graph_file = "tasks/table_top.yaml";
-    sup.Section("supervisor").Read("task_graph", &graph_file);
-    graph = supervisor::LoadTaskGraph(sup.ResolvePath(graph_file));
-  } catch (const std::exception& e) {
-    std::cerr << "\niplan demo: " << e.what() << "\n";
-    return 2;
+  dds::Vendor VendorOf(const std::string& name) const {
+    return o_.mixed && (name == "intent" || name == "trajopt" || name == "robot_sim") ? vendor_b_ : vendor_a_;
   }
+  std::string Cfg(const std::string& name) const { return (fs::path(config_dir_) / (name + ".yaml")).string(); }
 
-  // The recorder first, so that it hears every service from its first message.
-  std::unique_ptr<core::Process> recorder;
-  if (!o.record_file.empty()) {
+  // The state folder, the intent model (trained from the synthetic person's
+  // demonstrations once) and the task graph; an exit code when the run ends here.
+  std::optional<int> Prepare() {
+    if (config_dir_.empty()) {
+      std::cerr << "iplan demo: no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)\n";
+      return 2;
+    }
+    state_dir_ = o_.state_dir;
+    if (state_dir_.empty()) {
+      std::string tmpl = (fs::temp_directory_path() / "iplan-demo-XXXXXX").string();
+      if (!mkdtemp(tmpl.data())) {
+        std::cerr << "iplan demo: cannot create a state folder in " << fs::temp_directory_path() << "\n";
+        return 1;
+      }
+      state_dir_ = tmpl;
+    }
+    fs::create_directories(state_dir_);
+    std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain_ << "\n"
+              << "  configuration " << config_dir_ << "\n  state and service logs (<service>.err) " << state_dir_ << "\n";
+    if (o_.predictor != "model") std::cout << "  predictor: " << o_.predictor << " (ablation)\n";
     try {
-      recorder = StartRecorder(dds::ToString(vendor_a), domain, o.record_file, config_dir, state_dir + "/record");
-      std::cout << "  recording to " << o.record_file << "\n";
+      if (!fs::exists(fs::path(config_dir_) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir_);
+      std::cout << "  intent model: checking ..." << std::flush;
+      model_ = EnsureCellModel(Cfg("perception"), Cfg("intent"), state_dir_, o_.retrain);
+      std::cout << "\r  " << model_.summary << "\n";
+      if (o_.prepare_only) {
+        std::cout << "  model path: " << model_.path << "\n";
+        return 0;
+      }
+      framework::ConfigSection sup = framework::ConfigSection::Load(Cfg("supervisor"));
+      std::string graph_file = "tasks/table_top.yaml";
+      sup.Section("supervisor").Read("task_graph", &graph_file);
+      graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(graph_file));
     } catch (const std::exception& e) {
-      std::cerr << "iplan demo: " << e.what() << "\n";
-      return 1;
+      std::cerr << "\niplan demo: " << e.what() << "\n";
+      return 2;
     }
+    return std::nullopt;
   }
 
-  // Start the services.
-  const auto t0 = Clock::now();
-  std::vector<std::unique_ptr<core::Process>> procs;
-  std::vector<std::string> names;
-  const std::string bin = core::ExecutableDir();
-  std::cout << "  services:";
-  for (size_t i = 0; i < kServices.size(); ++i) {
-    const auto& [exe, name] = kServices[i];
-    const dds::Vendor v = vendor_of(name);
-    std::vector<std::string> argv = {bin + "/iplan-" + exe, "--config", cfg(name), "--dds", dds::ToString(v),
-                                     "--domain", std::to_string(domain)};
-    if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model.path});
-    if (name == "intent" && o.predictor != "model" && o.predictor != "none") {
-      argv.insert(argv.end(), {"--set", "intent.predictor=" + o.predictor});
+  std::vector<std::string> ServiceArguments(const std::string& exe, const std::string& name) const {
+    std::vector<std::string> argv = {core::ExecutableDir() + "/iplan-" + exe, "--config", Cfg(name), "--dds",
+                                     dds::ToString(VendorOf(name)), "--domain", std::to_string(domain_)};
+    if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_.path});
+    if (name == "intent" && o_.predictor != "model" && o_.predictor != "none") {
+      argv.insert(argv.end(), {"--set", "intent.predictor=" + o_.predictor});
     }
-    if (name == "trajopt" && o.predictor == "none") argv.insert(argv.end(), {"--set", "trajopt.use_prediction=false"});
+    if (name == "trajopt" && o_.predictor == "none") argv.insert(argv.end(), {"--set", "trajopt.use_prediction=false"});
     if (name == "perception") argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set",
                                                        "perception.publish_truth=true"});
     if (name == "supervisor") {
-      argv.insert(argv.end(), {"--set", "supervisor.max_episodes=" + std::to_string(o.episodes)});
-      if (!o.keep_learning) argv.insert(argv.end(), {"--set", "supervisor.q_table=" + state_dir + "/q_table.bin"});
+      argv.insert(argv.end(), {"--set", "supervisor.max_episodes=" + std::to_string(o_.episodes)});
+      if (!o_.keep_learning) argv.insert(argv.end(), {"--set", "supervisor.q_table=" + state_dir_ + "/q_table.bin"});
     }
-    try {
-      procs.push_back(std::make_unique<core::Process>(argv, std::map<std::string, std::string>{}, false,
-                                                      state_dir + "/" + name));
-    } catch (const std::exception& e) {
-      std::cerr << "\niplan demo: cannot start iplan-" << exe << ": " << e.what() << "\n";
-      return 1;
-    }
-    names.push_back(name);
-    std::cout << " " << name << " (" << dds::ToString(v) << ")";
-  }
-  std::cout << "\n  episodes: " << o.episodes << " of " << graph.tasks.size() << " robot tasks; Q-table "
-            << (o.keep_learning ? "from the configuration (keeps learning)" : "fresh (learns from scratch)") << "\n"
-            << std::endl;
-
-  dds::ParticipantOptions popts;
-  popts.vendor = vendor_a;
-  popts.domain_id = domain;
-  popts.name = "iplan-demo";
-  auto participant = dds::Participant::Create(popts);
-  spdlog::set_level(spdlog::level::warn);  // the progress lines say what matters
-  framework::NodeOptions nopts;
-  nopts.diagnostics_period = 0;
-  framework::Node node("demo", *participant, nopts);
-  CellMonitor mon(node, static_cast<int>(graph.tasks.size()), t0);
-
-  g_stop = 0;
-  signal(SIGINT, [](int) { g_stop = 1; });
-  signal(SIGTERM, [](int) { g_stop = 1; });
-  auto next_report = Clock::now() + 2s;
-  std::string failure;
-  while (!g_stop) {
-    node.SpinOnce(50ms);
-    for (const auto& e : mon.TakeEvents()) std::cout << "  [" << std::setw(4) << Fixed(mon.Now(), 0) << " s] " << e << std::endl;
-    if (mon.completed_episodes() >= o.episodes) break;
-    for (size_t i = 0; i < procs.size() && failure.empty(); ++i) {
-      if (!procs[i]->Running()) failure = "iplan-" + kServices[i].first + " exited unexpectedly:\n" + Tail(procs[i]->Stderr(), 15);
-    }
-    if (!failure.empty()) break;
-    if (mon.Now() > o.timeout) {
-      failure = "time limit of " + Fixed(o.timeout, 0) + " s reached";
-      break;
-    }
-    if (Clock::now() >= next_report) {
-      next_report += 2s;
-      std::cout << mon.Progress(o.episodes) << std::endl;
-    }
-  }
-  if (g_stop && failure.empty()) failure = "interrupted";
-  // Let the last diagnostics arrive, then stop every service.
-  for (int k = 0; k < 25; ++k) node.SpinOnce(40ms);
-  const double elapsed = mon.Now();
-  for (auto& p : procs) p->Signal(SIGTERM);
-  std::vector<int> exit_codes;
-  for (size_t i = 0; i < procs.size(); ++i) {
-    const auto rc = procs[i]->Wait(10s);
-    exit_codes.push_back(rc ? *rc : -1);
-    if (rc && *rc != 0 && failure.empty()) failure = "iplan-" + kServices[i].first + " exited with " + std::to_string(*rc);
-  }
-  if (recorder) {
-    if (auto err = StopRecorder(*recorder); err && failure.empty()) failure = *err;
+    return argv;
   }
 
-  // Summary.
-  const auto lat = core::Summarize(mon.latency_ms_);
-  const double contacts = mon.DiagNumber("robot_sim", "true_contacts", -1);
-  const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
-  std::vector<const Episode*> done;
-  double waiting_total = 0;
-  for (const auto& [n, e] : mon.episodes()) {
-    waiting_total += e.waiting;
-    if (e.done) done.push_back(&e);
-  }
-  std::cout << "\nSummary (" << Fixed(elapsed, 0) << " s)\n"
-            << "  episodes completed            " << done.size() << " / " << o.episodes << "\n"
-            << "  tasks completed               " << mon.succeeded_tasks_ << " (failed or cancelled: " << mon.failed_tasks_
-            << ")\n";
-  if (!done.empty()) {
-    std::vector<double> times;
-    for (const auto* e : done) times.push_back(e->completion());
-    const auto s = core::Summarize(times);
-    std::cout << "  completion time per episode   mean " << Fixed(s.mean, 1) << " s (min " << Fixed(s.min, 1) << ", max "
-              << Fixed(s.max, 1) << "); first " << Fixed(times.front(), 1) << " s, last " << Fixed(times.back(), 1)
-              << " s\n";
-  }
-  std::cout << "  robot waiting time            " << Fixed(waiting_total, 1) << " s in total\n"
-            << "  minimum separation            " << (min_true_sep >= 0 ? Fixed(min_true_sep, 3) + " m (true body)" : "-")
-            << (mon.min_observed_separation_ < 1e9 ? ", " + Fixed(mon.min_observed_separation_, 3) + " m (observed)" : "")
-            << "\n"
-            << "  maximum collision bound       " << Fixed(mon.max_bound_, 4) << " (executing trajectory), "
-            << Fixed(mon.max_plan_bound_, 4) << " (plans)\n"
-            << "  protective stops              " << mon.stops_ << "\n"
-            << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
-            << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
-            << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
-  const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
-             planning_lat = core::Summarize(mon.planning_ms_);
-  std::cout << "    stages p50/p99: intent " << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
-            << " ms, prediction to planning " << Fixed(queue_lat.p50, 1) << "/" << Fixed(queue_lat.p99, 1)
-            << " ms, planning " << Fixed(planning_lat.p50, 1) << "/" << Fixed(planning_lat.p99, 1) << " ms\n";
-  for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
-  std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
-  for (const auto& [n, e] : mon.episodes()) {
-    std::cout << "  " << std::setw(7) << n << "  " << std::setw(6) << (e.done ? Fixed(e.completion(), 1) : "-") << "  "
-              << std::setw(9) << Fixed(e.waiting, 1) << " ";
-    for (const auto& t : e.order) std::cout << " " << t;
-    std::cout << (e.done ? "" : " (incomplete)") << "\n";
+  // The recorder first, so that it hears every service from its first
+  // message, then every service; an exit code when one cannot start.
+  std::optional<int> StartServices() {
+    if (!o_.record_file.empty()) {
+      try {
+        recorder_ = StartRecorder(dds::ToString(vendor_a_), domain_, o_.record_file, config_dir_, state_dir_ + "/record");
+        std::cout << "  recording to " << o_.record_file << "\n";
+      } catch (const std::exception& e) {
+        std::cerr << "iplan demo: " << e.what() << "\n";
+        return 1;
+      }
+    }
+    t0_ = Clock::now();
+    std::cout << "  services:";
+    for (const auto& [exe, name] : kServices) {
+      try {
+        procs_.push_back(std::make_unique<core::Process>(ServiceArguments(exe, name), std::map<std::string, std::string>{},
+                                                         false, state_dir_ + "/" + name));
+      } catch (const std::exception& e) {
+        std::cerr << "\niplan demo: cannot start iplan-" << exe << ": " << e.what() << "\n";
+        return 1;
+      }
+      names_.push_back(name);
+      std::cout << " " << name << " (" << dds::ToString(VendorOf(name)) << ")";
+    }
+    std::cout << "\n  episodes: " << o_.episodes << " of " << graph_.tasks.size() << " robot tasks; Q-table "
+              << (o_.keep_learning ? "from the configuration (keeps learning)" : "fresh (learns from scratch)") << "\n"
+              << std::endl;
+    return std::nullopt;
   }
 
-  if (!o.summary_file.empty()) {
+  // Progress until every episode is done, a service exits, the time limit
+  // or a signal.
+  void Watch(framework::Node& node, CellMonitor& mon) {
+    g_stop = 0;
+    signal(SIGINT, [](int) { g_stop = 1; });
+    signal(SIGTERM, [](int) { g_stop = 1; });
+    auto next_report = Clock::now() + 2s;
+    while (!g_stop) {
+      node.SpinOnce(50ms);
+      for (const auto& e : mon.TakeEvents()) std::cout << "  [" << std::setw(4) << Fixed(mon.Now(), 0) << " s] " << e << std::endl;
+      if (mon.completed_episodes() >= o_.episodes) break;
+      for (size_t i = 0; i < procs_.size() && failure_.empty(); ++i) {
+        if (!procs_[i]->Running()) failure_ = "iplan-" + kServices[i].first + " exited unexpectedly:\n" + Tail(procs_[i]->Stderr(), 15);
+      }
+      if (!failure_.empty()) break;
+      if (mon.Now() > o_.timeout) {
+        failure_ = "time limit of " + Fixed(o_.timeout, 0) + " s reached";
+        break;
+      }
+      if (Clock::now() >= next_report) {
+        next_report += 2s;
+        std::cout << mon.Progress(o_.episodes) << std::endl;
+      }
+    }
+    if (g_stop && failure_.empty()) failure_ = "interrupted";
+  }
+
+  // Lets the last diagnostics arrive, then stops every service and the recorder.
+  void Stop(framework::Node& node, CellMonitor& mon) {
+    for (int k = 0; k < 25; ++k) node.SpinOnce(40ms);
+    elapsed_ = mon.Now();
+    for (auto& p : procs_) p->Signal(SIGTERM);
+    for (size_t i = 0; i < procs_.size(); ++i) {
+      const auto rc = procs_[i]->Wait(10s);
+      exit_codes_.push_back(rc ? *rc : -1);
+      if (rc && *rc != 0 && failure_.empty()) failure_ = "iplan-" + kServices[i].first + " exited with " + std::to_string(*rc);
+    }
+    if (recorder_) {
+      if (auto err = StopRecorder(*recorder_); err && failure_.empty()) failure_ = *err;
+    }
+  }
+
+  void PrintSummary(const CellMonitor& mon, double contacts) const {
+    const auto lat = core::Summarize(mon.latency_ms_);
+    const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
+    std::vector<const Episode*> done;
+    double waiting_total = 0;
+    for (const auto& [n, e] : mon.episodes()) {
+      waiting_total += e.waiting;
+      if (e.done) done.push_back(&e);
+    }
+    std::cout << "\nSummary (" << Fixed(elapsed_, 0) << " s)\n"
+              << "  episodes completed            " << done.size() << " / " << o_.episodes << "\n"
+              << "  tasks completed               " << mon.succeeded_tasks_ << " (failed or cancelled: " << mon.failed_tasks_
+              << ")\n";
+    if (!done.empty()) {
+      std::vector<double> times;
+      for (const auto* e : done) times.push_back(e->completion());
+      const auto s = core::Summarize(times);
+      std::cout << "  completion time per episode   mean " << Fixed(s.mean, 1) << " s (min " << Fixed(s.min, 1) << ", max "
+                << Fixed(s.max, 1) << "); first " << Fixed(times.front(), 1) << " s, last " << Fixed(times.back(), 1)
+                << " s\n";
+    }
+    std::cout << "  robot waiting time            " << Fixed(waiting_total, 1) << " s in total\n"
+              << "  minimum separation            " << (min_true_sep >= 0 ? Fixed(min_true_sep, 3) + " m (true body)" : "-")
+              << (mon.min_observed_separation_ < 1e9 ? ", " + Fixed(mon.min_observed_separation_, 3) + " m (observed)" : "")
+              << "\n"
+              << "  maximum collision bound       " << Fixed(mon.max_bound_, 4) << " (executing trajectory), "
+              << Fixed(mon.max_plan_bound_, 4) << " (plans)\n"
+              << "  protective stops              " << mon.stops_ << "\n"
+              << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
+              << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
+              << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
+    const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
+               planning_lat = core::Summarize(mon.planning_ms_);
+    std::cout << "    stages p50/p99: intent " << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
+              << " ms, prediction to planning " << Fixed(queue_lat.p50, 1) << "/" << Fixed(queue_lat.p99, 1)
+              << " ms, planning " << Fixed(planning_lat.p50, 1) << "/" << Fixed(planning_lat.p99, 1) << " ms\n";
+    for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
+    std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
+    for (const auto& [n, e] : mon.episodes()) {
+      std::cout << "  " << std::setw(7) << n << "  " << std::setw(6) << (e.done ? Fixed(e.completion(), 1) : "-") << "  "
+                << std::setw(9) << Fixed(e.waiting, 1) << " ";
+      for (const auto& t : e.order) std::cout << " " << t;
+      std::cout << (e.done ? "" : " (incomplete)") << "\n";
+    }
+  }
+
+  void WriteSummary(const CellMonitor& mon, double contacts) const {
+    const auto lat = core::Summarize(mon.latency_ms_);
+    const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
+               planning_lat = core::Summarize(mon.planning_ms_);
+    const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
+    std::vector<const Episode*> done;
+    double waiting_total = 0;
+    for (const auto& [n, e] : mon.episodes()) {
+      waiting_total += e.waiting;
+      if (e.done) done.push_back(&e);
+    }
     nlohmann::json j;
-    j["domain"] = domain;
-    j["predictor"] = o.predictor;
+    j["domain"] = domain_;
+    j["predictor"] = o_.predictor;
     j["vendors"] = nlohmann::json::object();
-    for (const std::string& name : names) j["vendors"][name] = dds::ToString(vendor_of(name));
-    j["monitor_vendor"] = dds::ToString(vendor_a);
-    j["duration_s"] = elapsed;
-    j["episodes_requested"] = o.episodes;
+    for (const std::string& name : names_) j["vendors"][name] = dds::ToString(VendorOf(name));
+    j["monitor_vendor"] = dds::ToString(vendor_a_);
+    j["duration_s"] = elapsed_;
+    j["episodes_requested"] = o_.episodes;
     j["episodes_completed"] = done.size();
     j["tasks_completed"] = mon.succeeded_tasks_;
     j["tasks_failed_or_cancelled"] = mon.failed_tasks_;
@@ -463,27 +504,34 @@ int RunDemo(const DemoOptions& o) {
                                      {"tasks_completed", e.succeeded},
                                      {"order", e.order}});
     }
-    j["intent_model"] = {{"path", model.path}, {"trained_now", model.trained}, {"training_s", model.seconds}};
-    j["service_exit_codes"] = exit_codes;
-    j["failure"] = failure;
-    if (!o.record_file.empty()) j["recording"] = fs::absolute(o.record_file).string();
-    std::ofstream(o.summary_file) << j.dump(2) << "\n";
-    std::cout << "\nsummary written to " << o.summary_file << "\n";
-    const std::string report = (fs::path(o.summary_file).parent_path() / fs::path(o.summary_file).stem()).string() + ".html";
-    if (auto err = WriteReport(o.summary_file, o.record_file, report)) std::cerr << "iplan demo: no report: " << *err << "\n";
-    else std::cout << "report written to " << report << " (iplan report " << o.summary_file << ")\n";
+    j["intent_model"] = {{"path", model_.path}, {"trained_now", model_.trained}, {"training_s", model_.seconds}};
+    j["service_exit_codes"] = exit_codes_;
+    j["failure"] = failure_;
+    if (!o_.record_file.empty()) j["recording"] = fs::absolute(o_.record_file).string();
+    std::ofstream(o_.summary_file) << j.dump(2) << "\n";
+    std::cout << "\nsummary written to " << o_.summary_file << "\n";
+    const std::string report = (fs::path(o_.summary_file).parent_path() / fs::path(o_.summary_file).stem()).string() + ".html";
+    if (auto err = WriteReport(o_.summary_file, o_.record_file, report)) std::cerr << "iplan demo: no report: " << *err << "\n";
+    else std::cout << "report written to " << report << " (iplan report " << o_.summary_file << ")\n";
   }
-  if (!failure.empty()) {
-    std::cerr << "\niplan demo: " << failure << "\n";
-    return 1;
-  }
-  if (contacts != 0) {
-    std::cerr << "\niplan demo: the robot touched the person (" << contacts << " true contacts)\n";
-    return 1;
-  }
-  std::cout << std::flush;
-  return 0;
-}
+
+  const DemoOptions& o_;
+  const dds::Vendor vendor_a_, vendor_b_;
+  const int domain_;
+  const std::string config_dir_;
+  std::string state_dir_;
+  CellModelResult model_;
+  supervisor::TaskGraph graph_;
+  std::unique_ptr<core::Process> recorder_;
+  Clock::time_point t0_;
+  std::vector<std::unique_ptr<core::Process>> procs_;
+  std::vector<std::string> names_;
+  std::vector<int> exit_codes_;
+  std::string failure_;
+  double elapsed_ = 0;
+};
+
+int RunDemo(const DemoOptions& o) { return DemoRun(o).Run(); }
 
 void Register(CLI::App& app) {
   static DemoOptions o;
