@@ -11,6 +11,8 @@
 #include <fstream>
 #include <thread>
 
+#include <iterator>
+#include <sstream>
 #include <gtest/gtest.h>
 
 #include "iplan/dds/participant.h"
@@ -112,6 +114,45 @@ TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
   Process check({BinPath("iplan-perception"), "--check-config"});
   ASSERT_EQ(check.Wait(20s), 0) << check.Stderr();
   EXPECT_NE(check.Stdout().find("configuration is valid"), std::string::npos);
+}
+
+// node.realtime_priority and node.lock_memory either take effect (the
+// process runs under SCHED_FIFO with its memory locked) or are refused with a
+// message saying what to grant; the service runs either way.
+TEST(ServiceFramework, RealtimeSchedulingTakesEffectOrIsReported) {
+  Process svc({BinPath("iplan-perception"), "--domain", std::to_string(UniqueDomain(7)), "--set",
+               "node.realtime_priority=10", "--set", "node.lock_memory=true"});
+  std::this_thread::sleep_for(3s);
+  ASSERT_TRUE(svc.Running()) << svc.Stderr();
+  std::ifstream stat("/proc/" + std::to_string(svc.pid()) + "/stat");
+  std::string text((std::istreambuf_iterator<char>(stat)), std::istreambuf_iterator<char>());
+  // Field 41 (policy) counted after the ')' closing the command name.
+  std::istringstream fields(text.substr(text.rfind(')') + 2));
+  std::vector<std::string> f{std::istream_iterator<std::string>(fields), std::istream_iterator<std::string>()};
+  ASSERT_GE(f.size(), 39u);
+  const int policy = std::stoi(f[38]);  // field 41 is the 39th after the state (field 3)
+  std::ifstream status("/proc/" + std::to_string(svc.pid()) + "/status");
+  std::string line, locked;
+  while (std::getline(status, line)) {
+    if (line.rfind("VmLck:", 0) == 0) locked = line;
+  }
+  const std::string err = svc.Stderr();
+  if (err.find("SCHED_FIFO refused") == std::string::npos) {
+    EXPECT_EQ(policy, 1) << "SCHED_FIFO neither set nor reported refused\n" << err;
+  } else {
+    EXPECT_NE(err.find("LimitRTPRIO=10"), std::string::npos) << err;
+    EXPECT_EQ(policy, 0);
+  }
+  if (err.find("mlockall refused") == std::string::npos) {
+    EXPECT_EQ(locked.find(" 0 kB"), std::string::npos) << "memory neither locked nor reported refused: " << locked;
+  } else {
+    EXPECT_NE(err.find("LimitMEMLOCK=infinity"), std::string::npos) << err;
+  }
+  svc.Signal(SIGTERM);
+  EXPECT_EQ(svc.Wait(10s), 0) << err;
+  Process bad({BinPath("iplan-perception"), "--check-config", "--set", "node.realtime_priority=120"});
+  EXPECT_EQ(bad.Wait(20s), 2);
+  EXPECT_NE(bad.Stderr().find("realtime_priority"), std::string::npos) << bad.Stderr();
 }
 
 TEST(ServiceFramework, PublishesDiagnosticsAndStopsCleanlyOnSigterm) {

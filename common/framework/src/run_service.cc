@@ -7,6 +7,7 @@
 #include <spdlog/spdlog.h>
 
 #include "iplan/framework/service.h"
+#include "realtime.h"
 #include "iplan/framework/systemd.h"
 
 namespace iplan::framework {
@@ -35,6 +36,8 @@ bool LoadConfiguration(const std::string& name, const std::string& config_file,
     node_section.Read("diagnostics_period", &nopts->diagnostics_period, NonNegative<double>());
     node_section.Read("hardware_id", &nopts->hardware_id);
     node_section.Read("max_stamp_ahead", &nopts->max_stamp_ahead, InRange(0.0, 60.0));
+    node_section.Read("realtime_priority", &nopts->realtime_priority, InRange(0, 99));
+    node_section.Read("lock_memory", &nopts->lock_memory);
     node_section.Read("frame_id", &nopts->frame_id, Check<std::string>([](const std::string& f) {
       return f.empty() ? std::string("must not be empty") : std::string();
     }));
@@ -180,6 +183,10 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
 
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
+  // Before the participant: its threads inherit the scheduling policy.
+  for (const std::string& why : internal::ApplyRealtime(nopts.realtime_priority, nopts.lock_memory)) {
+    spdlog::warn("iplan-{}: {}", info.name, why);
+  }
 
   std::unique_ptr<dds::Participant> participant;
   std::unique_ptr<Node> node;

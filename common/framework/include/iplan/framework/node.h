@@ -57,6 +57,13 @@ struct NodeOptions {
   /// whose samples are accepted; replaces the catalogue's list for that topic.
   /// An empty list accepts every writer.
   std::map<std::string, std::vector<std::string>> entitled_writers;
+  /// SCHED_FIFO priority (1-99) of the service's threads; 0: the default
+  /// scheduler. Needs LimitRTPRIO (systemd) or CAP_SYS_NICE; refused, the
+  /// service says so and runs on the default scheduler.
+  int realtime_priority = 0;
+  /// Lock all memory (mlockall): no page faults on the executor. Needs
+  /// LimitMEMLOCK=infinity or CAP_IPC_LOCK; refused, the service says so.
+  bool lock_memory = false;
 };
 
 /// Counters of one subscribed topic.
