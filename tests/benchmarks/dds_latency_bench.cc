@@ -6,8 +6,9 @@
 // shipped loopback transport config); one-way = round trip / 2.
 //   raw        vendor-generated types, vendor API, a wait set; the echo side
 //              writes back the sample it took.
-//   framework  iplan::msg types through idds::Writer/Reader (conversion to and
-//              from vendor types), and on both sides a framework::Node whose
+//   framework  iplan::msg types through idds::Writer/Reader (Fast DDS: the
+//              plain types serialised directly; Cyclone: conversion to and
+//              from idlc's structs), and on both sides a framework::Node whose
 //              subscription runs the boundary check before the callback.
 // Throughput: the sender writes as fast as the writer accepts for a fixed
 // time (reliable, keep last 100); the receiver counts what it delivers.
@@ -40,6 +41,7 @@
 #include <nlohmann/json.hpp>
 #include <spdlog/spdlog.h>
 
+#include "bench_messages.h"
 #include "cyclone_convert.h"
 #include "fastdds_convert.h"
 #include "iplan/core/process.h"
@@ -59,44 +61,6 @@ namespace fdds = eprosima::fastdds::dds;
 namespace {
 
 const std::string kConfigDir = IPLAN_SOURCE_DIR "/config/dds";
-
-msg::HumanSkeleton MakeSkeleton() {
-  msg::HumanSkeleton s;
-  s.header.frame_id = "world";
-  s.body_id = 1;
-  s.confidence = 1;
-  const char* names[] = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l", "shoulder_r", "elbow_r", "hand_r"};
-  for (int j = 0; j < 9; ++j) {
-    msg::HumanJoint h;
-    h.name = names[j];
-    h.position.x = 0.1 * j;
-    h.covariance = {1e-4, 0, 0, 0, 1e-4, 0, 0, 0, 1e-4};
-    h.confidence = 1;
-    s.joints.push_back(h);
-  }
-  return s;
-}
-
-msg::HumanPrediction MakePrediction() {
-  msg::HumanPrediction p;
-  p.header.frame_id = "world";
-  p.body_id = 1;
-  p.time_step = 1.0 / 15;
-  p.num_steps = 15;
-  p.joint_names = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l", "shoulder_r", "elbow_r", "hand_r"};
-  for (int a = 0; a < 10; ++a) {
-    msg::ActionPrediction ap;
-    ap.action = "action_" + std::to_string(a);
-    ap.probability = 0.1;
-    ap.joints.resize(15 * 9);
-    for (auto& g : ap.joints) {
-      g.mean.x = 0.5;
-      g.covariance = {1e-3, 0, 0, 0, 1e-3, 0, 0, 0, 1e-3};
-    }
-    p.actions.push_back(ap);
-  }
-  return p;
-}
 
 idds::QosProfile BenchQos(int depth) {
   idds::QosProfile q = idds::QosProfile::Command(std::chrono::nanoseconds(0));
@@ -327,8 +291,8 @@ std::vector<double> FrameworkPing(idds::Vendor vendor, int domain, const T& m, i
 }
 
 std::vector<double> Ping(const Case& c, int domain, int warmup, int n) {
-  const auto skeleton = MakeSkeleton();
-  const auto prediction = MakePrediction();
+  const auto skeleton = iplan::bench::MakeSkeleton();
+  const auto prediction = iplan::bench::MakePrediction();
   if (c.impl == "framework") {
     const auto v = idds::ParseVendor(c.vendor);
     return c.msg == "skeleton" ? FrameworkPing(v, domain, skeleton, warmup, n)
@@ -432,8 +396,8 @@ int Sink(const Case& c, int domain, double seconds) {
 
 // Source: writes for `seconds`; returns messages written.
 uint64_t Source(const Case& c, int domain, double seconds) {
-  const auto skeleton = MakeSkeleton();
-  const auto prediction = MakePrediction();
+  const auto skeleton = iplan::bench::MakeSkeleton();
+  const auto prediction = iplan::bench::MakePrediction();
   uint64_t n = 0;
   auto run = [&](auto write, auto matched) {
     const auto wait_end = Clock::now() + 20s;

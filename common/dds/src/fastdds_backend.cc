@@ -1,4 +1,5 @@
-// Fast DDS 2.9 backend: fastddsgen classes, one wait set per participant.
+// Fast DDS 2.9 backend: the plain message types serialised directly with Fast
+// CDR (fastdds_plain_type.h), one wait set per participant.
 #include <map>
 #include <mutex>
 #include <stdexcept>
@@ -21,7 +22,7 @@
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
 #include "backend.h"
-#include "fastdds_convert.h"
+#include "fastdds_plain_type.h"
 
 namespace iplan::dds::internal {
 namespace {
@@ -38,11 +39,10 @@ Duration_t ToDuration(std::chrono::nanoseconds ns) {
                     static_cast<uint32_t>(ns.count() % 1000000000));
 }
 
-const fastdds_gen::FastTypeOps& FindOps(const std::string& dds_type) {
-  for (const auto& ops : fastdds_gen::AllFastTypes()) {
-    if (dds_type == ops.dds_name) return ops;
-  }
-  throw std::runtime_error("Fast DDS: no type support for '" + dds_type + "'");
+const fastdds_plain::PlainTypeEntry& FindOps(const std::string& dds_type) {
+  const fastdds_plain::PlainTypeEntry* e = fastdds_plain::FindPlainType(dds_type);
+  if (!e) throw std::runtime_error("Fast DDS: no type support for '" + dds_type + "'");
+  return *e;
 }
 
 void ApplyCommon(const QosProfile& q, fdds::DurabilityQosPolicy* durability,
@@ -106,16 +106,12 @@ class WriterNames {
 
 class FastWriter final : public BackendWriter {
  public:
-  FastWriter(const fastdds_gen::FastTypeOps& ops, fdds::Publisher* pub, fdds::DataWriter* w)
-      : ops_(ops), publisher_(pub), writer_(w), sample_(ops.new_vendor()) {}
-  ~FastWriter() override {
-    publisher_->delete_datawriter(writer_);
-    ops_.delete_vendor(sample_);
-  }
+  FastWriter(fdds::Publisher* pub, fdds::DataWriter* w) : publisher_(pub), writer_(w) {}
+  ~FastWriter() override { publisher_->delete_datawriter(writer_); }
   bool Write(const void* plain, std::string* error) override {
-    std::lock_guard<std::mutex> lock(mu_);
-    ops_.to_vendor(plain, sample_);
-    if (!writer_->write(sample_)) {
+    // The type support serialises `plain` inside write() (thread-safe) and
+    // only reads it.
+    if (!writer_->write(const_cast<void*>(plain))) {
       if (error) *error = "Fast DDS DataWriter::write failed";
       return false;
     }
@@ -131,24 +127,23 @@ class FastWriter final : public BackendWriter {
   }
 
  private:
-  const fastdds_gen::FastTypeOps& ops_;
   fdds::Publisher* publisher_;
   fdds::DataWriter* writer_;
-  std::mutex mu_;
-  void* sample_;
 };
 
 class FastReader final : public BackendReader {
  public:
-  FastReader(FastParticipant* owner, const fastdds_gen::FastTypeOps& ops, fdds::Subscriber* sub,
-             fdds::DataReader* r, const WriterNames& names)
-      : owner_(owner), ops_(ops), subscriber_(sub), reader_(r), sample_(ops.new_vendor()), names_(names) {}
+  FastReader(FastParticipant* owner, fdds::Subscriber* sub, fdds::DataReader* r, const WriterNames& names)
+      : owner_(owner), subscriber_(sub), reader_(r), names_(names) {}
   ~FastReader() override;
   bool Take(void* plain, SampleInfo* info) override {
     fdds::SampleInfo si;
-    while (reader_->take_next_sample(sample_, &si) == RC::RETCODE_OK) {
-      if (!si.valid_data) continue;  // dispose/unregister notifications
-      ops_.from_vendor(sample_, plain);
+    // Deserialised straight into `plain`; a sample that does not deserialise
+    // is dropped here (and counted and logged by the type support).
+    for (;;) {
+      fastdds_plain::ClearDeserializeFailure();
+      if (reader_->take_next_sample(plain, &si) != RC::RETCODE_OK) break;
+      if (!si.valid_data || fastdds_plain::DeserializeFailed()) continue;  // or dispose/unregister
       info->source_timestamp_ns = si.source_timestamp.to_ns();
       info->reception_ns = NowNs();
       info->writer_id = HashBytes(si.publication_handle.value, 16);
@@ -217,10 +212,8 @@ class FastReader final : public BackendReader {
 
  private:
   FastParticipant* owner_;
-  const fastdds_gen::FastTypeOps& ops_;
   fdds::Subscriber* subscriber_;
   fdds::DataReader* reader_;
-  void* sample_;
   const WriterNames& names_;
   std::unordered_map<uint64_t, std::string> cache_;
 };
@@ -327,7 +320,7 @@ class FastParticipant final : public BackendParticipant {
     }
     const auto& ops = FindOps(dds_type);
     if (participant_->find_type(dds_type).empty()) {
-      fdds::TypeSupport ts(ops.make_pubsub_type());
+      fdds::TypeSupport ts(ops.make());
       if (ts.register_type(participant_) != RC::RETCODE_OK) {
         throw std::runtime_error("Fast DDS: cannot register type " + dds_type);
       }
@@ -355,7 +348,7 @@ class FastParticipant final : public BackendParticipant {
     qos.user_data().data_vec(std::vector<eprosima::fastrtps::rtps::octet>(user_data_.begin(), user_data_.end()));
     fdds::DataWriter* w = publisher_->create_datawriter(t, qos, nullptr, fdds::StatusMask::none());
     if (!w) throw std::runtime_error("Fast DDS: cannot create a writer on " + topic);
-    return std::make_unique<FastWriter>(FindOps(dds_type), publisher_, w);
+    return std::make_unique<FastWriter>(publisher_, w);
   }
 
   std::unique_ptr<BackendReader> CreateReader(const std::string& topic, const std::string& dds_type,
@@ -371,7 +364,7 @@ class FastParticipant final : public BackendParticipant {
         eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
     fdds::DataReader* r = subscriber_->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
     if (!r) throw std::runtime_error("Fast DDS: cannot create a reader on " + topic);
-    auto reader = std::make_unique<FastReader>(this, FindOps(dds_type), subscriber_, r, listener_->names());
+    auto reader = std::make_unique<FastReader>(this, subscriber_, r, listener_->names());
     fdds::StatusCondition& cond = r->get_statuscondition();
     fdds::StatusMask mask = fdds::StatusMask::data_available();
     mask << fdds::StatusMask::requested_deadline_missed() << fdds::StatusMask::liveliness_changed()
@@ -433,7 +426,6 @@ class FastParticipant final : public BackendParticipant {
 FastReader::~FastReader() {
   owner_->DetachReader(reader_);
   subscriber_->delete_datareader(reader_);
-  ops_.delete_vendor(sample_);
 }
 
 }  // namespace

@@ -1,4 +1,6 @@
-// Type support table for the Fast DDS backend (generated entries).
+// fastddsgen classes and the conversions to them (generated entries). Not on
+// the data path (see fastdds_plain_type.h): used by the raw-vendor side of
+// dds_latency_bench, fastdds_serialize_bench and fastdds_plain_type_test.
 #pragma once
 
 #include <string>

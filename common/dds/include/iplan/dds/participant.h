@@ -1,6 +1,6 @@
 // One C++ interface to DDS with two run-time selectable backends: Fast DDS
-// (fastddsgen classes) and Cyclone DDS (idlc C structs). Callers only see
-// iplan::msg types; the backend converts to and from the vendor types.
+// (the plain types serialised directly with Fast CDR) and Cyclone DDS (idlc C
+// structs, converted to and from). Callers only see iplan::msg types.
 //
 // Threading model: a Participant owns one wait set. Readers never call back
 // on vendor threads; the owner of the participant (usually the service
