@@ -21,14 +21,14 @@
 #include <sstream>
 
 #include "command_registry.h"
-#include "core/synthetic_person.h"
-#include "core/task_planner.h"
+#include "perception/core/synthetic_person.h"
+#include "supervisor/core/task_planner.h"
 #include "iplan/framework/config.h"
 #include "iplan/framework/service.h"
 #include "iplan/planning/planner.h"
-#include "risk_config.h"
-#include "synthetic_config.h"
-#include "trajopt_config.h"
+#include "collision_risk/risk_config.h"
+#include "perception/synthetic_config.h"
+#include "trajopt/trajopt_config.h"
 
 namespace iplan::cli {
 namespace {

@@ -1,9 +1,9 @@
 // `iplan collision-bound`: the collision bound of METHOD 4 for JSON lines on
-// stdin (see iplan/collision/bound_cli.h for the format).
+// stdin (see collision_bound_cli.h for the format).
 #include <iostream>
 
 #include "command_registry.h"
-#include "iplan/collision/bound_cli.h"
+#include "collision_bound_cli.h"
 
 namespace {
 

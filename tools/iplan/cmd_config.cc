@@ -6,13 +6,13 @@
 #include <string>
 
 #include "command_registry.h"
-#include "core/robot_sim_settings.h"
-#include "core/supervisor_settings.h"
-#include "core/task_planner.h"
+#include "robot_sim/core/robot_sim_settings.h"
+#include "supervisor/core/supervisor_settings.h"
+#include "supervisor/core/task_planner.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/core/params.h"
 #include "iplan/planning/planner_params.h"
-#include "trajopt_config.h"
+#include "trajopt/trajopt_config.h"
 
 namespace {
 

@@ -22,7 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
-#include "core/task_planner.h"
+#include "supervisor/core/task_planner.h"
 #include "dds_cell_model.h"
 #include "dds_common.h"
 #include "dds_viewer_common.h"

@@ -22,9 +22,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cell_config.h"
+#include "cell_sim/cell_config.h"
 #include "command_registry.h"
-#include "core/interaction_benchmark.h"
+#include "cell_sim/core/interaction_benchmark.h"
 #include "dds_cell_model.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/core/stats.h"

@@ -1,9 +1,9 @@
-// `iplan plan`: one-shot trajectory planning (logic in iplan/planning/plan_cli.h).
+// `iplan plan`: one-shot trajectory planning (logic in plan_cli.h).
 #include <cstdint>
 #include <iostream>
 
 #include "command_registry.h"
-#include "iplan/planning/plan_cli.h"
+#include "plan_cli.h"
 
 namespace {
 

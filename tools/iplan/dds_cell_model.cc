@@ -5,12 +5,12 @@
 #include <fstream>
 #include <sstream>
 
-#include "core/synthetic_person.h"
+#include "perception/core/synthetic_person.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/framework/config.h"
 #include "iplan/intent/intent_model.h"
 #include "iplan/intent/model_io.h"
-#include "synthetic_config.h"
+#include "perception/synthetic_config.h"
 
 namespace iplan::cli {
 namespace {

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "core/synthetic_person.h"
+#include "perception/core/synthetic_person.h"
 #include "iplan/intent/skeleton_data.h"
 
 namespace iplan::cli {

@@ -1,4 +1,4 @@
-#include "iplan/collision/scene.h"
+#include "iplan/collision/static_scene.h"
 
 #include <cmath>
 #include <fstream>

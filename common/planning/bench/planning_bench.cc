@@ -28,7 +28,7 @@
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/cell/joint_trajectory.h"
-#include "iplan/collision/scene.h"
+#include "iplan/collision/static_scene.h"
 #ifdef IPLAN_HAVE_OMPL
 #include "ompl_peer.h"
 #endif

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/collision/human_model.h"
+#include "iplan/collision/static_scene.h"
 #include "iplan/planning/planner.h"
 #include "test_util.h"
 

@@ -1,4 +1,4 @@
-#include "iplan/collision/bound_cli.h"
+#include "collision_bound_cli.h"
 
 #include <sstream>
 #include <string>

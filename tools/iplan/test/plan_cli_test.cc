@@ -4,7 +4,7 @@
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
 
-#include "iplan/planning/plan_cli.h"
+#include "plan_cli.h"
 
 namespace iplan::planning {
 namespace {

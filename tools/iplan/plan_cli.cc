@@ -1,4 +1,4 @@
-#include "iplan/planning/plan_cli.h"
+#include "plan_cli.h"
 
 #include <exception>
 #include <ostream>

@@ -1,4 +1,4 @@
-#include "iplan/collision/bound_cli.h"
+#include "collision_bound_cli.h"
 
 #include <array>
 #include <cmath>
