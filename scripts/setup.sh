@@ -25,7 +25,7 @@ PACKAGES=(
   # viewer (iplan view / record / report): HTTP + WebSocket server, Node.js for
   # the page's npm dependencies, the MCAP writer and the report, Chromium for
   # the browser tests
-  libwebsocketpp-dev libasio-dev nodejs npm chromium
+  libwebsocketpp-dev libasio-dev chromium
 )
 
 missing=()
@@ -34,6 +34,11 @@ for p in "${PACKAGES[@]}"; do
     missing+=("$p")
   fi
 done
+# Node.js and npm: Debian's packages only where no node/npm is installed
+# (a machine with NodeSource's nodejs has npm inside it, and Debian's npm
+# package conflicts with that nodejs).
+command -v node >/dev/null 2>&1 || missing+=(nodejs)
+command -v npm >/dev/null 2>&1 || missing+=(npm)
 if ((${#missing[@]})); then
   echo "setup: installing ${#missing[@]} Debian packages: ${missing[*]}"
   SUDO=""
