@@ -5,6 +5,7 @@
 #include <map>
 #include <string>
 
+#include "collision_risk/core/risk_monitor.h"
 #include "command_registry.h"
 #include "robot_sim/core/robot_sim_settings.h"
 #include "supervisor/core/supervisor_settings.h"
@@ -25,6 +26,9 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"planner",
        {"config/planner.yaml (top level); PlannerParams",
         [] { return iplan::core::DescribeParams(iplan::planning::PlannerParams{}); }}},
+      {"collision-risk",
+       {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066)",
+        [] { return iplan::core::DescribeParams(iplan::collision_risk::RiskParams{}); }}},
       {"replanner",
        {"config/trajopt.yaml, section trajopt; ReplannerParams",
         [] { return iplan::core::DescribeParams(iplan::trajopt::ReplannerParams{}); }}},

@@ -67,6 +67,20 @@ struct RiskParams {
   SsmParams ssm;
   /// Empty when valid, else the reason.
   std::string Validate() const;
+
+  /// The keys of section collision_risk (config/collision_risk.yaml), the
+  /// ISO/TS 15066 ones in its iso_ts_15066 mapping; ranges: Validate().
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(delta_cl, "a waypoint is safe when its bound < 1 - delta_cl, in (0, 1)"));
+    a->Visit(IPLAN_NVP(stop_horizon, "s; a violation within it stops, later slows down, >= 0"));
+    a->Visit(IPLAN_NVP(slow_down_fraction, "slow down above this fraction of 1 - delta_cl, in (0, 1]"));
+    a->Visit(IPLAN_NVP(slow_down_margin, "m; slow down within S_p + this, >= 0"));
+    a->Visit(IPLAN_NVP(stale_after, "s; older skeletons, predictions, robot states are not used, > 0"));
+    a->Visit(IPLAN_NVP(person_required, "no fresh skeleton means protective stop"));
+    a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a robot state further outside the limits is refused, >= 0"));
+    a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "ISO/TS 15066 speed and separation monitoring"));
+  }
 };
 
 using cell::Verdict;

@@ -4,6 +4,8 @@
 
 #include <gtest/gtest.h>
 
+#include "iplan/core/params.h"
+
 namespace iplan::collision_risk {
 namespace {
 
@@ -312,6 +314,12 @@ TEST(RiskMonitorFailSafe, WithoutAUsablePredictionSeparationUsesTheDefaultHumanS
   EXPECT_DOUBLE_EQ(r.human_speed, p.ssm.default_human_speed);
   EXPECT_NEAR(r.protective_separation, 1.6 * (0.1 + 0.3) + 0.1 + 0.05 + 0.02, 1e-9);
   EXPECT_NE(r.reason.find("degraded"), std::string::npos) << r.reason;
+}
+
+TEST(RiskParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(RiskParams{})),
+            "");
 }
 
 }  // namespace

@@ -16,6 +16,8 @@
 
 #include <optional>
 
+#include "iplan/core/name_value.h"
+
 namespace iplan::cell {
 
 struct SsmParams {
@@ -34,6 +36,24 @@ struct SsmParams {
   double intrusion_distance = 0.1;  ///< m, C
   double sensing_uncertainty = 0.05;  ///< m, Z_d
   double robot_uncertainty = 0.02;    ///< m, Z_r
+
+  /// The keys of a configuration's iso_ts_15066 mapping; ranges: the
+  /// owner's Validate() (RiskParams).
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(directed, "speeds towards each other per sphere pair; false: fastest joint and sphere, S_s always"));
+    a->Visit(IPLAN_NVP(measure_human_speed, "v_h from the skeleton; false: default_human_speed"));
+    a->Visit(IPLAN_NVP(default_human_speed, "m/s; v_h when not measured (ISO: 1.6), >= 0"));
+    a->Visit(IPLAN_NVP(degrade_without_prediction, "without a usable prediction v_h is default_human_speed"));
+    a->Visit(IPLAN_NVP(speed_window, "s; displacement window of the measured speed, > 0"));
+    a->Visit(IPLAN_NVP(reaction_time, "s; T_r, >= 0"));
+    a->Visit(IPLAN_NVP(stopping_time, "s; T_s, >= 0"));
+    a->Visit(IPLAN_NVP(stopping_distance, "m; S_s at stopping_speed, >= 0"));
+    a->Visit(IPLAN_NVP(stopping_speed, "m/s; robot speed at which stopping_distance was measured, > 0"));
+    a->Visit(IPLAN_NVP(intrusion_distance, "m; C, >= 0"));
+    a->Visit(IPLAN_NVP(sensing_uncertainty, "m; Z_d, >= 0"));
+    a->Visit(IPLAN_NVP(robot_uncertainty, "m; Z_r, >= 0"));
+  }
 };
 
 /// S_s for a robot moving at v_r towards the person: with `directed`,
