@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/framework/node.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -39,24 +40,6 @@ struct Scenario {
   Eigen::Vector3d velocity;  // m/s
   double duration;           // s
 };
-
-// The person standing with the torso at `torso`, as perception publishes it.
-msg::HumanSkeleton SkeletonAt(const msg::Time& stamp, const Eigen::Vector3d& torso) {
-  msg::HumanSkeleton s;
-  s.header.stamp = stamp;
-  s.header.frame_id = "world";
-  s.body_id = 1;
-  s.confidence = 1;
-  const auto joints = Person(torso);
-  for (std::size_t j = 0; j < joints.size(); ++j) {
-    msg::HumanJoint h;
-    h.name = kJoints[j];
-    h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
-    h.confidence = 1;
-    s.joints.push_back(h);
-  }
-  return s;
-}
 
 // A one-action constant-velocity prediction from `torso`, 15 steps of 1/15 s,
 // sigma growing from 3 cm by 5 cm per second.
@@ -135,7 +118,7 @@ std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
       next_js += 20ms;
     }
     if (now >= next_skel) {
-      skel.Write(SkeletonAt(stamp, torso));
+      skel.Write(SkeletonMessage(stamp, kJoints, Person(torso), 1));
       next_skel += 33ms;
     }
     if (now >= next_pred) {

@@ -18,6 +18,7 @@
 
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -70,21 +71,6 @@ msg::HumanPrediction StandingPrediction(const msg::Time& stamp, const std::vecto
   }
   m.actions = {a};
   return m;
-}
-
-msg::HumanSkeleton SkeletonOf(const msg::Time& stamp, const std::vector<Eigen::Vector3d>& joints) {
-  msg::HumanSkeleton s;
-  s.header.stamp = stamp;
-  s.header.frame_id = "world";
-  s.confidence = 1;
-  for (std::size_t j = 0; j < joints.size(); ++j) {
-    msg::HumanJoint h;
-    h.name = kJoints[j];
-    h.position = {joints[j].x(), joints[j].y(), joints[j].z()};
-    h.confidence = 1;
-    s.joints.push_back(h);
-  }
-  return s;
 }
 
 // The test's subscriptions: trajectories until the outcome, outcomes, and the
@@ -195,7 +181,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
       const auto joints = PersonWithHandAt(hand);
       const msg::Time stamp = msg::Now();
       pred.Write(StandingPrediction(stamp, joints));
-      truth.Write(SkeletonOf(stamp, joints));
+      truth.Write(SkeletonMessage(stamp, kJoints, joints));
       next += 66ms;
     }
     node.SpinOnce(10ms);
