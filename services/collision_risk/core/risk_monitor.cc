@@ -168,7 +168,8 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
   const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
   r.human_speed = v_h_max;
   r.robot_speed = v_r_max;
-  r.protective_separation = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+  const double sp_undirected = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+  r.protective_separation = sp_undirected;
   if (!in.person) return;
   collision::CalcForwardKinematics(robot_, state_->second, &data_);
   const Eigen::Matrix3Xd& joints = skeletons_.back().second;
@@ -184,7 +185,7 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
       const Eigen::Vector3d delta = data_.p_WS.col(ki) - c;  // human -> robot
       const double centres = delta.norm();
       const double d = centres - robot_spheres[k].radius - human_radius;
-      double v_h = v_h_max, v_r = v_r_max, sp = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+      double v_h = v_h_max, v_r = v_r_max, sp = sp_undirected;
       if (s.directed) {
         // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
         const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
