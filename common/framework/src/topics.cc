@@ -13,8 +13,15 @@ Topic<msg::HumanSkeleton> HumanSkeleton() {
 Topic<msg::HumanSkeleton> HumanTruth() {
   return {"rt/iplan/sim/human_truth", Q::SensorStream(milliseconds(150), milliseconds(300)), {}, true};
 }
-Topic<msg::PointCloud2> Obstacles() {
-  return {"rt/iplan/obstacles", Q::SensorStream(milliseconds(1000), milliseconds(1000))};
+Topic<msg::PointCloud2> DepthPoints() {
+  // Any provider may publish clouds (the depth camera is swappable).
+  return {"rt/iplan/depth/points", Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
+Topic<msg::ObstacleArray> Obstacles() {
+  return {"rt/iplan/obstacles", Q::SensorStream(milliseconds(1000), milliseconds(1000)), {"iplan-cloud"}, true};
+}
+Topic<msg::HumanPoints> HumanPoints() {
+  return {"rt/iplan/human/points", Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-cloud"}, true};
 }
 Topic<msg::ActionBelief> ActionBelief() {
   return {"rt/iplan/human/action_belief", Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-intent"}};
@@ -63,7 +70,9 @@ std::vector<TopicDescription> All() {
   return {
       Describe(HumanSkeleton(), "tracked human skeletons (perception)"),
       Describe(HumanTruth(), "true pose of the simulated person (simulation only)"),
-      Describe(Obstacles(), "obstacle point cloud (perception)"),
+      Describe(DepthPoints(), "depth camera point cloud, sensor frame (perception or any camera driver)"),
+      Describe(Obstacles(), "static unknown obstacles as boxes (cloud)"),
+      Describe(HumanPoints(), "points of moving objects (people) with sensor noise (cloud)"),
       Describe(ActionBelief(), "probability of each human action (intent)"),
       Describe(HumanPrediction(), "predicted human motion, Gaussian mixture over actions (intent)"),
       Describe(JointStates(), "robot joint state (robot or simulator)"),

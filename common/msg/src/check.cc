@@ -176,6 +176,18 @@ std::optional<std::string> CheckSizes(const PointCloud2& m) {
   return std::nullopt;
 }
 
+std::optional<std::string> CheckSizes(const ObstacleArray& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.obstacles.size() > Limits::kObstacles) return Over("obstacles", m.obstacles.size(), Limits::kObstacles);
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSizes(const HumanPoints& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (m.points.size() > Limits::kHumanPoints) return Over("points", m.points.size(), Limits::kHumanPoints);
+  return std::nullopt;
+}
+
 std::optional<std::string> CheckSizes(const TaskCommand& m) {
   if (auto e = CheckSizes(m.header)) return e;
   if (auto e = CheckLength(m.task_name, Limits::kName, "task_name")) return e;
@@ -372,6 +384,28 @@ std::optional<std::string> CheckSemantics(const PointCloud2& m) {
   }
   for (const auto& f : m.fields) {
     if (f.datatype < 1 || f.datatype > 8) return "field '" + f.name + "' has datatype " + std::to_string(f.datatype);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSemantics(const ObstacleArray& m) {
+  if (auto e = CheckSemantics(m.header)) return e;
+  for (std::size_t i = 0; i < m.obstacles.size(); ++i) {
+    const Obstacle& o = m.obstacles[i];
+    if (o.id == 0) return "obstacles[" + std::to_string(i) + "].id is 0";
+    for (double h : o.half_extents) {
+      if (h < 0) return "obstacles[" + std::to_string(i) + "].half_extents has " + Num(h);
+    }
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSemantics(const HumanPoints& m) {
+  if (auto e = CheckSemantics(m.header)) return e;
+  if (m.voxel_size < 0) return "voxel_size " + Num(m.voxel_size) + " is negative";
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    auto path = [i] { return "points[" + std::to_string(i) + "].covariance"; };
+    if (auto e = CheckCovariance(m.points[i].covariance, path)) return e;
   }
   return std::nullopt;
 }

@@ -120,7 +120,7 @@ struct CellBridge::Impl {
       EmitScene(scene->Prediction(m));
     });
     SceneInput(topics::RobotTrajectory(), [this](const msg::JointTrajectory& m) { EmitScene(scene->Trajectory(m)); });
-    SceneInput(topics::Obstacles(), [this](const msg::PointCloud2& m) {
+    SceneInput(topics::DepthPoints(), [this](const msg::PointCloud2& m) {
       if (Clock::now() < next_cloud) return;
       next_cloud = Clock::now() + std::chrono::milliseconds(200);
       EmitScene(scene->Obstacles(m));

@@ -40,8 +40,15 @@ namespace topics {
 Topic<msg::HumanSkeleton> HumanSkeleton();
 /// The simulated person's true pose (simulation only; contact counting).
 Topic<msg::HumanSkeleton> HumanTruth();
-/// Obstacle point cloud from perception.
-Topic<msg::PointCloud2> Obstacles();
+/// Depth camera points (30 Hz nominal) from any provider: perception's
+/// simulated camera or PCD replay, or a ROS 2 camera driver. Frame: the
+/// sensor's (header.frame_id); the cloud stage knows its pose in the cell.
+Topic<msg::PointCloud2> DepthPoints();
+/// Static unknown obstacles (boxes, cell frame) the cloud stage found.
+Topic<msg::ObstacleArray> Obstacles();
+/// Points of moving objects (people) the cloud stage found, each with the
+/// sensor's noise covariance (cell frame).
+Topic<msg::HumanPoints> HumanPoints();
 /// p(action | motion) from intent, one per skeleton.
 Topic<msg::ActionBelief> ActionBelief();
 /// Predicted human motion mixture from intent, one per skeleton.

@@ -52,6 +52,10 @@ struct Limits {
   static constexpr std::size_t kCloudFields = 32;
   static constexpr std::size_t kCloudBytes = std::size_t{64} << 20;  ///< data, 64 MiB
 
+  // ObstacleArray and HumanPoints.
+  static constexpr std::size_t kObstacles = 256;        ///< boxes per array
+  static constexpr std::size_t kHumanPoints = 65536;    ///< a person on a 1 cm grid has ~20,000
+
   // DiagnosticArray.
   static constexpr std::size_t kDiagnosticStatuses = 64;   ///< status entries per array
   static constexpr std::size_t kDiagnosticValues = 256;    ///< values per status (a node sends ~5 per topic)
@@ -75,6 +79,8 @@ std::optional<std::string> CheckSizes(const HumanPrediction& m);
 std::optional<std::string> CheckSizes(const JointState& m);
 std::optional<std::string> CheckSizes(const JointTrajectory& m);
 std::optional<std::string> CheckSizes(const PointCloud2& m);
+std::optional<std::string> CheckSizes(const ObstacleArray& m);
+std::optional<std::string> CheckSizes(const HumanPoints& m);
 std::optional<std::string> CheckSizes(const TaskCommand& m);
 std::optional<std::string> CheckSizes(const TaskOutcome& m);
 std::optional<std::string> CheckSizes(const PlanStatus& m);
@@ -98,6 +104,8 @@ std::optional<std::string> CheckSemantics(const HumanPrediction& m);
 std::optional<std::string> CheckSemantics(const JointState& m);
 std::optional<std::string> CheckSemantics(const JointTrajectory& m);
 std::optional<std::string> CheckSemantics(const PointCloud2& m);
+std::optional<std::string> CheckSemantics(const ObstacleArray& m);
+std::optional<std::string> CheckSemantics(const HumanPoints& m);
 std::optional<std::string> CheckSemantics(const TaskCommand& m);
 std::optional<std::string> CheckSemantics(const TaskOutcome& m);
 std::optional<std::string> CheckSemantics(const PlanStatus& m);
