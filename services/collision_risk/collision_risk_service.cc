@@ -59,7 +59,7 @@ class CollisionRiskService : public framework::Service {
                        names.push_back(j.name);
                        p.emplace_back(j.position.x, j.position.y, j.position.z);
                      }
-                     node.CountRejection("skeleton", monitor_->UpdateSkeleton(msg::ToNanoseconds(m.header.stamp), names, p));
+                     node.CountRejection("skeleton", monitor_->UpdateSkeleton(m.body_id, msg::ToNanoseconds(m.header.stamp), names, p));
                    }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
@@ -86,7 +86,7 @@ class CollisionRiskService : public framework::Service {
  private:
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {
     const PredictionInput in = services::ToJointMixture(m);
-    const auto rejection = monitor_->UpdatePrediction(in);
+    const auto rejection = monitor_->UpdatePrediction(m.body_id, in);
     node.CountRejection("prediction", rejection);
     if (!rejection) Publish(node, msg::ToNanoseconds(msg::Now()));
   }

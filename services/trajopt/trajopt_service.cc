@@ -45,7 +45,7 @@ class TrajoptService : public framework::Service {
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      if (!use_prediction_) return;
-                     const auto why = replanner_->UpdatePrediction(services::ToJointMixture(m));
+                     const auto why = replanner_->UpdatePrediction(m.body_id, services::ToJointMixture(m));
                      node.CountRejection("prediction", why);
                      if (why) return;
                      latest_prediction_ = {msg::ToNanoseconds(m.observation_stamp), msg::ToNanoseconds(m.header.stamp)};
