@@ -347,6 +347,10 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   }
   const double margin = r.separation_margin.value_or(std::numeric_limits<double>::infinity());
   const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
+  // With several people the reason names the person (nothing added for one).
+  const std::string nearest = r.num_people > 1 ? " (body " + std::to_string(r.binding_body_id) + ")" : "";
+  const std::string likeliest =
+      r.num_predicted > 1 ? " (body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted) + ")" : "";
   if (!in.person && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = last_skeleton_ns_ == 0 ? "no person tracked yet (no skeleton): the person could be anywhere"
@@ -364,14 +368,15 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                (r.num_predicted > 1 ? ", body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted) : "") + ")";
   } else if (first_violation >= 0) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s";
+    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s" +
+               likeliest;
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
+    r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold) + likeliest;
   } else if (in.person && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
-               " m of the protective separation";
+               " m of the protective separation" + nearest;
   } else {
     r.verdict = Verdict::kOk;
     r.reason = !in.person    ? "no person seen"
