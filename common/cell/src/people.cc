@@ -10,12 +10,4 @@ double UnionBound(const std::vector<double>& per_person) {
   return std::min(1.0, sum);
 }
 
-Separation MinSeparation(const std::vector<Separation>& per_person) {
-  Separation best;
-  for (const Separation& s : per_person) {
-    if (s && (!best || *s < *best)) best = s;
-  }
-  return best;
-}
-
 }  // namespace iplan::cell

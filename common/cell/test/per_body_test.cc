@@ -75,13 +75,5 @@ TEST(UnionBound, IsTheSumOfThePersonsBoundsCappedAtOne) {
   EXPECT_DOUBLE_EQ(UnionBound({0.1, 0.0, 0.2, 0.05}), 0.35);
 }
 
-TEST(MinSeparation, IsTheSmallestOfThePersonsSeen) {
-  EXPECT_FALSE(MinSeparation({}));
-  EXPECT_FALSE(MinSeparation({std::nullopt, std::nullopt}));
-  EXPECT_DOUBLE_EQ(*MinSeparation({1.4, 0.35}), 0.35);
-  EXPECT_DOUBLE_EQ(*MinSeparation({std::nullopt, 0.8, 1.2}), 0.8);
-  EXPECT_DOUBLE_EQ(*MinSeparation({-0.05, 0.8}), -0.05);  // overlapping: negative
-}
-
 }  // namespace
 }  // namespace iplan::cell

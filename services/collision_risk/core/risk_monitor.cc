@@ -292,8 +292,9 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data_.p_WS;
     r.waypoint_times.push_back((times[w] - now_ns) * 1e-9);
   }
-  // Per waypoint: the sum over persons (raw, for the argmax) and the person
-  // with the largest share.
+  // Per waypoint: each person's bound, their sum (raw, for the argmax) and
+  // the person with the largest share.
+  std::vector<std::vector<double>> shares(traj.steps.size());
   std::vector<double> sum(traj.steps.size(), 0.0), share(traj.steps.size(), -1.0);
   std::vector<collision::WaypointBound> top(traj.steps.size());
   std::vector<cell::BodyId> top_body(traj.steps.size(), 0);
@@ -309,6 +310,7 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     }
     collision::EvaluateTrajectoryBound(p.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
     for (std::size_t w = 0; w < bounds_.size(); ++w) {
+      shares[w].push_back(bounds_[w].bound);
       sum[w] += bounds_[w].bound;
       if (bounds_[w].bound > share[w]) {
         share[w] = bounds_[w].bound;
@@ -320,9 +322,9 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
   }
   for (std::size_t w = 0; w < sum.size(); ++w) {
     const auto& b = top[w];
-    r.waypoint_bounds.push_back(cell::UnionBound({sum[w]}));
+    r.waypoint_bounds.push_back(cell::UnionBound(shares[w]));
     if (w == 0 || sum[w] > r.max_bound) {
-      r.max_bound = cell::UnionBound({sum[w]});
+      r.max_bound = r.waypoint_bounds[w];
       r.max_waypoint = static_cast<int>(w);
       r.max_time = r.waypoint_times[w];
       r.max_body_id = top_body[w];

@@ -182,8 +182,9 @@ class RiskMonitor {
   using SkeletonHistory = std::deque<std::pair<int64_t, Eigen::Matrix3Xd>>;
   /// The binding and closest sphere pairs over the persons so far.
   struct SeparationSearch;
-  /// One person's sphere pairs into `search`.
-  void SearchPerson(const SkeletonHistory& history, bool measured, const Eigen::Matrix3Xd& v_robot,
+  /// One person's sphere pairs into `search`; `may_measure` false: the
+  /// person is taken at the default speed (no fresh prediction, degraded).
+  void SearchPerson(const SkeletonHistory& history, bool may_measure, const Eigen::Matrix3Xd& v_robot,
                     SeparationSearch* search, RiskReport* r) const;
   /// Per-joint velocity (m/s, 3 x joints) over the speed window; false when
   /// not measured (measure_human_speed off or too little history).

@@ -10,8 +10,8 @@
 //    max_bodies are kept (a further body is refused, not an old one evicted).
 //  - UnionBound: P(contact with anyone) <= sum over persons of each person's
 //    bound (METHOD 4 per person, Boole's inequality over persons), capped at 1.
-//  - MinSeparation: ISO/TS 15066 separation of the cell is the smallest over
-//    the persons seen (nullopt: nobody).
+//  The ISO/TS 15066 separation of the cell is the nearest person's: the
+//  monitor searches every person's sphere pairs (risk_monitor.h).
 //
 // Stamps are ns since the epoch (wall clock). Not thread-safe.
 #pragma once
@@ -24,7 +24,6 @@
 #include <utility>
 #include <vector>
 
-#include "iplan/cell/ssm.h"
 
 namespace iplan::cell {
 
@@ -122,9 +121,5 @@ class PerBody {
 /// Upper bound of P(contact with any person) from each person's bound at the
 /// same waypoint: min(1, sum). 0 for nobody.
 double UnionBound(const std::vector<double>& per_person);
-
-/// The cell's separation: the smallest of the persons' (nullopt entries are
-/// persons without a measurement); nullopt when nobody has one.
-Separation MinSeparation(const std::vector<Separation>& per_person);
 
 }  // namespace iplan::cell
