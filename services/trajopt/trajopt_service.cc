@@ -208,6 +208,7 @@ class TrajoptService : public framework::Service {
       last_status_ = r.status;
     }
     node.SetDiagnosticValue("status", r.status);
+    if (r.planning_time > 0) node.SetDiagnosticValue("people", std::to_string(r.num_people));
     if (r.budget_exhausted) node.SetDiagnosticValue("budget_exhausted_cycles", std::to_string(++budget_exhausted_));
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }

@@ -20,6 +20,7 @@ using namespace std::chrono_literals;
 struct Observed {
   std::vector<msg::CollisionRisk> risks;
   std::set<uint32_t> predicted_bodies;
+  std::string people;  // collision_risk's diagnostics value "people"
 };
 
 // Starts the partial cell with `people` (the --set value of more_people) and
@@ -59,6 +60,7 @@ Observed RunCell(const std::string& tag, const std::string& people) {
   cell.Start("intent");
   EXPECT_TRUE(cell.SpinUntil([&] { return recording; }, 30s)) << cell.Logs("collision_risk") << cell.Logs("intent");
   cell.SpinFor(4s);
+  o.people = cell.Diag("collision_risk", "people");
   return o;
 }
 
@@ -81,6 +83,7 @@ TEST(People, ASecondPersonCloseToTheRobotStopsItThoughTheFirstIsFarAway) {
   const Observed one = RunCell("one", "[]");
   ASSERT_GT(one.risks.size(), 20u);
   EXPECT_EQ(one.predicted_bodies, (std::set<uint32_t>{1}));
+  EXPECT_EQ(one.people, "1 seen, 1 predicted");
   // Alone and far, the person lets the robot move: no stop, at most a slow-down.
   std::string reasons;
   EXPECT_EQ(Count(one.risks, msg::CollisionRisk::PROTECTIVE_STOP, &reasons), 0) << reasons;
@@ -90,6 +93,7 @@ TEST(People, ASecondPersonCloseToTheRobotStopsItThoughTheFirstIsFarAway) {
   const Observed two = RunCell("two", "[{torso: [0.62, 0.0, 0.25], seed: 5}]");
   ASSERT_GT(two.risks.size(), 20u);
   EXPECT_EQ(two.predicted_bodies, (std::set<uint32_t>{1, 2})) << "intent predicts each body";
+  EXPECT_EQ(two.people, "2 seen, 2 predicted");
   // After the first second every evaluation stops the robot, because of body 2.
   int late = 0, stops = 0, naming = 0;
   const int64_t first = msg::ToNanoseconds(two.risks.front().header.stamp);
