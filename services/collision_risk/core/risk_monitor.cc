@@ -286,6 +286,7 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     traj.steps.push_back(k);
     times.push_back(m.StepTime(k));
   }
+  const std::vector<int> ref_steps = traj.steps;
   traj.centres.resize(3, static_cast<Eigen::Index>(traj.steps.size()) * S);
   for (std::size_t w = 0; w < traj.steps.size(); ++w) {
     collision::CalcForwardKinematics(robot_, RobotConfigurationAt(times[w]), &data_);
@@ -302,11 +303,9 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
   for (const auto& [id, e] : predictions_) {
     const cell::TimedPrediction& p = e.value;
     if (!p.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9))) continue;
-    if (&p != ref) {  // its step nearest to each waypoint's time
-      for (std::size_t w = 0; w < times.size(); ++w) {
-        const double k = std::round((times[w] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
-        traj.steps[w] = static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
-      }
+    for (std::size_t w = 0; w < times.size(); ++w) {  // its step nearest to each waypoint's time
+      const double k = std::round((times[w] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
+      traj.steps[w] = &p == ref ? ref_steps[w] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
     }
     collision::EvaluateTrajectoryBound(p.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
     for (std::size_t w = 0; w < bounds_.size(); ++w) {

@@ -372,21 +372,21 @@ TEST_F(RiskMonitorPeopleTest, BoundIsTheSumOfEachPersonsBoundCappedAtOne) {
 }
 
 TEST_F(RiskMonitorPeopleTest, AnOlderPredictionIsTakenAtItsStepNearestToEachWaypoint) {
-  // Person 2's prediction is one step (0.1 s) older than person 1's: the
-  // waypoints are person 1's (t + (w + 1) 0.1 s), where person 2's step w + 1
+  // Body 1's prediction is one step (0.1 s) older than body 2's: the
+  // waypoints are body 2's (t + (w + 1) 0.1 s), where body 1's step w + 1
   // falls (its last step beyond its end).
   const int64_t t = 100 * kSec;
   const Eigen::Vector3d a(1.6, 0.25, 0.55), va(-0.6, 0, 0), b(1.8, -0.3, 0.6), vb(-0.5, 0.1, 0);
   RiskMonitor only_b = Make(), both = Make();
   for (RiskMonitor* m : {&only_b, &both}) Ready(m, t);
-  Add(&both, 1, t, a, va);
+  Add(&both, 2, t, a, va);
   for (RiskMonitor* m : {&only_b, &both}) {
-    ASSERT_EQ(m->UpdateSkeleton(2, t, kJoints, Person(b)), std::nullopt);
-    ASSERT_EQ(m->UpdatePrediction(2, Predict(t - kSec / 10, b - vb * 0.1, vb, 30, 0.1)), std::nullopt);
+    ASSERT_EQ(m->UpdateSkeleton(1, t, kJoints, Person(b)), std::nullopt);
+    ASSERT_EQ(m->UpdatePrediction(1, Predict(t - kSec / 10, b - vb * 0.1, vb, 30, 0.1)), std::nullopt);
   }
   RiskMonitor only_a = Make();
   Ready(&only_a, t);
-  Add(&only_a, 1, t, a, va);
+  Add(&only_a, 2, t, a, va);
   const RiskReport ra = only_a.Evaluate(t), rb = only_b.Evaluate(t), r = both.Evaluate(t);
   EXPECT_EQ(r.prediction_stamp_ns, t) << "the newest prediction gives the waypoints";
   ASSERT_EQ(r.waypoint_bounds.size(), 30u);
