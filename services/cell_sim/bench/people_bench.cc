@@ -131,8 +131,8 @@ void BM_Intent(benchmark::State& state) {
   for (auto _ : state) {
     timing.Start();
     for (int b = 0; b < n; ++b) {
-      const intent_service::SkeletonFrame frame{static_cast<uint32_t>(b + 1), k / kRate,
-                                                s.frames[static_cast<std::size_t>(b)][static_cast<std::size_t>(k % kFrames)]};
+      const auto& joints = s.frames[static_cast<std::size_t>(b)][static_cast<std::size_t>(k % kFrames)];
+      const intent_service::SkeletonFrame frame{static_cast<uint32_t>(b + 1), static_cast<double>(k) / kRate, joints};
       if (!estimator.Update(frame, &out).accepted()) state.SkipWithError("frame rejected");
     }
     timing.Stop();

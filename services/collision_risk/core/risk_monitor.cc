@@ -305,7 +305,8 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     if (!p.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9))) continue;
     for (std::size_t w = 0; w < times.size(); ++w) {  // its step nearest to each waypoint's time
       const double k = std::round((times[w] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
-      traj.steps[w] = &p == ref ? ref_steps[w] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
+      traj.steps[w] =
+          &p == ref ? ref_steps[w] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
     }
     collision::EvaluateTrajectoryBound(p.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
     for (std::size_t w = 0; w < bounds_.size(); ++w) {
@@ -350,8 +351,9 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
   // With several people the reason names the person (nothing added for one).
   const std::string nearest = r.num_people > 1 ? " (body " + std::to_string(r.binding_body_id) + ")" : "";
-  const std::string likeliest =
-      r.num_predicted > 1 ? " (body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted) + ")" : "";
+  const std::string likeliest = r.num_predicted > 1 ? " (body " + std::to_string(r.max_body_id) + " of " +
+                                                          std::to_string(r.num_predicted) + ")"
+                                                    : "";
   if (!in.person && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = last_skeleton_ns_ == 0 ? "no person tracked yet (no skeleton): the person could be anywhere"
@@ -360,13 +362,16 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   } else if (in.person && margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
-               (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") + ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
+               (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") +
+               ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
                ", v_r " + Fmt(r.robot_speed) + " m/s)";
   } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) +
                " s (" + r.max_robot_link + " / " + r.max_human_segment + ", " + r.max_action +
-               (r.num_predicted > 1 ? ", body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted) : "") + ")";
+               (r.num_predicted > 1 ? ", body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted)
+                                    : "") +
+               ")";
   } else if (first_violation >= 0) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s" +

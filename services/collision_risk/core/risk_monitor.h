@@ -143,7 +143,8 @@ class RiskMonitor {
                                               const std::vector<double>& times,
                                               const std::vector<std::vector<double>>& positions);
   /// One person's skeleton (refused when not after that body's previous one).
-  std::optional<std::string> UpdateSkeleton(cell::BodyId body_id, int64_t stamp_ns, const std::vector<std::string>& names,
+  std::optional<std::string> UpdateSkeleton(cell::BodyId body_id, int64_t stamp_ns,
+                                            const std::vector<std::string>& names,
                                             const std::vector<Eigen::Vector3d>& positions);
   /// One person's prediction: replaces that body's, when its observation
   /// (t0) is newer.
