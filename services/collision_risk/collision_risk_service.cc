@@ -59,7 +59,7 @@ class CollisionRiskService : public framework::Service {
                        names.push_back(j.name);
                        p.emplace_back(j.position.x, j.position.y, j.position.z);
                      }
-                     node.CountRejection("skeleton", monitor_->UpdateSkeleton(msg::ToNanoseconds(m.header.stamp), names, p));
+                     node.CountRejection("skeleton", monitor_->UpdateSkeleton(m.body_id, msg::ToNanoseconds(m.header.stamp), names, p));
                    }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
@@ -86,7 +86,7 @@ class CollisionRiskService : public framework::Service {
  private:
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {
     const PredictionInput in = services::ToJointMixture(m);
-    const auto rejection = monitor_->UpdatePrediction(in);
+    const auto rejection = monitor_->UpdatePrediction(m.body_id, in);
     node.CountRejection("prediction", rejection);
     if (!rejection) Publish(node, msg::ToNanoseconds(msg::Now()));
   }
@@ -125,6 +125,12 @@ class CollisionRiskService : public framework::Service {
     permit_writer_->Write(p);
     last_publish_ns_ = now_ns;
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+    if (r.num_people != last_people_ || r.num_predicted != last_predicted_) {
+      last_people_ = r.num_people;
+      last_predicted_ = r.num_predicted;
+      node.SetDiagnosticValue("people", std::to_string(r.num_people) + " seen, " + std::to_string(r.num_predicted) +
+                                            " predicted");
+    }
     if (r.verdict != last_verdict_) {
       node.log().info("verdict {}: {}", ToString(r.verdict), r.reason);
       last_verdict_ = r.verdict;
@@ -141,6 +147,7 @@ class CollisionRiskService : public framework::Service {
   int timer_ = 0;
   int64_t last_publish_ns_ = 0;
   Verdict last_verdict_ = Verdict::kOk;
+  int last_people_ = -1, last_predicted_ = -1;  // persons in the last evaluation (diagnostics)
 };
 
 }  // namespace

@@ -4,6 +4,7 @@
 // recorded times (core/skeleton_replay.h).
 #include <chrono>
 #include <filesystem>
+#include <vector>
 
 #include "core/skeleton_replay.h"
 #include "iplan/framework/service.h"
@@ -25,14 +26,18 @@ class PerceptionService : public framework::Service {
     config.Read("publish_truth", &publish_truth_);
     start_ = std::chrono::system_clock::now();
     ConfigSection syn = config.Section("synthetic");
-    params_ = ReadSyntheticPerson(syn, &script_start_);
+    std::vector<SyntheticPersonParams> others;
+    params_ = ReadSyntheticPerson(syn, &script_start_, &others);
     if (Result r = ConfigureReplay(config); !r.ok) return r;
     if (provider_ == "synthetic") {
       try {
-        person_ = std::make_unique<SyntheticPerson>(params_);
+        // Body 1 is the first person, bodies 2, 3, ... perception.synthetic.more_people.
+        people_.push_back(std::make_unique<SyntheticPerson>(params_));
+        for (const SyntheticPersonParams& p : others) people_.push_back(std::make_unique<SyntheticPerson>(p));
       } catch (const std::exception& e) {
         return Result::Fail(config.file() + ": key 'perception.synthetic': " + e.what());
       }
+      node.SetDiagnosticValue("people", std::to_string(people_.size()));
       if (script_start_ == ScriptStart::kEpisodes) {
         // The person starts their part of the task with each episode.
         using SI = const dds::SampleInfo&;
@@ -40,7 +45,7 @@ class PerceptionService : public framework::Service {
                        std::function<void(const msg::TaskCommand&, SI)>([this, &node](const msg::TaskCommand& m, SI) {
                          if (m.command != msg::TaskCommand::START || m.episode == 0 || m.episode == episode_) return;
                          episode_ = m.episode;
-                         person_->StartScript(Seconds());
+                         for (auto& person : people_) person->StartScript(Seconds());
                          node.log().info("episode {}: the person starts their script", episode_);
                        }),
                        framework::SubscribeOptions{false});
@@ -171,14 +176,17 @@ class PerceptionService : public framework::Service {
     const auto tick_start = std::chrono::steady_clock::now();
     const double t = Seconds();
     const msg::Time stamp = msg::Now();
-    std::string err;
-    if (!skeleton_writer_->Write(ToMessage(person_->Observe(t), stamp), &err)) {
-      node.log().warn("skeleton not published: {}", err);
+    for (std::size_t i = 0; i < people_.size(); ++i) {
+      const uint32_t body_id = static_cast<uint32_t>(i + 1);
+      std::string err;
+      if (!skeleton_writer_->Write(ToMessage(people_[i]->Observe(t), stamp, body_id), &err)) {
+        node.log().warn("skeleton of body {} not published: {}", body_id, err);
+      }
+      if (truth_writer_) truth_writer_->Write(ToMessage(people_[i]->TruePose(t), stamp, body_id));
+      ++published_;
     }
-    if (truth_writer_) truth_writer_->Write(ToMessage(person_->TruePose(t), stamp));
-    ++published_;
     node.SetDiagnosticValue("published", std::to_string(published_));
-    const std::string& action = person_->ActionAt(t);
+    const std::string& action = people_.front()->ActionAt(t);
     if (action != action_) {
       action_ = action;
       node.SetDiagnosticValue("action", action_);  // the simulated person's true action
@@ -191,7 +199,7 @@ class PerceptionService : public framework::Service {
   std::string frame_id_ = "world";
   bool publish_truth_ = false;
   SyntheticPersonParams params_;
-  std::unique_ptr<SyntheticPerson> person_;
+  std::vector<std::unique_ptr<SyntheticPerson>> people_;  // body i + 1
   ScriptStart script_start_ = ScriptStart::kLoop;
   uint32_t episode_ = 0;
   std::string action_;

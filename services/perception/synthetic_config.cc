@@ -7,9 +7,29 @@ std::string Three(const std::vector<double>& v) {
   return v.size() == 3 ? std::string() : "must have 3 numbers (x, y, z in m)";
 }
 
+// The further persons: the first person's parameters with their own pose and seed.
+std::vector<SyntheticPersonParams> ReadMorePeople(framework::ConfigSection& syn, const SyntheticPersonParams& first) {
+  std::vector<SyntheticPersonParams> out;
+  if (!syn.Has("more_people")) return out;
+  std::vector<framework::ConfigSection> people = syn.Elements("more_people");
+  for (std::size_t i = 0; i < people.size(); ++i) {
+    framework::ConfigSection& e = people[i];
+    SyntheticPersonParams p = first;
+    std::vector<double> torso = {p.torso_W.x(), p.torso_W.y(), p.torso_W.z()};
+    if (e.Read("torso", &torso, framework::Check<std::vector<double>>(Three))) p.torso_W = {torso[0], torso[1], torso[2]};
+    e.Read("facing_yaw", &p.facing_yaw);
+    int seed = static_cast<int>(first.seed + i + 1);
+    e.Read("seed", &seed, framework::NonNegative<int>());
+    p.seed = static_cast<uint64_t>(seed);
+    out.push_back(p);
+  }
+  return out;
+}
+
 }  // namespace
 
-SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& syn, ScriptStart* start) {
+SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& syn, ScriptStart* start,
+                                          std::vector<SyntheticPersonParams>* others) {
   SyntheticPersonParams p;
   std::vector<double> torso = {p.torso_W.x(), p.torso_W.y(), p.torso_W.z()};
   if (syn.Read("torso", &torso, framework::Check<std::vector<double>>(Three))) p.torso_W = {torso[0], torso[1], torso[2]};
@@ -61,6 +81,8 @@ SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& syn, ScriptS
     for (size_t i = 0; i < script.size(); ++i) p.script.push_back({script[i], durations[i]});
   }
   if (const std::string why = p.Validate(); !why.empty() && !p.actions.empty()) syn.AddError("script", why);
+  std::vector<SyntheticPersonParams> more = ReadMorePeople(syn, p);
+  if (others) *others = std::move(more);
   return p;
 }
 

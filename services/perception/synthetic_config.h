@@ -16,7 +16,16 @@ enum class ScriptStart {
 
 /// Reads `section` (perception.synthetic) into params; problems are recorded
 /// in the configuration (reported by Finish()). Keys: torso, facing_yaw,
-/// noise_stddev, variation, transition, rest_hand, seed, start, actions, script, durations.
-SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& section, ScriptStart* start);
+/// noise_stddev, variation, transition, rest_hand, seed, start, actions, script,
+/// durations, more_people.
+///
+/// more_people: the further persons of the cell (bodies 2, 3, ...), a list
+/// of mappings with the keys torso (m, world frame), facing_yaw (rad) and
+/// seed, each defaulting to the first person's (seed: the first person's +
+/// the person's index); everything else (actions, script, noise) is the
+/// first person's. Default empty: one person. Into *others when not null
+/// (the keys are checked either way).
+SyntheticPersonParams ReadSyntheticPerson(framework::ConfigSection& section, ScriptStart* start,
+                                          std::vector<SyntheticPersonParams>* others = nullptr);
 
 }  // namespace iplan::perception

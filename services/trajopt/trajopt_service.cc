@@ -45,7 +45,7 @@ class TrajoptService : public framework::Service {
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      if (!use_prediction_) return;
-                     const auto why = replanner_->UpdatePrediction(services::ToJointMixture(m));
+                     const auto why = replanner_->UpdatePrediction(m.body_id, services::ToJointMixture(m));
                      node.CountRejection("prediction", why);
                      if (why) return;
                      latest_prediction_ = {msg::ToNanoseconds(m.observation_stamp), msg::ToNanoseconds(m.header.stamp)};
@@ -208,6 +208,7 @@ class TrajoptService : public framework::Service {
       last_status_ = r.status;
     }
     node.SetDiagnosticValue("status", r.status);
+    if (r.planning_time > 0) node.SetDiagnosticValue("people", std::to_string(r.num_people));
     if (r.budget_exhausted) node.SetDiagnosticValue("budget_exhausted_cycles", std::to_string(++budget_exhausted_));
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }

@@ -55,9 +55,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
           o.human.empty() ? collision::HumanBodyParams::DefaultUpperBody()
                           : collision::LoadHumanBodyParams(o.human));
       pred = LoadPredictionFile(o.prediction, *body);
-      req.prediction = pred.prediction.get();
-      req.prediction_dt = pred.dt;
-      req.prediction_start = pred.start_time;
+      req.people = {{pred.prediction.get(), pred.dt, pred.start_time}};
     }
     const PlanningResult r = planner.Plan(req);
     if (o.json) {

@@ -242,9 +242,7 @@ void RunReplanning(const Planner& replanner, const std::vector<Problem>& problem
     bool task_ok = true;
     for (int k = 0; k < cycles_per_task; ++k) {
       const collision::HumanPrediction pred = make(k);
-      req.prediction = &pred;
-      req.prediction_dt = 0.1;
-      req.prediction_start = 0.0;
+      req.people = {{&pred, 0.1, 0.0}};
       if (k > 0 && prev.positions.cols() > 1) {
         req.warm_start = Planner::ShiftTrajectory(prev.positions, prev.dt, 0.1);
         req.start_q = req.warm_start.col(0);

@@ -22,8 +22,8 @@ void PlannerModel::Evaluate(const Problem& at, const Eigen::MatrixXd& Q, Workspa
   // Forward kinematics of the free waypoints (the only ones the costs use).
   for (int i = at.k; i < at.n; ++i) collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
   AddObstacleCost(at, ws, ev, G);
-  if (at.prediction) AddDynamicCost(at, ws, ev, G);
-  if (at.prediction && params.human_separation > 0.0) AddSeparationCost(at, ws, ev, G);
+  if (!at.people.empty()) AddDynamicCost(at, ws, ev, G);
+  if (!at.people.empty() && params.human_separation > 0.0) AddSeparationCost(at, ws, ev, G);
   ev->total = ev->smooth + ev->obstacle + ev->dynamic + ev->goal + ev->limits + ev->separation;
 }
 
@@ -123,14 +123,20 @@ void PlannerModel::AddObstacleCost(const Problem& at, Workspace* ws, CostTerms* 
 }
 
 // separation = w sum p(c) max(0, D - dist)^2: the keep-out from the means of
-// the likely actions (PlannerParams::human_separation = D).
+// the likely actions (PlannerParams::human_separation = D), summed over the
+// people.
 void PlannerModel::AddSeparationCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const {
-  const collision::HumanPrediction& hp = *at.prediction;
+  for (const Problem::Person& person : at.people) AddPersonSeparationCost(person, at, ws, ev, G);
+}
+
+void PlannerModel::AddPersonSeparationCost(const Problem::Person& person, const Problem& at, Workspace* ws,
+                                           CostTerms* ev, Eigen::MatrixXd* G) const {
+  const collision::HumanPrediction& hp = *person.prediction;
   const int H = hp.num_spheres();
   const double D = params.human_separation, w = params.weights.separation;
   for (int i = at.k; i < at.n; ++i) {
     const collision::RobotData& d = ws->data[i];
-    const int t = at.steps[i];
+    const int t = person.steps[i];
     for (std::size_t g = 0; g < link_groups.size(); ++g) {
       // A ball around the link's spheres first, as for the obstacles.
       Eigen::Vector3d c;

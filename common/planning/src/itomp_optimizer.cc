@@ -38,7 +38,7 @@ void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, 
   c->bounds.clear();
   c->max_bound = 0.0;
   c->first_unsafe = -1;
-  if (at.prediction) {
+  if (!at.people.empty()) {
     c->bounds = at.fixed_bounds;
     for (int i = at.k; i < at.n; ++i) c->bounds[i] = ev.bounds[i - at.k].bound;
     for (int i = at.k; i <= at.n; ++i) {

@@ -171,7 +171,7 @@ void DescribeFailure(const PlannerModel& M, const Problem& at, const Candidate& 
                      PlanningResult* result) {
   Fill(best, at.k, result);
   std::ostringstream s;
-  if (any_static && at.prediction) {
+  if (any_static && !at.people.empty()) {
     result->status = PlanStatus::kNoSafeTrajectory;
     s << "no trajectory kept the bound below " << M.Threshold() << " after " << result->num_waits
       << " waits; best max bound " << best.max_bound;
@@ -187,7 +187,7 @@ void DescribeFailure(const PlannerModel& M, const Problem& at, const Candidate& 
 // The optimisers' bounds below the dynamic cost's activation are upper
 // bounds (see AddDynamicCost); exact values for the returned trajectory.
 void ReportExactBounds(const PlannerModel& M, const Problem& at, PlanningResult* result) {
-  if (!at.prediction || result->positions.cols() != at.n + 1) return;
+  if (at.people.empty() || result->positions.cols() != at.n + 1) return;
   M.ExactBounds(at, result->positions, 0, at.n, &result->bounds);
   result->max_bound = 0.0;
   for (int i = at.k; i <= at.n; ++i) result->max_bound = std::max(result->max_bound, result->bounds[i]);
@@ -269,7 +269,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     have_fail = true;
     result.winning_optimizer = pick;
     // Waiting helps only against the person, and takes another attempt.
-    if (at.prediction == nullptr || result.num_waits >= P.max_waits || at.OutOfTime()) break;
+    if (at.people.empty() || result.num_waits >= P.max_waits || at.OutOfTime()) break;
     M.InsertWait(&at, sel.reference >= 0 ? &cands[sel.reference] : nullptr, wait_steps);
     ++result.num_waits;
     result.delay += wait_steps * P.dt;

@@ -57,13 +57,17 @@ struct Problem {
   Eigen::MatrixXd base;  // nq x (n+1) initial trajectory (frozen prefix, goal)
   Eigen::VectorXd qdot0, q_goal;
   Eigen::MatrixXd Hinv;  // m x m inverse smoothness Hessian (unweighted)
-  std::vector<int> steps;  // prediction step of each waypoint (planner.h)
-  const collision::HumanPrediction* prediction = nullptr;
+  // One predicted person: the prediction and the step of each waypoint (planner.h).
+  struct Person {
+    const collision::HumanPrediction* prediction = nullptr;
+    double dt = 0.1, start = 0.0;
+    std::vector<int> steps;
+  };
+  std::vector<Person> people;  // empty: nobody
   // Exact bounds of the waypoints no optimiser changes (the frozen prefix
   // 0..k-1 and the goal n; size n+1, free entries unused), computed once
   // per attempt by FixBounds.
   std::vector<double> fixed_bounds;
-  double prediction_dt = 0.1, prediction_start = 0.0;
   bool perturb_base = true;
   // Wall time at which the optimisers stop (PlanningRequest::time_budget);
   // time_point::max() without a budget.
@@ -82,7 +86,10 @@ struct Workspace {
   std::vector<collision::RobotData> data;
   std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
   Eigen::MatrixXd A, V, G;
-  std::vector<double> group_log_volume;  // [group * H + human sphere]
+  std::vector<std::vector<double>> group_log_volume;  // [person][group * H + human sphere]
+  std::vector<std::vector<collision::WaypointBound>> person_bounds;  // [person][free waypoint], several people
+  std::vector<double> shares;            // [person]: one waypoint's bounds
+  std::vector<double> culled_log_bound;  // [free waypoint]: log of the level-1 bound (FindActiveWaypoints)
   std::vector<int> active;               // free waypoints passed to the bound
   std::vector<char> group_needed;        // link groups passed to the bound
   std::vector<char> far;                 // [group * objects + object]: beyond the margin
@@ -180,13 +187,19 @@ struct PlannerModel {
   void AddObstacleCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
   void AddDynamicCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
   void AddSeparationCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
+  void AddPersonSeparationCost(const Problem::Person& person, const Problem& at, Workspace* ws, CostTerms* ev,
+                               Eigen::MatrixXd* G) const;
   // The dynamic term's parts: waypoints whose bound may exceed its
   // activation, their bounds, and the gradient at one waypoint.
-  void FindActiveWaypoints(const Problem& at, double log_negligible, Workspace* ws) const;
-  void EvaluateActiveBounds(const Problem& at, const collision::TrajectoryBoundParams& bp, Workspace* ws,
-                            CostTerms* ev) const;
-  void AddBoundGradient(const Problem& at, int i, const collision::WaypointBound& wb, double scale,
+  // Each for one person `p`; the person's bounds of the free waypoints into *out.
+  void FindActiveWaypoints(const Problem& at, int p, double log_negligible, Workspace* ws) const;
+  void EvaluateActiveBounds(const Problem& at, int p, const collision::TrajectoryBoundParams& bp, Workspace* ws,
+                            std::vector<collision::WaypointBound>* out) const;
+  void AddBoundGradient(const Problem& at, int p, int i, const collision::WaypointBound& wb, double scale,
                         Workspace* ws, Eigen::MatrixXd* G) const;
+  // The union over persons of ws->person_bounds into *out (the largest
+  // share's pair and action, exact only when every share is).
+  void CombineBounds(const Problem& at, Workspace* ws, std::vector<collision::WaypointBound>* out) const;
 
   // --- itomp_optimizer.cc ----------------------------------------------------
   void Project(const Problem& at, Eigen::MatrixXd* Q) const;

@@ -8,6 +8,7 @@
 #include <Eigen/Cholesky>
 
 #include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/people.h"
 #include "planner_model.h"
 
 namespace iplan::planning::internal {
@@ -41,11 +42,12 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
   }
   if (req.num_frozen > 1 && req.warm_start.cols() < req.num_frozen)
     Bad("num_frozen = " + std::to_string(req.num_frozen) + " needs a warm_start with as many columns");
-  if (req.prediction) {
-    if (!(req.prediction_dt > 0.0) || !std::isfinite(req.prediction_dt))
-      Bad("prediction_dt must be > 0, got " + std::to_string(req.prediction_dt));
-    if (!std::isfinite(req.prediction_start))
-      Bad("prediction_start must be finite, got " + std::to_string(req.prediction_start));
+  for (std::size_t p = 0; p < req.people.size(); ++p) {
+    const PersonPrediction& person = req.people[p];
+    const std::string who = "person " + std::to_string(p) + ": ";
+    if (!person.spheres) Bad(who + "prediction is null");
+    if (!(person.dt > 0.0) || !std::isfinite(person.dt)) Bad(who + "dt must be > 0, got " + std::to_string(person.dt));
+    if (!std::isfinite(person.start)) Bad(who + "start must be finite, got " + std::to_string(person.start));
   }
   if (!(req.time_budget >= 0.0) || !std::isfinite(req.time_budget))
     Bad("time_budget must be finite and >= 0, got " + std::to_string(req.time_budget));
@@ -90,9 +92,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
         std::to_string(at.n) + " intervals");
   at.qdot0 = req.start_qdot.size() != 0 ? req.start_qdot : Eigen::VectorXd::Zero(nq);
   at.q_goal = q_goal;
-  at.prediction = req.prediction;
-  at.prediction_dt = req.prediction_dt;
-  at.prediction_start = req.prediction_start;
+  for (const PersonPrediction& person : req.people) at.people.push_back({person.spheres, person.dt, person.start, {}});
   at.base.resize(nq, at.n + 1);
   if (warm && stretched) {
     // The frozen prefix, then straight to the goal over the stretched time.
@@ -158,19 +158,20 @@ void PlannerModel::BuildSmoothness(Problem* at) const {
 }
 
 void PlannerModel::SetSteps(Problem* at) const {
-  at->steps.assign(at->n + 1, 0);
-  if (!at->prediction) return;
-  const int last = at->prediction->num_steps() - 1;
-  for (int i = 0; i <= at->n; ++i) {
-    const double s = std::round((i * at->dt - at->prediction_start) / at->prediction_dt);
-    at->steps[i] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(last)));
+  for (Problem::Person& person : at->people) {
+    person.steps.assign(at->n + 1, 0);
+    const int last = person.prediction->num_steps() - 1;
+    for (int i = 0; i <= at->n; ++i) {
+      const double s = std::round((i * at->dt - person.start) / person.dt);
+      person.steps[i] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(last)));
+    }
   }
 }
 
 void PlannerModel::PrepareWorkspace(const Problem& at, Workspace* ws) const {
   const int W = at.n + 1;
   while (static_cast<int>(ws->data.size()) < W) ws->data.emplace_back(robot);
-  if (at.prediction == nullptr) return;
+  if (at.people.empty()) return;
   // Only the free waypoints k..n-1 are evaluated: the others never change
   // (FixBounds).
   ws->sub.centres.resize(3, static_cast<Eigen::Index>(at.n - at.k) * radii.size());
@@ -180,16 +181,21 @@ void PlannerModel::PrepareWorkspace(const Problem& at, Workspace* ws) const {
   ws->sub_spheres.reserve(radii.size());
   ws->active.reserve(at.n - at.k);
   ws->active_bounds.reserve(at.n - at.k);
-  if (!ws->bound_ws)
-    ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(static_cast<int>(radii.size()),
-                                                                         at.prediction->num_spheres());
-  const int H = at.prediction->num_spheres();
-  ws->group_log_volume.resize(link_groups.size() * H);
-  for (std::size_t g = 0; g < link_groups.size(); ++g) {
-    double r = 0.0;
-    for (int sp : link_groups[g]) r = std::max(r, radii[sp]);
-    for (int l = 0; l < H; ++l)
-      ws->group_log_volume[g * H + l] = std::log(collision::BallVolume(r + at.prediction->radius(l)));
+  int max_h = 0;
+  for (const Problem::Person& person : at.people) max_h = std::max(max_h, person.prediction->num_spheres());
+  if (!ws->bound_ws || static_cast<int>(ws->bound_ws->log_volume.size()) < static_cast<int>(radii.size()) * max_h)
+    ws->bound_ws = std::make_unique<collision::TrajectoryBoundWorkspace>(static_cast<int>(radii.size()), max_h);
+  ws->group_log_volume.resize(at.people.size());
+  for (std::size_t p = 0; p < at.people.size(); ++p) {
+    const collision::HumanPrediction& hp = *at.people[p].prediction;
+    const int H = hp.num_spheres();
+    std::vector<double>& glv = ws->group_log_volume[p];
+    glv.resize(link_groups.size() * H);
+    for (std::size_t g = 0; g < link_groups.size(); ++g) {
+      double r = 0.0;
+      for (int sp : link_groups[g]) r = std::max(r, radii[sp]);
+      for (int l = 0; l < H; ++l) glv[g * H + l] = std::log(collision::BallVolume(r + hp.radius(l)));
+    }
   }
 }
 
@@ -204,33 +210,40 @@ void PlannerModel::ExactBounds(const Problem& at, const Eigen::MatrixXd& Q, int 
   for (int i = from; i <= to; ++i) {
     collision::CalcForwardKinematics(robot, Q.col(i), &d);
     rs.centres.middleCols(static_cast<Eigen::Index>(i - from) * S, S) = d.p_WS;
-    rs.steps.push_back(at.steps[i]);
   }
-  collision::TrajectoryBoundWorkspace bw(S, at.prediction->num_spheres());
+  // Per person, then the union over persons.
+  std::vector<std::vector<double>> shares(static_cast<std::size_t>(to - from + 1));
   std::vector<collision::WaypointBound> wb;
-  collision::EvaluateTrajectoryBound(*at.prediction, rs, collision::TrajectoryBoundParams{}, &bw, &wb);
-  for (int i = from; i <= to; ++i) (*out)[i] = wb[i - from].bound;
+  for (const Problem::Person& person : at.people) {
+    rs.steps.assign(person.steps.begin() + from, person.steps.begin() + to + 1);
+    collision::TrajectoryBoundWorkspace bw(S, person.prediction->num_spheres());
+    collision::EvaluateTrajectoryBound(*person.prediction, rs, collision::TrajectoryBoundParams{}, &bw, &wb);
+    for (int i = from; i <= to; ++i) shares[static_cast<std::size_t>(i - from)].push_back(wb[i - from].bound);
+  }
+  for (int i = from; i <= to; ++i) (*out)[i] = cell::UnionBound(shares[static_cast<std::size_t>(i - from)]);
 }
 
 void PlannerModel::FixBounds(Problem* at) const {
   at->fixed_bounds.assign(at->n + 1, 0.0);
-  if (!at->prediction) return;
+  if (at->people.empty()) return;
   ExactBounds(*at, at->base, 0, at->k - 1, &at->fixed_bounds);
   ExactBounds(*at, at->base, at->n, at->n, &at->fixed_bounds);
 }
 
 double PlannerModel::HumanSeparation(const Problem& at, const Eigen::MatrixXd& Q, int from, int to) const {
   double best = std::numeric_limits<double>::infinity();
-  const collision::HumanPrediction& hp = *at.prediction;
   collision::RobotData d(robot);
   for (int i = from; i <= to; ++i) {
     collision::CalcForwardKinematics(robot, Q.col(i), &d);
-    for (int a = 0; a < hp.num_actions(); ++a) {
-      if (hp.action_probability(a) < kSeparationMinProbability) continue;
-      for (int l = 0; l < hp.num_spheres(); ++l) {
-        const Eigen::Vector3d& mu = hp.sphere(a, at.steps[i], l).mean;
-        for (int s = 0; s < static_cast<int>(radii.size()); ++s)
-          best = std::min(best, (d.p_WS.col(s) - mu).norm() - radii[s] - hp.radius(l));
+    for (const Problem::Person& person : at.people) {  // the nearest person's
+      const collision::HumanPrediction& hp = *person.prediction;
+      for (int a = 0; a < hp.num_actions(); ++a) {
+        if (hp.action_probability(a) < kSeparationMinProbability) continue;
+        for (int l = 0; l < hp.num_spheres(); ++l) {
+          const Eigen::Vector3d& mu = hp.sphere(a, person.steps[i], l).mean;
+          for (int s = 0; s < static_cast<int>(radii.size()); ++s)
+            best = std::min(best, (d.p_WS.col(s) - mu).norm() - radii[s] - hp.radius(l));
+        }
       }
     }
   }

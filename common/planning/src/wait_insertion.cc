@@ -1,6 +1,7 @@
 // Wait insertion (METHOD.md section 5): when no optimiser found a safe
 // trajectory, the robot holds a safe pose for a while and the optimisers
 // run again on the longer trajectory.
+#include "iplan/cell/people.h"
 #include "planner_model.h"
 
 namespace iplan::planning::internal {
@@ -24,7 +25,6 @@ void PlannerModel::InsertWait(Problem* at, const Candidate* ref, int wait_steps)
       // Holding q_cand must stay safe during the wait.
       Problem hold = *at;
       hold.n = cand + wait_steps;
-      hold.steps.clear();
       SetSteps(&hold);
       PrepareWorkspace(hold, &ws);
       collision::RobotData d(robot);
@@ -34,15 +34,18 @@ void PlannerModel::InsertWait(Problem* at, const Candidate* ref, int wait_steps)
       rs.radii = radii;
       rs.links = links;
       rs.centres.resize(3, static_cast<Eigen::Index>(wait_steps) * S);
-      for (int w = 0; w < wait_steps; ++w) {
-        rs.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = d.p_WS;
-        rs.steps.push_back(hold.steps[cand + 1 + w]);
+      for (int w = 0; w < wait_steps; ++w) rs.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = d.p_WS;
+      // Safe when the union bound over the people stays below the threshold.
+      std::vector<std::vector<double>> shares(static_cast<std::size_t>(wait_steps));
+      for (const Problem::Person& person : hold.people) {
+        rs.steps.assign(person.steps.begin() + cand + 1, person.steps.begin() + cand + 1 + wait_steps);
+        collision::TrajectoryBoundWorkspace bw(S, person.prediction->num_spheres());
+        std::vector<collision::WaypointBound> out;
+        collision::EvaluateTrajectoryBound(*person.prediction, rs, collision::TrajectoryBoundParams{}, &bw, &out);
+        for (int w = 0; w < wait_steps; ++w) shares[static_cast<std::size_t>(w)].push_back(out[w].bound);
       }
-      collision::TrajectoryBoundWorkspace bw(S, at->prediction->num_spheres());
-      std::vector<collision::WaypointBound> out;
-      collision::EvaluateTrajectoryBound(*at->prediction, rs, collision::TrajectoryBoundParams{}, &bw, &out);
       bool safe = true;
-      for (const auto& b : out) safe = safe && b.bound < Threshold();
+      for (const auto& b : shares) safe = safe && cell::UnionBound(b) < Threshold();
       if (safe) {
         j = cand;
         break;

@@ -1,3 +1,4 @@
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string>
@@ -115,8 +116,7 @@ TEST_F(PlannerTest, PersonAcrossThePathIsAvoidedOrWaitedFor) {
   // Without the person, the straight path crosses the hand's region.
   const PlanningResult free_r = planner_.Plan(req);
   ASSERT_TRUE(free_r.success());
-  req.prediction = &pred;
-  req.prediction_dt = 0.1;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult r = planner_.Plan(req);
   const double thr = 1.0 - planner_.params().delta_cl;
   if (r.success()) {
@@ -133,6 +133,103 @@ TEST_F(PlannerTest, PersonAcrossThePathIsAvoidedOrWaitedFor) {
   }
 }
 
+// One person's exact bound of every waypoint of Q (prediction step s at
+// s * 0.1 s, the nearest step per waypoint), computed here independently.
+std::vector<double> PersonBounds(const collision::RobotModel& robot, const collision::HumanPrediction& pred,
+                                 const Eigen::MatrixXd& Q, double dt) {
+  collision::RobotSpheresTrajectory rs;
+  for (const auto& sp : robot.spheres) {
+    rs.radii.push_back(sp.radius);
+    rs.links.push_back(sp.link);
+  }
+  const int S = static_cast<int>(robot.spheres.size());
+  rs.centres.resize(3, Q.cols() * S);
+  collision::RobotData d(robot);
+  for (int i = 0; i < Q.cols(); ++i) {
+    collision::CalcForwardKinematics(robot, Q.col(i), &d);
+    rs.centres.middleCols(static_cast<Eigen::Index>(i) * S, S) = d.p_WS;
+    rs.steps.push_back(std::clamp(static_cast<int>(std::lround(i * dt / 0.1)), 0, pred.num_steps() - 1));
+  }
+  collision::TrajectoryBoundWorkspace ws(S, pred.num_spheres());
+  std::vector<collision::WaypointBound> wb;
+  collision::EvaluateTrajectoryBound(pred, rs, collision::TrajectoryBoundParams{}, &ws, &wb);
+  std::vector<double> out;
+  for (const auto& b : wb) out.push_back(b.bound);
+  return out;
+}
+
+TEST_F(PlannerTest, TwoPeopleAreBoundedByTheSumOfTheirBounds) {
+  // The person of PersonAcrossThePath, and a second one reaching from the
+  // other side of the path (torso 0.3 m further along y).
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction a =
+      testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
+  const collision::HumanPrediction b = testing::MakeReachingPrediction(
+      body_, {{0.52, -0.15, 0.35}}, 15, 0.02, 0.05, Eigen::Vector3d(0.05, -0.3, 0.0));
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.people = {{&a, 0.1, 0.0}, {&b, 0.1, 0.0}};
+  const PlanningResult r = planner_.Plan(req);
+  ASSERT_EQ(static_cast<int>(r.bounds.size()), r.positions.cols());
+  const std::vector<double> pa = PersonBounds(robot_, a, r.positions, r.dt);
+  const std::vector<double> pb = PersonBounds(robot_, b, r.positions, r.dt);
+  int both = 0;
+  for (std::size_t i = 0; i < r.bounds.size(); ++i) {
+    EXPECT_NEAR(r.bounds[i], std::min(1.0, pa[i] + pb[i]), 1e-12) << "waypoint " << i;
+    both += pa[i] > 1e-4 && pb[i] > 1e-4;
+  }
+  EXPECT_GT(both, 0) << "both persons near the path somewhere";
+  const double thr = 1.0 - planner_.params().delta_cl;
+  if (r.success()) {
+    ExpectValid(r, req.start_q);
+    for (int i = r.num_frozen; i < r.positions.cols(); ++i) EXPECT_LT(pa[i] + pb[i], thr) << "waypoint " << i;
+  } else {
+    EXPECT_EQ(r.status, PlanStatus::kNoSafeTrajectory) << r.reason;
+  }
+}
+
+TEST_F(PlannerTest, APersonFarAwayChangesNothing) {
+  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction near =
+      testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
+  const collision::HumanPrediction far = testing::MakeReachingPrediction(
+      body_, {{3.0, 0.0, 0.3}}, 15, 0.02, 0.05, Eigen::Vector3d(3.0, 0.0, 0.0));
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.people = {{&near, 0.1, 0.0}};
+  const PlanningResult one = planner_.Plan(req);
+  req.people = {{&far, 0.1, 0.0}, {&near, 0.1, 0.0}};
+  const PlanningResult two = planner_.Plan(req);
+  EXPECT_EQ(two.status, one.status);
+  ASSERT_EQ(two.positions.cols(), one.positions.cols());
+  EXPECT_EQ(two.positions, one.positions);  // bit-identical: the far person's terms are ~1e-100
+  EXPECT_EQ(two.num_waits, one.num_waits);
+  EXPECT_NEAR(two.max_bound, one.max_bound, 1e-15);
+  EXPECT_EQ(two.human_separation, one.human_separation);  // the nearest person's
+}
+
+TEST_F(PlannerTest, RefusesAPersonWithoutAPrediction) {
+  PlanningRequest req;
+  req.start_q = Ready();
+  req.goal = Goal::Joint(Ready());
+  req.people = {{nullptr, 0.1, 0.0}};
+  EXPECT_THROW(planner_.Plan(req), std::invalid_argument);
+  const collision::HumanPrediction p = testing::MakeReachingPrediction(body_, {{0.5, 0.0, 0.3}}, 15);
+  req.people = {{&p, 0.1, 0.0}, {&p, 0.0, 0.0}};
+  try {
+    planner_.Plan(req);
+    ADD_FAILURE() << "dt 0 accepted";
+  } catch (const std::invalid_argument& e) {
+    EXPECT_NE(std::string(e.what()).find("person 1: dt must be > 0"), std::string::npos) << e.what();
+  }
+}
+
 TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
   const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
   const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
@@ -143,7 +240,7 @@ TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
   PlanningRequest req;
   req.start_q = s.q;
   req.goal = Goal::Joint(g.q);
-  req.prediction = &pred;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult r = planner_.Plan(req);
   EXPECT_FALSE(r.success());
   EXPECT_EQ(r.status, PlanStatus::kNoSafeTrajectory) << r.reason;
@@ -167,7 +264,7 @@ TEST_F(PlannerTest, SeparationKeepOutHoldsPlansAwayFromThePredictedPerson) {
   PlanningRequest req;
   req.start_q = s.q;
   req.goal = Goal::Joint(g.q);
-  req.prediction = &hand;
+  req.people = {{&hand, 0.1, 0.0}};
   const PlanningResult off = planner_.Plan(req);
   ExpectValid(off, req.start_q);
   EXPECT_LT(off.max_bound, 1.0 - planner_.params().delta_cl);
@@ -196,7 +293,7 @@ TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
   req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
-  req.prediction = &pred;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult a = planner_.Plan(req, 6, 1, 42);
   const PlanningResult b = planner_.Plan(req, 6, 3, 42);
   const PlanningResult c = planner_.Plan(req, 6, 6, 42);
@@ -230,7 +327,7 @@ TEST_F(PlannerTest, EarlyStopIsBitIdenticalForAnyThreadCountAndValid) {
   PlanningRequest req;
   req.start_q = s.q;
   req.goal = Goal::Joint(g.q);
-  req.prediction = &pred;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult a = planner.Plan(req, 6, 1, 42);
   ASSERT_TRUE(a.success()) << a.reason;
   ExpectValid(a, req.start_q);
@@ -256,7 +353,7 @@ TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
   req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
-  req.prediction = &pred;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult a = planner.Plan(req, 4, 2, 42);
   const PlanningResult b = planner_.Plan(req, 4, 2, 42);
   ASSERT_FALSE(a.success());
@@ -277,8 +374,7 @@ TEST_F(PlannerTest, AnExhaustedBudgetStopsTheOptimisersAndInsertsNoWait) {
   PlanningRequest req;
   req.start_q = s.q;
   req.goal = Goal::Joint(g.q);
-  req.prediction = &pred;
-  req.prediction_dt = 0.1;
+  req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult unlimited = planner_.Plan(req);
   EXPECT_FALSE(unlimited.budget_exhausted);
   ASSERT_GT(unlimited.num_waits, 0) << unlimited.reason;

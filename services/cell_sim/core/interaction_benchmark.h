@@ -55,6 +55,11 @@
 
 namespace iplan::cell_sim {
 
+/// The intent library's prediction as the cell's joint-level mixture
+/// (collision::JointMixture) for the observation at t0_ns, joints named `joints`.
+collision::JointMixture ToJointMixture(const intent::MixturePrediction& m, const std::vector<std::string>& joints,
+                                       int64_t t0_ns);
+
 enum class Predictor { kNone, kConstantPosition, kConstantVelocity, kModel, kOracle };
 
 /// "none", "constant-position", "constant-velocity", "model", "oracle".

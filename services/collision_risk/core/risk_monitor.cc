@@ -74,22 +74,29 @@ std::optional<std::string> RiskMonitor::UpdateTrajectory(int64_t start_ns, const
   return std::nullopt;
 }
 
-std::optional<std::string> RiskMonitor::UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
+std::optional<std::string> RiskMonitor::UpdateSkeleton(cell::BodyId body_id, int64_t stamp_ns,
+                                                       const std::vector<std::string>& names,
                                                        const std::vector<Eigen::Vector3d>& positions) {
   std::vector<int> idx;
   if (auto e = cell::MapJointNames(names, body_.params().joints, &idx)) return "skeleton: " + *e;
+  const int64_t keep = static_cast<int64_t>((params_.ssm.speed_window + params_.stale_after) * 1e9);
+  skeletons_.Expire(stamp_ns, keep);  // people who left
+  std::string why;
+  SkeletonHistory* history = skeletons_.Touch(body_id, stamp_ns, &why);
+  if (!history) return "skeleton: " + why;
   Eigen::Matrix3Xd p(3, body_.num_joints());
   for (int j = 0; j < body_.num_joints(); ++j) p.col(j) = positions[static_cast<std::size_t>(idx[static_cast<std::size_t>(j)])];
-  skeletons_.emplace_back(stamp_ns, p);
-  const int64_t keep = static_cast<int64_t>((params_.ssm.speed_window + params_.stale_after) * 1e9);
-  while (skeletons_.size() > 2 && stamp_ns - skeletons_.front().first > keep) skeletons_.pop_front();
+  history->emplace_back(stamp_ns, p);
+  while (history->size() > 2 && stamp_ns - history->front().first > keep) history->pop_front();
+  last_skeleton_ns_ = std::max(last_skeleton_ns_, stamp_ns);
   return std::nullopt;
 }
 
-std::optional<std::string> RiskMonitor::UpdatePrediction(const PredictionInput& in) {
+std::optional<std::string> RiskMonitor::UpdatePrediction(cell::BodyId body_id, const PredictionInput& in) {
   cell::TimedPrediction p;
   if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
-  prediction_ = std::move(p);
+  predictions_.Expire(in.t0_ns, static_cast<int64_t>(params_.stale_after * 1e9));
+  if (auto why = predictions_.Update(body_id, p.t0_ns(), std::move(p))) return "prediction: " + *why;
   return std::nullopt;
 }
 
@@ -97,12 +104,12 @@ Eigen::VectorXd RiskMonitor::RobotConfigurationAt(int64_t t_ns) const {
   return trajectory_.empty() ? state_->second : trajectory_.PositionAt(t_ns);
 }
 
-bool RiskMonitor::MeasuredJointVelocities(Eigen::Matrix3Xd* v) const {
-  if (!params_.ssm.measure_human_speed || skeletons_.size() < 2) return false;
-  const auto& newest = skeletons_.back();
+bool RiskMonitor::MeasuredJointVelocities(const SkeletonHistory& history, Eigen::Matrix3Xd* v) const {
+  if (!params_.ssm.measure_human_speed || history.size() < 2) return false;
+  const auto& newest = history.back();
   const int64_t window = static_cast<int64_t>(params_.ssm.speed_window * 1e9);
   // The oldest skeleton still within the window, at least half a window back.
-  for (const auto& s : skeletons_) {
+  for (const auto& s : history) {
     const int64_t dt = newest.first - s.first;
     if (dt <= window && dt >= window / 2) {
       *v = (newest.second - s.second) / (dt * 1e-9);
@@ -142,9 +149,17 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
     return r;
   }
   Inputs in;
-  in.person = !skeletons_.empty() && now_ns - skeletons_.back().first <= stale;
-  in.predicted = prediction_ && prediction_->FreshAt(now_ns, stale);
-  in.degraded = in.person && !in.predicted && params_.ssm.degrade_without_prediction;
+  in.stale_ns = stale;
+  r.num_people = skeletons_.CountFresh(now_ns, stale);
+  r.num_predicted = predictions_.CountFresh(now_ns, stale);
+  in.person = r.num_people > 0;
+  in.predicted = r.num_predicted > 0;
+  // Degraded when someone seen has no fresh prediction of their own.
+  for (const auto& [id, e] : skeletons_) {
+    const auto* pred = predictions_.Find(id);
+    if (now_ns - e.stamp_ns <= stale && (!pred || now_ns - pred->stamp_ns > stale))
+      in.degraded = params_.ssm.degrade_without_prediction;
+  }
   r.trajectory_stamp_ns = trajectory_.empty() ? 0 : trajectory_.start_ns;
   EvaluateSeparation(now_ns, in, &r);
   if (in.predicted) EvaluateBound(now_ns, &r);
@@ -154,28 +169,62 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
 
 // ISO/TS 15066 layer: current separation against S_p, per sphere pair when
 // directed (see the header), else one S_p from the fastest joint and the
-// fastest robot sphere.
-void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* out) {
-  RiskReport& r = *out;
-  const SsmParams& s = params_.ssm;
-  const auto& robot_spheres = robot_.spheres;
-  Eigen::Matrix3Xd v_robot;
-  RobotSphereVelocities(now_ns, &v_robot);
-  Eigen::Matrix3Xd v_joints;
-  const bool measured = in.person && !in.degraded && MeasuredJointVelocities(&v_joints);
-  // Undirected speeds (also what is reported when nobody is seen).
-  const double v_h_max = measured ? v_joints.colwise().norm().maxCoeff() : s.default_human_speed;
-  const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
-  r.human_speed = v_h_max;
-  r.robot_speed = v_r_max;
-  const double sp_undirected = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
-  r.protective_separation = sp_undirected;
-  if (!in.person) return;
-  collision::CalcForwardKinematics(robot_, state_->second, &data_);
-  const Eigen::Matrix3Xd& joints = skeletons_.back().second;
+// fastest robot sphere; the smallest over the persons seen.
+struct RiskMonitor::SeparationSearch {
   double best = std::numeric_limits<double>::infinity(), best_margin = best;
   std::size_t closest_k = 0, binding_k = 0;
   int closest_h = 0, binding_h = 0;
+  cell::BodyId body = 0;  // the person searched now
+};
+
+void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* out) {
+  RiskReport& r = *out;
+  const SsmParams& s = params_.ssm;
+  Eigen::Matrix3Xd v_robot;
+  RobotSphereVelocities(now_ns, &v_robot);
+  // Undirected speeds of nobody (what is reported when nobody is seen).
+  r.human_speed = s.default_human_speed;
+  r.robot_speed = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
+  r.protective_separation = cell::ProtectiveSeparationDistance(s, r.human_speed, r.robot_speed);
+  if (!in.person) return;
+  collision::CalcForwardKinematics(robot_, state_->second, &data_);
+  SeparationSearch search;
+  for (const auto& [id, e] : skeletons_) {
+    if (now_ns - e.stamp_ns > in.stale_ns) continue;
+    const auto* pred = predictions_.Find(id);
+    const bool predicted = pred && now_ns - pred->stamp_ns <= in.stale_ns;
+    // A person without a usable prediction is taken at the default speed.
+    const bool degraded = !predicted && s.degrade_without_prediction;
+    search.body = id;
+    SearchPerson(e.value, !degraded, v_robot, &search, &r);
+  }
+  const auto& robot_spheres = robot_.spheres;
+  auto link = [&](std::size_t k) { return robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)]; };
+  auto segment = [&](int h) {
+    return body_.params().segments[static_cast<std::size_t>(body_.spheres()[static_cast<std::size_t>(h)].segment)].name;
+  };
+  r.min_separation = search.best;
+  r.separation_robot_link = link(search.closest_k);
+  r.separation_human_segment = segment(search.closest_h);
+  r.separation_margin = search.best_margin;
+  r.binding_robot_link = link(search.binding_k);
+  r.binding_human_segment = segment(search.binding_h);
+}
+
+// One person's sphere pairs: the closest and the binding (smallest margin
+// to S_p) pair, when closer than the persons' so far.
+void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure, const Eigen::Matrix3Xd& v_robot,
+                               SeparationSearch* search, RiskReport* out) const {
+  RiskReport& r = *out;
+  const SsmParams& s = params_.ssm;
+  const auto& robot_spheres = robot_.spheres;
+  Eigen::Matrix3Xd v_joints;
+  const bool measured = may_measure && MeasuredJointVelocities(history, &v_joints);
+  const double v_h_max = measured ? v_joints.colwise().norm().maxCoeff() : s.default_human_speed;
+  const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
+  const double sp_undirected = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+  const Eigen::Matrix3Xd& joints = history.back().second;
+  SeparationSearch& f = *search;
   for (int h = 0; h < body_.num_spheres(); ++h) {
     const double human_radius = body_.spheres()[static_cast<std::size_t>(h)].radius;
     const Eigen::Vector3d c = body_.SphereCentre(h, joints);
@@ -193,39 +242,36 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
         v_r = std::max(0.0, -v_robot.col(ki).dot(u));
         sp = cell::ProtectiveSeparationDistance(s, v_h, v_r);
       }
-      if (d < best) {
-        best = d;
-        closest_k = k;
-        closest_h = h;
+      if (d < f.best) {
+        f.best = d;
+        f.closest_k = k;
+        f.closest_h = h;
       }
-      if (d - sp < best_margin) {
-        best_margin = d - sp;
-        binding_k = k;
-        binding_h = h;
+      if (d - sp < f.best_margin) {
+        f.best_margin = d - sp;
+        f.binding_k = k;
+        f.binding_h = h;
         r.binding_separation = d;
+        r.binding_body_id = f.body;
         r.protective_separation = sp;
         r.human_speed = v_h;
         r.robot_speed = v_r;
       }
     }
   }
-  auto link = [&](std::size_t k) { return robot_.link_names[static_cast<std::size_t>(robot_spheres[k].link)]; };
-  auto segment = [&](int h) {
-    return body_.params().segments[static_cast<std::size_t>(body_.spheres()[static_cast<std::size_t>(h)].segment)].name;
-  };
-  r.min_separation = best;
-  r.separation_robot_link = link(closest_k);
-  r.separation_human_segment = segment(closest_h);
-  r.separation_margin = best_margin;
-  r.binding_robot_link = link(binding_k);
-  r.binding_human_segment = segment(binding_h);
 }
 
-// Prediction layer: the bound along the executing trajectory at every
-// prediction step not yet past.
+// Prediction layer: the bound along the executing trajectory at every step
+// of the newest prediction not yet past, the union over the persons.
 void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
   RiskReport& r = *out;
-  const cell::TimedPrediction& m = *prediction_;
+  // The newest fresh prediction gives the waypoints.
+  const cell::TimedPrediction* ref = nullptr;
+  for (const auto& [id, e] : predictions_) {
+    if (e.value.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9)) && (!ref || e.stamp_ns > ref->t0_ns()))
+      ref = &e.value;
+  }
+  const cell::TimedPrediction& m = *ref;
   r.prediction_stamp_ns = m.t0_ns();
   r.time_step = m.time_step();
   collision::RobotSpheresTrajectory traj;
@@ -234,27 +280,58 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     traj.radii.push_back(sp.radius);
     traj.links.push_back(sp.link);
   }
-  for (int k = 0; k < m.num_steps(); ++k)
-    if (m.StepTime(k) >= now_ns) traj.steps.push_back(k);
+  std::vector<int64_t> times;
+  for (int k = 0; k < m.num_steps(); ++k) {
+    if (m.StepTime(k) < now_ns) continue;
+    traj.steps.push_back(k);
+    times.push_back(m.StepTime(k));
+  }
+  const std::vector<int> ref_steps = traj.steps;
   traj.centres.resize(3, static_cast<Eigen::Index>(traj.steps.size()) * S);
   for (std::size_t w = 0; w < traj.steps.size(); ++w) {
-    const int64_t t_k = m.StepTime(traj.steps[w]);
-    collision::CalcForwardKinematics(robot_, RobotConfigurationAt(t_k), &data_);
+    collision::CalcForwardKinematics(robot_, RobotConfigurationAt(times[w]), &data_);
     traj.centres.middleCols(static_cast<Eigen::Index>(w) * S, S) = data_.p_WS;
-    r.waypoint_times.push_back((t_k - now_ns) * 1e-9);
+    r.waypoint_times.push_back((times[w] - now_ns) * 1e-9);
   }
-  collision::EvaluateTrajectoryBound(m.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
-  for (std::size_t w = 0; w < bounds_.size(); ++w) {
-    const auto& b = bounds_[w];
-    r.waypoint_bounds.push_back(std::clamp(b.bound, 0.0, 1.0));
-    if (w == 0 || b.bound > r.max_bound) {
-      r.max_bound = std::clamp(b.bound, 0.0, 1.0);
+  // Per waypoint: each person's bound, their sum (raw, for the argmax) and
+  // the person with the largest share.
+  std::vector<std::vector<double>> shares(traj.steps.size());
+  std::vector<double> sum(traj.steps.size(), 0.0), share(traj.steps.size(), -1.0);
+  std::vector<collision::WaypointBound> top(traj.steps.size());
+  std::vector<cell::BodyId> top_body(traj.steps.size(), 0);
+  std::vector<const cell::TimedPrediction*> top_prediction(traj.steps.size(), &m);
+  for (const auto& [id, e] : predictions_) {
+    const cell::TimedPrediction& p = e.value;
+    if (!p.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9))) continue;
+    for (std::size_t w = 0; w < times.size(); ++w) {  // its step nearest to each waypoint's time
+      const double k = std::round((times[w] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
+      traj.steps[w] =
+          &p == ref ? ref_steps[w] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
+    }
+    collision::EvaluateTrajectoryBound(p.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
+    for (std::size_t w = 0; w < bounds_.size(); ++w) {
+      shares[w].push_back(bounds_[w].bound);
+      sum[w] += bounds_[w].bound;
+      if (bounds_[w].bound > share[w]) {
+        share[w] = bounds_[w].bound;
+        top[w] = bounds_[w];
+        top_body[w] = id;
+        top_prediction[w] = &p;
+      }
+    }
+  }
+  for (std::size_t w = 0; w < sum.size(); ++w) {
+    const auto& b = top[w];
+    r.waypoint_bounds.push_back(cell::UnionBound(shares[w]));
+    if (w == 0 || sum[w] > r.max_bound) {
+      r.max_bound = r.waypoint_bounds[w];
       r.max_waypoint = static_cast<int>(w);
       r.max_time = r.waypoint_times[w];
+      r.max_body_id = top_body[w];
       r.max_robot_link = b.robot_link >= 0 ? robot_.link_names[static_cast<std::size_t>(b.robot_link)] : "";
       r.max_human_segment =
           b.human_segment >= 0 ? body_.params().segments[static_cast<std::size_t>(b.human_segment)].name : "";
-      r.max_action = b.action >= 0 ? m.actions()[static_cast<std::size_t>(b.action)] : "";
+      r.max_action = b.action >= 0 ? top_prediction[w]->actions()[static_cast<std::size_t>(b.action)] : "";
     }
   }
 }
@@ -272,30 +349,40 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   }
   const double margin = r.separation_margin.value_or(std::numeric_limits<double>::infinity());
   const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
+  // With several people the reason names the person (nothing added for one).
+  const std::string nearest = r.num_people > 1 ? " (body " + std::to_string(r.binding_body_id) + ")" : "";
+  const std::string likeliest = r.num_predicted > 1 ? " (body " + std::to_string(r.max_body_id) + " of " +
+                                                          std::to_string(r.num_predicted) + ")"
+                                                    : "";
   if (!in.person && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
-    r.reason = skeletons_.empty() ? "no person tracked yet (no skeleton): the person could be anywhere"
-                                  : "person no longer tracked (no skeleton for " +
-                                        Fmt((now_ns - skeletons_.back().first) * 1e-9) + " s): the person could be anywhere";
+    r.reason = last_skeleton_ns_ == 0 ? "no person tracked yet (no skeleton): the person could be anywhere"
+                                      : "person no longer tracked (no skeleton for " +
+                                            Fmt((now_ns - last_skeleton_ns_) * 1e-9) + " s): the person could be anywhere";
   } else if (in.person && margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
+               (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") +
                ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
                ", v_r " + Fmt(r.robot_speed) + " m/s)";
   } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) +
-               " s (" + r.max_robot_link + " / " + r.max_human_segment + ", " + r.max_action + ")";
+               " s (" + r.max_robot_link + " / " + r.max_human_segment + ", " + r.max_action +
+               (r.num_predicted > 1 ? ", body " + std::to_string(r.max_body_id) + " of " + std::to_string(r.num_predicted)
+                                    : "") +
+               ")";
   } else if (first_violation >= 0) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s";
+    r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) + " s" +
+               likeliest;
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
-    r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
+    r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold) + likeliest;
   } else if (in.person && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
-               " m of the protective separation";
+               " m of the protective separation" + nearest;
   } else {
     r.verdict = Verdict::kOk;
     r.reason = !in.person    ? "no person seen"

@@ -24,6 +24,18 @@
 // a margin of either; OK otherwise. Without a usable prediction the monitor
 // runs degraded: separation only, at the ISO default human speed.
 //
+// Several people (skeletons and predictions carry a body id): each body's
+// skeleton history and newest prediction are kept apart (cell::PerBody:
+// out-of-order updates refused, bodies unseen for speed_window + stale_after
+// dropped). The separation is the minimum over the persons seen (each with
+// its own measured speed, or the default speed when that person has no
+// fresh prediction); the bound at a waypoint is the union bound over the
+// persons with a fresh prediction, min(1, sum of each person's bound)
+// (cell::UnionBound). The waypoints are those of the newest prediction;
+// another person's prediction is taken at its step nearest to each
+// waypoint's time (its first step before it, its last after it), as the
+// planner does.
+//
 // Frames and units: positions in the world frame (= robot base frame), m;
 // times are ns since the epoch on input and s relative to the evaluation in
 // the report. Not thread-safe (one owner, the service's executor).
@@ -38,6 +50,7 @@
 #include <Eigen/Core>
 
 #include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/people.h"
 #include "iplan/cell/ssm.h"
 #include "iplan/cell/status.h"
 #include "iplan/cell/timed_prediction.h"
@@ -96,6 +109,9 @@ struct RiskReport {
   int max_waypoint = 0;
   double max_time = 0;                   ///< s after stamp_ns
   std::string max_robot_link, max_human_segment, max_action;
+  cell::BodyId max_body_id = 0;          ///< person of the largest share of max_bound (0: none)
+  int num_people = 0;                    ///< persons with a fresh skeleton
+  int num_predicted = 0;                 ///< persons with a fresh prediction (terms of the union bound)
   cell::Separation min_separation;       ///< m; nullopt when no person is seen
   std::string separation_robot_link, separation_human_segment;
   double protective_separation = 0;      ///< m, S_p of the binding pair (smallest separation - S_p)
@@ -104,6 +120,7 @@ struct RiskReport {
   cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
   cell::Separation separation_margin;    ///< m, binding_separation - protective_separation; < 0 stops
   std::string binding_robot_link, binding_human_segment;
+  cell::BodyId binding_body_id = 0;      ///< person of the binding pair (0: nobody seen)
   Verdict verdict = Verdict::kProtectiveStop;
   std::string reason;
 };
@@ -125,9 +142,21 @@ class RiskMonitor {
   std::optional<std::string> UpdateTrajectory(int64_t start_ns, const std::vector<std::string>& names,
                                               const std::vector<double>& times,
                                               const std::vector<std::vector<double>>& positions);
-  std::optional<std::string> UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
+  /// One person's skeleton (refused when not after that body's previous one).
+  std::optional<std::string> UpdateSkeleton(cell::BodyId body_id, int64_t stamp_ns,
+                                            const std::vector<std::string>& names,
                                             const std::vector<Eigen::Vector3d>& positions);
-  std::optional<std::string> UpdatePrediction(const PredictionInput& prediction);
+  /// One person's prediction: replaces that body's, when its observation
+  /// (t0) is newer.
+  std::optional<std::string> UpdatePrediction(cell::BodyId body_id, const PredictionInput& prediction);
+  /// The same for a cell of one person (body 1).
+  std::optional<std::string> UpdateSkeleton(int64_t stamp_ns, const std::vector<std::string>& names,
+                                            const std::vector<Eigen::Vector3d>& positions) {
+    return UpdateSkeleton(1, stamp_ns, names, positions);
+  }
+  std::optional<std::string> UpdatePrediction(const PredictionInput& prediction) {
+    return UpdatePrediction(1, prediction);
+  }
 
   /// Evaluates both layers at `now_ns`. Allocates (report vectors).
   RiskReport Evaluate(int64_t now_ns);
@@ -139,8 +168,9 @@ class RiskMonitor {
   /// What Evaluate knows before it looks at the layers.
   struct Inputs {
     bool person = false;     ///< a fresh skeleton
-    bool predicted = false;  ///< a fresh prediction
+    bool predicted = false;  ///< a fresh prediction (of anyone)
     bool degraded = false;   ///< a person without a usable prediction (SsmParams::degrade_without_prediction)
+    int64_t stale_ns = 0;    ///< RiskParams::stale_after
   };
   /// The ISO/TS 15066 layer into r: separation and S_p per sphere pair.
   void EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* r);
@@ -149,9 +179,17 @@ class RiskMonitor {
   /// The verdict policy (see the file comment) from both layers.
   void DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* r) const;
   Eigen::VectorXd RobotConfigurationAt(int64_t t_ns) const;
+  /// Skeleton history of one body (body joint order), newest last.
+  using SkeletonHistory = std::deque<std::pair<int64_t, Eigen::Matrix3Xd>>;
+  /// The binding and closest sphere pairs over the persons so far.
+  struct SeparationSearch;
+  /// One person's sphere pairs into `search`; `may_measure` false: the
+  /// person is taken at the default speed (no fresh prediction, degraded).
+  void SearchPerson(const SkeletonHistory& history, bool may_measure, const Eigen::Matrix3Xd& v_robot,
+                    SeparationSearch* search, RiskReport* r) const;
   /// Per-joint velocity (m/s, 3 x joints) over the speed window; false when
   /// not measured (measure_human_speed off or too little history).
-  bool MeasuredJointVelocities(Eigen::Matrix3Xd* v) const;
+  bool MeasuredJointVelocities(const SkeletonHistory& history, Eigen::Matrix3Xd* v) const;
   /// Velocity (m/s, 3 x spheres) of the robot spheres along the executing
   /// trajectory, else from the last two joint states, else zero.
   void RobotSphereVelocities(int64_t now_ns, Eigen::Matrix3Xd* v);
@@ -166,10 +204,11 @@ class RiskMonitor {
   std::optional<std::pair<int64_t, Eigen::VectorXd>> state_, previous_state_;
   // Executing trajectory (empty: none).
   cell::JointTrajectory trajectory_;
-  // Skeleton history (body joint order), newest last.
-  std::deque<std::pair<int64_t, Eigen::Matrix3Xd>> skeletons_;
-  // Latest prediction, converted for the bound.
-  std::optional<cell::TimedPrediction> prediction_;
+  // Skeleton history per person.
+  cell::PerBody<SkeletonHistory> skeletons_;
+  int64_t last_skeleton_ns_ = 0;  // newest skeleton of anyone (0: none yet), for the verdict's reason
+  // Newest prediction per person (stamp: its t0), converted for the bound.
+  cell::PerBody<cell::TimedPrediction> predictions_;
   collision::TrajectoryBoundWorkspace workspace_;
   std::vector<collision::WaypointBound> bounds_;
 };

@@ -322,5 +322,117 @@ TEST(RiskParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
             "");
 }
 
+// Several people: the bound is the union over persons, the separation the
+// nearest person's.
+class RiskMonitorPeopleTest : public RiskMonitorTest {
+ protected:
+  static RiskMonitor Make() {
+    return RiskMonitor(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml"),
+                       collision::HumanBodyParams::DefaultUpperBody(), Params());
+  }
+  // Person `id` with torso `torso` walking at `v`, seen and predicted at t into `m`.
+  void Add(RiskMonitor* m, cell::BodyId id, int64_t t, const Eigen::Vector3d& torso, const Eigen::Vector3d& v) {
+    ASSERT_EQ(m->UpdateSkeleton(id, t - 3 * kSec / 10, kJoints, Person(torso - v * 0.3)), std::nullopt);
+    ASSERT_EQ(m->UpdateSkeleton(id, t, kJoints, Person(torso)), std::nullopt);
+    ASSERT_EQ(m->UpdatePrediction(id, Predict(t, torso, v, 30, 0.1)), std::nullopt);
+  }
+  static void Ready(RiskMonitor* m, int64_t t) {
+    ASSERT_EQ(m->UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  }
+};
+
+TEST_F(RiskMonitorPeopleTest, BoundIsTheSumOfEachPersonsBoundCappedAtOne) {
+  const int64_t t = 100 * kSec;
+  const Eigen::Vector3d a(1.6, 0.25, 0.55), va(-0.6, 0, 0), b(1.8, -0.3, 0.6), vb(-0.5, 0.1, 0);
+  RiskMonitor only_a = Make(), only_b = Make(), both = Make();
+  for (RiskMonitor* m : {&only_a, &only_b, &both}) Ready(m, t);
+  Add(&only_a, 1, t, a, va);
+  Add(&only_b, 2, t, b, vb);
+  Add(&both, 1, t, a, va);
+  Add(&both, 2, t, b, vb);
+  const RiskReport ra = only_a.Evaluate(t), rb = only_b.Evaluate(t), r = both.Evaluate(t);
+  EXPECT_EQ(r.num_people, 2);
+  EXPECT_EQ(r.num_predicted, 2);
+  ASSERT_EQ(r.waypoint_bounds.size(), ra.waypoint_bounds.size());
+  ASSERT_EQ(r.waypoint_bounds.size(), rb.waypoint_bounds.size());
+  int summed = 0, capped = 0;
+  for (std::size_t w = 0; w < r.waypoint_bounds.size(); ++w) {
+    const double sum = ra.waypoint_bounds[w] + rb.waypoint_bounds[w];
+    EXPECT_NEAR(r.waypoint_bounds[w], std::min(1.0, sum), 1e-12) << "waypoint " << w;
+    summed += ra.waypoint_bounds[w] > 1e-3 && rb.waypoint_bounds[w] > 1e-3 && sum < 1;
+    capped += sum > 1;
+  }
+  EXPECT_GT(summed, 0) << "a waypoint where both persons contribute and the sum is below 1";
+  EXPECT_GT(capped, 0) << "a waypoint where the sum is capped";
+  EXPECT_LE(r.max_bound, std::min(1.0, ra.max_bound + rb.max_bound) + 1e-12);
+  EXPECT_GE(r.max_bound, std::max(ra.max_bound, rb.max_bound));
+  // Separation: the nearer person's.
+  EXPECT_NEAR(r.min_separation.value(), std::min(ra.min_separation.value(), rb.min_separation.value()), 1e-12);
+  EXPECT_NEAR(r.separation_margin.value(), std::min(ra.separation_margin.value(), rb.separation_margin.value()), 1e-12);
+}
+
+TEST_F(RiskMonitorPeopleTest, AnOlderPredictionIsTakenAtItsStepNearestToEachWaypoint) {
+  // Body 1's prediction is one step (0.1 s) older than body 2's: the
+  // waypoints are body 2's (t + (w + 1) 0.1 s), where body 1's step w + 1
+  // falls (its last step beyond its end).
+  const int64_t t = 100 * kSec;
+  const Eigen::Vector3d a(1.6, 0.25, 0.55), va(-0.6, 0, 0), b(1.8, -0.3, 0.6), vb(-0.5, 0.1, 0);
+  RiskMonitor only_b = Make(), both = Make();
+  for (RiskMonitor* m : {&only_b, &both}) Ready(m, t);
+  Add(&both, 2, t, a, va);
+  for (RiskMonitor* m : {&only_b, &both}) {
+    ASSERT_EQ(m->UpdateSkeleton(1, t, kJoints, Person(b)), std::nullopt);
+    ASSERT_EQ(m->UpdatePrediction(1, Predict(t - kSec / 10, b - vb * 0.1, vb, 30, 0.1)), std::nullopt);
+  }
+  RiskMonitor only_a = Make();
+  Ready(&only_a, t);
+  Add(&only_a, 2, t, a, va);
+  const RiskReport ra = only_a.Evaluate(t), rb = only_b.Evaluate(t), r = both.Evaluate(t);
+  EXPECT_EQ(r.prediction_stamp_ns, t) << "the newest prediction gives the waypoints";
+  ASSERT_EQ(r.waypoint_bounds.size(), 30u);
+  ASSERT_EQ(rb.waypoint_bounds.size(), 30u);  // its steps at t + k 0.1 s, k = 0..29
+  EXPECT_NEAR(rb.waypoint_times[1], r.waypoint_times[0], 1e-9);
+  for (std::size_t w = 0; w < 30; ++w) {
+    const double b_at = rb.waypoint_bounds[std::min<std::size_t>(w + 1, 29)];
+    EXPECT_NEAR(r.waypoint_bounds[w], std::min(1.0, ra.waypoint_bounds[w] + b_at), 1e-12) << "waypoint " << w;
+  }
+  EXPECT_GT(rb.max_bound, 1e-3);
+}
+
+TEST_F(RiskMonitorPeopleTest, ASecondPersonCloseStopsThoughTheFirstIsFarAway) {
+  const int64_t t = 100 * kSec;
+  RiskMonitor m = Make();
+  Ready(&m, t);
+  Add(&m, 1, t, {2.5, 0, 1.0}, {0, 0, 0});
+  const RiskReport far = m.Evaluate(t);
+  EXPECT_EQ(far.verdict, Verdict::kOk) << far.reason;
+  Add(&m, 7, t, {1.4, 0, 0.55}, {-0.8, 0, 0});  // walking at the robot's hand
+  const RiskReport r = m.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+  EXPECT_EQ(r.max_body_id, 7u);
+  EXPECT_NE(r.reason.find("body 7 of 2"), std::string::npos) << r.reason;
+  EXPECT_LT(r.min_separation.value(), far.min_separation.value() - 0.5);
+}
+
+TEST_F(RiskMonitorPeopleTest, OutOfOrderAndStalePredictionsOfABodyAreNotUsed) {
+  const int64_t t = 100 * kSec;
+  RiskMonitor m = Make();
+  Ready(&m, t);
+  Add(&m, 1, t, {2.5, 0, 1.0}, {0, 0, 0});
+  // Body 1's older prediction does not replace its newer one.
+  const auto late = m.UpdatePrediction(1, Predict(t - kSec / 10, {1.4, 0, 0.55}, {-0.8, 0, 0}, 30, 0.1));
+  ASSERT_TRUE(late);
+  EXPECT_NE(late->find("out of order"), std::string::npos) << *late;
+  EXPECT_LT(m.Evaluate(t).max_bound, 1e-6);
+  // A close person whose newest prediction is older than stale_after (0.5 s)
+  // is not in the bound; with no skeleton either, not in the separation.
+  ASSERT_EQ(m.UpdatePrediction(2, Predict(t - 6 * kSec / 10, {1.4, 0, 0.55}, {-0.8, 0, 0}, 30, 0.1)), std::nullopt);
+  const RiskReport r = m.Evaluate(t);
+  EXPECT_EQ(r.num_predicted, 1);
+  EXPECT_EQ(r.num_people, 1);
+  EXPECT_LT(r.max_bound, 1e-6);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.reason;
+}
+
 }  // namespace
 }  // namespace iplan::collision_risk

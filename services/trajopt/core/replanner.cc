@@ -51,10 +51,11 @@ std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const s
   return std::nullopt;
 }
 
-std::optional<std::string> Replanner::UpdatePrediction(const collision::JointMixture& in) {
+std::optional<std::string> Replanner::UpdatePrediction(cell::BodyId body_id, const collision::JointMixture& in) {
   cell::TimedPrediction p;
   if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
-  prediction_ = std::move(p);
+  predictions_.Expire(in.t0_ns, static_cast<int64_t>(params_.stale_after * 1e9));
+  if (auto why = predictions_.Update(body_id, p.t0_ns(), std::move(p))) return "prediction: " + *why;
   return std::nullopt;
 }
 
@@ -231,12 +232,13 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_
   req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
   req.time_budget = params_.cycle_budget;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
-  if (prediction_ && prediction_->FreshAt(now_ns, stale)) {
-    req.prediction = &prediction_->spheres();
-    req.prediction_dt = prediction_->time_step();
-    r->prediction_t0_ns = prediction_->t0_ns();
-    req.prediction_start = prediction_->StartRelativeTo(*start_ns);
+  predictions_.Expire(now_ns, stale);
+  for (const auto& [id, e] : predictions_) {
+    const cell::TimedPrediction& p = e.value;
+    req.people.push_back({&p.spheres(), p.time_step(), p.StartRelativeTo(*start_ns)});
+    r->prediction_t0_ns = std::max(r->prediction_t0_ns, p.t0_ns());
   }
+  r->num_people = static_cast<int>(req.people.size());
   return req;
 }
 

@@ -23,6 +23,7 @@
 #include <Eigen/Core>
 
 #include "iplan/cell/joint_trajectory.h"
+#include "iplan/cell/people.h"
 #include "iplan/cell/status.h"
 #include "iplan/cell/timed_prediction.h"
 #include "iplan/collision/joint_mixture.h"
@@ -101,7 +102,8 @@ struct CycleResult {
   double dt = 0;
   Eigen::MatrixXd positions;         ///< nq x (n + 1)
   double planning_time = 0;          ///< s, 0 when nothing was planned
-  int64_t prediction_t0_ns = 0;      ///< stamp of the observation behind the prediction planned against (0: none)
+  int64_t prediction_t0_ns = 0;      ///< stamp of the observation behind the newest prediction planned against (0: none)
+  int num_people = 0;                ///< persons planned against (fresh predictions)
   bool waiting = false;              ///< the plan holds the robot (waits inserted or no safe trajectory)
   bool held_off = false;             ///< the plan keeps out of the person's space (PlannerParams::human_separation)
   double max_bound = 0;              ///< highest per-waypoint collision bound of the plan
@@ -132,8 +134,15 @@ class Replanner {
   /// position or velocity outside the limits by more than the tolerance).
   std::optional<std::string> UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                               const std::vector<double>& q, const std::vector<double>& qd);
-  /// Newest prediction. Returns why it was refused.
-  std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction);
+  /// Newest prediction of one person (body id): replaces that body's when
+  /// its observation is newer. Returns why it was refused. Every cycle plans
+  /// against each person whose prediction is fresh (stale_after); older
+  /// ones are dropped.
+  std::optional<std::string> UpdatePrediction(cell::BodyId body_id, const collision::JointMixture& prediction);
+  /// The same for a cell of one person (body 1).
+  std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction) {
+    return UpdatePrediction(1, prediction);
+  }
 
   /// One planning step at `now_ns`.
   CycleResult Cycle(int64_t now_ns);
@@ -155,7 +164,7 @@ class Replanner {
   Eigen::VectorXd qd_;
   bool robot_stopped_ = false;
   std::vector<std::string> robot_joints_;
-  std::optional<cell::TimedPrediction> prediction_;
+  cell::PerBody<cell::TimedPrediction> predictions_;  // newest per person, stamp: its observation
   struct Active {
     TaskSpec spec;
     int64_t start_ns = 0;

@@ -308,5 +308,32 @@ TEST(ReplannerParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
             "");
 }
 
+TEST_F(ReplannerTest, PlansAgainstEveryFreshPersonAndDropsStaleOnes) {
+  int64_t t = 100 * kSec;
+  SetState(t, Ready(), Eigen::VectorXd::Zero(7));
+  TaskSpec task;
+  task.id = 1;
+  task.goal = planning::Goal::Joint(Goal());
+  replanner_.StartTask(task, t);
+  // Two people far from the path (behind the robot's reach), bodies 3 and 8.
+  ASSERT_EQ(replanner_.UpdatePrediction(3, PersonAt(t, {1.6, 0.8, 0.3})), std::nullopt);
+  ASSERT_EQ(replanner_.UpdatePrediction(8, PersonAt(t, {1.6, -0.8, 0.3})), std::nullopt);
+  // Body 3's older prediction is refused; its newer one stays.
+  const auto late = replanner_.UpdatePrediction(3, PersonAt(t - kSec / 10, {0.5, 0.0, 0.3}));
+  ASSERT_TRUE(late);
+  EXPECT_NE(late->find("out of order"), std::string::npos) << *late;
+  CycleResult c = replanner_.Cycle(t);
+  EXPECT_EQ(c.num_people, 2) << c.status;
+  EXPECT_EQ(c.prediction_t0_ns, t);
+  EXPECT_LT(c.max_bound, 1e-6) << "neither person is near the path";
+  // 0.4 s later body 8 is seen again, body 3 is not: at 0.6 s body 3's
+  // prediction is older than stale_after (0.5 s) and no longer planned against.
+  ASSERT_EQ(replanner_.UpdatePrediction(8, PersonAt(t + 4 * kSec / 10, {1.6, -0.8, 0.3})), std::nullopt);
+  SetState(t + 6 * kSec / 10, At(c, t + 6 * kSec / 10), Eigen::VectorXd::Zero(7));
+  c = replanner_.Cycle(t + 6 * kSec / 10);
+  EXPECT_EQ(c.num_people, 1) << c.status;
+  EXPECT_EQ(c.prediction_t0_ns, t + 4 * kSec / 10);
+}
+
 }  // namespace
 }  // namespace iplan::trajopt

@@ -24,11 +24,17 @@
 //   limits      squared excess of |v|, |a| over limit_scale x limit, normalised
 // Positions are kept inside the limits by projection after every step.
 //
-// Prediction timing: waypoint i (time t_i) uses prediction step
-//   s_i = clamp(round((t_i - prediction_start) / prediction_dt), 0, S - 1),
-// i.e. the step nearest to t_i. Waypoints before the prediction's first step
-// use step 0, waypoints beyond its last step use the last step (the person is
-// assumed to stay where last predicted, rather than to vanish).
+// Prediction timing, per person: waypoint i (time t_i) uses step
+//   s_i = clamp(round((t_i - start) / dt), 0, S - 1)
+// of that person's prediction (PersonPrediction), i.e. the step nearest to
+// t_i. Waypoints before the prediction's first step use step 0, waypoints
+// beyond its last step use the last step (the person is assumed to stay
+// where last predicted, rather than to vanish).
+//
+// Several people: P_i is the union bound over them, min(1, sum over persons
+// of each person's bound) (cell::UnionBound); the keep-out cost adds up over
+// persons and human_separation is the nearest person's. With one person
+// everything is as for that person alone.
 //
 // The pieces (problem, cost terms, optimiser, multi-start, waits) are
 // internal: common/planning/src/planner_model.h maps them to their files.
@@ -63,6 +69,15 @@ struct Goal {
   static Goal Pose(const Eigen::Vector3d& p_WE, const Eigen::Quaterniond& R_WE);
 };
 
+/// One person's prediction for a plan.
+struct PersonPrediction {
+  /// Not owned, not null; its summaries must be up to date
+  /// (HumanPrediction::UpdateSummaries).
+  const collision::HumanPrediction* spheres = nullptr;
+  double dt = 0.1;     ///< time between prediction steps (s), > 0
+  double start = 0.0;  ///< time of step 0 minus time of waypoint 0 (s)
+};
+
 struct PlanningRequest {
   Eigen::VectorXd start_q;     ///< size nq (rad), within limits
   Eigen::VectorXd start_qdot;  ///< size nq (rad/s), or empty = at rest
@@ -75,11 +90,8 @@ struct PlanningRequest {
   /// start). Waypoints 1 .. num_frozen-1 are taken from warm_start, which
   /// must then have at least num_frozen columns.
   int num_frozen = 1;
-  /// Human prediction (not owned; may be null = no person). Its summaries
-  /// must be up to date (HumanPrediction::UpdateSummaries).
-  const collision::HumanPrediction* prediction = nullptr;
-  double prediction_dt = 0.1;     ///< time between prediction steps (s), > 0
-  double prediction_start = 0.0;  ///< time of step 0 minus time of waypoint 0 (s)
+  /// The predicted people (empty: nobody), one entry per person.
+  std::vector<PersonPrediction> people;
   /// Wall time Plan may take (s); 0: no limit. With a budget the planner is
   /// anytime: when it runs out, the optimisers stop at their next iteration,
   /// no further wait is inserted, and the best feasible and safe trajectory
@@ -116,8 +128,8 @@ struct PlanningResult {
   double planning_time = 0.0;    ///< wall time of Plan (s)
   bool budget_exhausted = false; ///< PlanningRequest::time_budget ran out before the optimisers finished
   double time_to_first_feasible = -1.0;  ///< wall time until some optimiser was feasible (s), -1 if never
-  double max_bound = 0.0;        ///< max_i P_i over the non-frozen waypoints (0 without prediction)
-  std::vector<double> bounds;    ///< P_i per waypoint (empty without prediction)
+  double max_bound = 0.0;        ///< max_i P_i over the non-frozen waypoints (0 without people)
+  std::vector<double> bounds;    ///< P_i per waypoint (empty without people)
   double cost = 0.0;             ///< final total cost
   double min_clearance = 0.0;    ///< m, at the interpolated check points
   /// m, smallest distance of the free waypoints to the predicted person
