@@ -58,6 +58,9 @@ struct Problem {
   Eigen::VectorXd qdot0, q_goal;
   Eigen::MatrixXd Hinv;  // m x m inverse smoothness Hessian (unweighted)
   std::vector<int> steps;  // prediction step of each waypoint (planner.h)
+  // PlanningRequest::obstacles, checked against every robot sphere; their
+  // object indices follow the scene's (PlannerModel::NumObjects).
+  std::vector<ClearanceObject> obstacles;
   const collision::HumanPrediction* prediction = nullptr;
   // Exact bounds of the waypoints no optimiser changes (the frozen prefix
   // 0..k-1 and the goal n; size n+1, free entries unused), computed once
@@ -147,8 +150,16 @@ struct PlannerModel {
   // spheres' mean) and its radius, which covers every sphere. Distances
   // are 1-Lipschitz, so the ball's distance bounds all its spheres'.
   double LinkBall(const collision::RobotData& data, const std::vector<int>& group, Eigen::Vector3d* c) const;
-  // Minimum signed distance of all checked spheres at the FK in `data`.
-  double Clearance(const collision::RobotData& data) const;
+  // Minimum signed distance of all checked spheres at the FK in `data` to
+  // the scene and to `obstacles` (may be null; every sphere is checked).
+  double Clearance(const collision::RobotData& data, const std::vector<ClearanceObject>* obstacles = nullptr) const;
+  // The scene's objects, then the attempt's obstacles, by one index.
+  int NumObjects(const Problem& at) const { return static_cast<int>(objects.size() + at.obstacles.size()); }
+  const ClearanceObject& Object(const Problem& at, int o) const {
+    const int ns = static_cast<int>(objects.size());
+    return o < ns ? objects[o] : at.obstacles[o - ns];
+  }
+  bool Checked(int sphere, int o) const { return o >= static_cast<int>(objects.size()) || checked[sphere][o]; }
 
   // --- problem.cc -----------------------------------------------------------
   /// Throws std::invalid_argument "Plan: ..." for bad requests.

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "iplan/core/name_value.h"
@@ -134,6 +135,9 @@ class Replanner {
                                               const std::vector<double>& q, const std::vector<double>& qd);
   /// Newest prediction. Returns why it was refused.
   std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction);
+  /// The perceived obstacles (W) every later cycle keeps clear of
+  /// (PlanningRequest::obstacles; see obstacle_set.h).
+  void SetObstacles(std::vector<collision::SceneObject> obstacles) { obstacles_ = std::move(obstacles); }
 
   /// One planning step at `now_ns`.
   CycleResult Cycle(int64_t now_ns);
@@ -156,6 +160,7 @@ class Replanner {
   bool robot_stopped_ = false;
   std::vector<std::string> robot_joints_;
   std::optional<cell::TimedPrediction> prediction_;
+  std::vector<collision::SceneObject> obstacles_;
   struct Active {
     TaskSpec spec;
     int64_t start_ns = 0;
