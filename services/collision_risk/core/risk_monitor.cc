@@ -31,7 +31,7 @@ std::string RiskParams::Validate() const {
   }
   if (!(s.speed_window > 0)) return "speed_window must be > 0";
   if (!(s.stopping_speed > 0)) return "stopping_speed must be > 0";
-  return "";
+  return human_points.Validate();
 }
 
 RiskMonitor::RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params)
@@ -145,9 +145,15 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   in.person = !skeletons_.empty() && now_ns - skeletons_.back().first <= stale;
   in.predicted = prediction_ && prediction_->FreshAt(now_ns, stale);
   in.degraded = in.person && !in.predicted && params_.ssm.degrade_without_prediction;
+  in.points = points_stamp_ns_ > 0 && now_ns - points_stamp_ns_ <= stale;
   r.trajectory_stamp_ns = trajectory_.empty() ? 0 : trajectory_.start_ns;
   EvaluateSeparation(now_ns, in, &r);
-  if (in.predicted) EvaluateBound(now_ns, &r);
+  if (!in.person && in.points) EvaluateSeparationFromPoints(now_ns, &r);
+  if (in.predicted) {
+    EvaluateBound(now_ns, &r);
+  } else if (in.points) {
+    EvaluateBoundFromPoints(now_ns, &r);
+  }
   DecideVerdict(now_ns, in, &r);
   return r;
 }
@@ -272,12 +278,14 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   }
   const double margin = r.separation_margin.value_or(std::numeric_limits<double>::infinity());
   const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
-  if (!in.person && params_.person_required) {
+  const bool seen = in.person || in.points;  // fresh points: the depth camera tracks the person
+  if (!seen && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
-    r.reason = skeletons_.empty() ? "no person tracked yet (no skeleton): the person could be anywhere"
-                                  : "person no longer tracked (no skeleton for " +
-                                        Fmt((now_ns - skeletons_.back().first) * 1e-9) + " s): the person could be anywhere";
-  } else if (in.person && margin < 0) {
+    const int64_t last_seen = std::max(skeletons_.empty() ? 0 : skeletons_.back().first, points_stamp_ns_);
+    r.reason = last_seen == 0 ? "no person tracked yet (no skeleton, no depth points): the person could be anywhere"
+                              : "person no longer tracked (no skeleton or depth points for " +
+                                    Fmt((now_ns - last_seen) * 1e-9) + " s): the person could be anywhere";
+  } else if (seen && margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
                ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
@@ -292,13 +300,15 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold);
-  } else if (in.person && margin < params_.slow_down_margin) {
+  } else if (seen && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
                " m of the protective separation";
   } else {
     r.verdict = Verdict::kOk;
-    r.reason = !in.person    ? "no person seen"
+    r.reason = !seen         ? "no person seen"
+               : !in.person   ? (r.binding_separation ? "clear (depth points only; separation at the default human speed)"
+                                                      : "no person seen (depth: no points)")
                : in.predicted ? "clear"
                : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
                               : "clear (separation only: no current prediction)";
