@@ -96,27 +96,47 @@ void EvaluatePointsBound(const GaussianPoints& points, const RobotSpheresTraject
     WaypointBound& wb = (*out)[static_cast<std::size_t>(w)];
     wb = WaypointBound{};
     bool culled = false;
-    for (int k = 0; k < S; ++k) {
+    // A pair whose upper bound V(R) exp(log_peak - (dist - R)^2 / 2 s_max)
+    // cannot exceed the best so far is skipped too (so the maximum and its
+    // argmax, the first pair attaining it, are those of all pairs); a bound
+    // of 1 cannot be exceeded at all.
+    double best_log = -std::numeric_limits<double>::infinity();
+    for (int k = 0; k < S && wb.bound < 1.0; ++k) {
       const Eigen::Vector3d b = t.centres.col(static_cast<Eigen::Index>(w) * S + k);
       const double R = t.radii[static_cast<std::size_t>(k)] + points.radius();
       if (!(R > 0.0)) continue;
       const double log_volume = std::log(BallVolume(R));
       for (const GaussianPoints::Block& blk : points.blocks()) {
         const double reach = R + CullDistance(blk, log_volume, log_negligible);
-        if ((b - blk.centre).norm() - blk.radius >= reach) {
+        const double block_gap = (b - blk.centre).norm() - blk.radius - R;
+        if (block_gap + R >= reach) {
           wb.pairs_pruned += blk.end - blk.begin;
           culled = true;
           continue;
         }
+        const double block_log_peak = log_volume + blk.max_log_peak, half_inv = 0.5 / blk.max_eigenvalue;
+        if (block_gap > 0.0 && block_log_peak - block_gap * block_gap * half_inv <= best_log) {
+          wb.pairs_pruned += blk.end - blk.begin;
+          continue;
+        }
         for (int l = blk.begin; l < blk.end; ++l) {
           const FactorizedGaussian& g = points.point(l);
-          if ((b - g.mean).norm() >= reach) {
+          const double dist = (b - g.mean).norm();
+          if (dist >= reach) {
             ++wb.pairs_pruned;
             culled = true;
             continue;
           }
+          if (dist > R && block_log_peak - (dist - R) * (dist - R) * half_inv <= best_log) {
+            ++wb.pairs_pruned;
+            continue;
+          }
           ++wb.pairs_evaluated;
-          Record(EvaluatePairLogBound(g, b, R), k, l, t, points, &wb);
+          const double log_bound = EvaluatePairLogBound(g, b, R);
+          if (log_bound > best_log) {
+            best_log = log_bound;
+            Record(log_bound, k, l, t, points, &wb);
+          }
         }
       }
     }

@@ -13,7 +13,11 @@
 // covariance eigenvalue and density peak, has a bound below `negligible`
 // (the density outside that distance is below negligible / V(R) everywhere
 // in the ball), and a block whose ball is that far from a robot sphere is
-// skipped whole. When every pair of a waypoint was culled its bound is
+// skipped whole. A pair (or block) whose upper bound V(R) exp(log_peak -
+// (dist - R)^2 / 2 s_max) cannot exceed the waypoint's best so far is
+// skipped as well, and a waypoint stops at a bound of 1, so the maximum and
+// its argmax (the first pair attaining it) are those of all pairs.
+// When every pair of a waypoint was culled its bound is
 // reported as `negligible` (exact = false), so the result is always an upper
 // bound and equals the all-pairs maximum whenever that is above negligible.
 //
@@ -76,7 +80,8 @@ struct PointsBoundParams {
 /// P_i per waypoint of `trajectory` (its `steps` only count the waypoints)
 /// into *out (resized to trajectory.num_waypoints()): bound, exact, the
 /// robot sphere and link, human_sphere = the point's input index (segment and
-/// action -1), pairs evaluated and culled. Empty points give bound 0.
+/// action -1), pairs evaluated and skipped (culled or unable to exceed the
+/// best; pairs after a bound of 1 are not counted). Empty points give bound 0.
 /// Does not allocate when *out has the right size. Thread-safe.
 void EvaluatePointsBound(const GaussianPoints& points, const RobotSpheresTrajectory& trajectory,
                          const PointsBoundParams& params, std::vector<WaypointBound>* out);
