@@ -5,6 +5,9 @@
 #include "risk_monitor.h"
 
 namespace iplan::collision_risk {
+namespace {
+constexpr double kMinPointVariance = 1e-6;  // m^2, (1 mm)^2
+}  // namespace
 
 std::optional<std::string> RiskMonitor::UpdateHumanPoints(int64_t stamp_ns, double voxel_size,
                                                           const Eigen::Matrix3Xd& means,
@@ -12,8 +15,13 @@ std::optional<std::string> RiskMonitor::UpdateHumanPoints(int64_t stamp_ns, doub
   if (!(voxel_size >= 0)) return std::string("human points: voxel_size is negative or not finite");
   const PointsParams& pp = params_.human_points;
   const double radius = std::max(pp.min_point_radius, 0.5 * voxel_size);
+  // A floor of 1 mm standard deviation: noise-free points (a simulator's, a
+  // zero covariance the boundary accepts as semi-definite) still have a
+  // density; it changes the sensor's millimetre-to-centimetre noise by little.
+  std::vector<Eigen::Matrix3d> floored(covariances);
+  for (Eigen::Matrix3d& c : floored) c += kMinPointVariance * Eigen::Matrix3d::Identity();
   collision::GaussianPoints points;
-  if (auto why = points.Set(means, covariances, radius, pp.block_size)) return "human points: " + *why;
+  if (auto why = points.Set(means, floored, radius, pp.block_size)) return "human points: " + *why;
   points_ = std::move(points);
   points_stamp_ns_ = stamp_ns;
   return std::nullopt;

@@ -112,14 +112,18 @@ TEST_F(RiskPointsTest, BadPointsAreRefusedAndLeaveTheLastGoodOnes) {
   const int64_t t = 100 * kSec;
   RobotAtReady(t);
   SeePoints(t, 1.2, 50);
-  Eigen::Matrix3Xd mu = Eigen::Matrix3Xd::Zero(3, 1);
-  auto why = monitor_.UpdateHumanPoints(t, 0.01, mu, {Eigen::Matrix3d::Zero()});
+  Eigen::Matrix3Xd mu = Eigen::Matrix3Xd::Constant(3, 1, 5.0);
+  auto why = monitor_.UpdateHumanPoints(t, 0.01, mu, {-1e-4 * Eigen::Matrix3d::Identity()});
   ASSERT_TRUE(why.has_value());
   EXPECT_NE(why->find("not positive definite"), std::string::npos) << *why;
   EXPECT_NE(monitor_.UpdateHumanPoints(t, -1.0, mu, {1e-4 * Eigen::Matrix3d::Identity()}), std::nullopt);
-  const RiskReport r = monitor_.Evaluate(t);
+  RiskReport r = monitor_.Evaluate(t);
   ASSERT_TRUE(r.min_separation.has_value());
   EXPECT_NEAR(*r.min_separation, 1.2, 1e-9);
+  // Noise-free points (zero covariance, semi-definite) get the 1 mm floor.
+  EXPECT_EQ(monitor_.UpdateHumanPoints(t, 0.01, mu, {Eigen::Matrix3d::Zero()}), std::nullopt);
+  r = monitor_.Evaluate(t);
+  EXPECT_GT(*r.min_separation, 4.0);
 }
 
 }  // namespace
