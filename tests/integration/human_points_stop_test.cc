@@ -101,9 +101,20 @@ double Distance(const collision::RobotModel& robot, const std::vector<double>& q
   return best;
 }
 
-TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
+struct Walk {
+  std::vector<State> states;
+  std::vector<Risk> risks;
+};
+
+// The cell with the person walking in: 2 s standing 2.3 m away (the robot
+// reaches), then the walk at 0.5 m/s to kFinalX, then 3 s standing there.
+// Times are s since the walk started.
+Walk RunWalk(const std::string& risk_vendor) {
   const int domain = UniqueDomain(95);
-  Process risk({BinPath("iplan-collision-risk"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
+  Walk w;
+  std::vector<State>& states = w.states;
+  std::vector<Risk>& risks = w.risks;
+  Process risk({BinPath("iplan-collision-risk"), "--dds", risk_vendor, "--domain", std::to_string(domain), "--set",
                 "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]"});
   Process sim({BinPath("iplan-robot-sim"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
                "robot_sim.permits.monitors=[iplan-collision_risk]", "--set",
@@ -113,8 +124,6 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
   framework::Node& node = *cell.node;
   auto& traj = node.Advertise(framework::topics::RobotTrajectory());
   auto& points = cloud.node->Advertise(framework::topics::HumanPoints());
-  std::vector<State> states;
-  std::vector<Risk> risks;
   Clock::time_point walk_start{};
   double person_x = 2.3;
   auto since = [&] { return std::chrono::duration<double>(Clock::now() - walk_start).count(); };
@@ -130,10 +139,8 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
                      }));
   const auto up = Clock::now() + 30s;
   while (Clock::now() < up && (traj.MatchedReaders() < 2 || points.MatchedReaders() == 0)) node.SpinOnce(20ms);
-  ASSERT_EQ(traj.MatchedReaders(), 2) << risk.Stderr() << sim.Stderr();
+  EXPECT_EQ(traj.MatchedReaders(), 2) << risk.Stderr() << sim.Stderr();
   traj.Write(Reaching(msg::Now()));
-  // 2 s with the person standing 2.3 m away (the robot reaches), then the
-  // walk at 0.5 m/s to kFinalX, then 3 s standing there.
   const auto t0 = Clock::now();
   auto next_points = t0;
   while (Clock::now() - t0 < 9s) {
@@ -151,6 +158,11 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
   EXPECT_EQ(risk.Wait(10s), 0) << risk.Stderr();
   EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
   if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << risk.Stderr() << "\n";  // the monitor's log, to debug
+  return w;
+}
+
+TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
+  const auto [states, risks] = RunWalk("fastdds");
 
   // Without a stop the reaching arm would go through the standing person's points.
   double unstopped = std::numeric_limits<double>::infinity();
@@ -161,7 +173,10 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
   ASSERT_GT(risks.size(), 50u);
   ASSERT_GT(states.size(), 100u);
   // The robot sweeps under an OK verdict while the person is far.
-  EXPECT_EQ(risks.front().r.verdict, msg::CollisionRisk::OK) << risks.front().r.reason;
+  // (A verdict may stop for points that came late: safe, and not the point.)
+  int early_ok = 0;
+  for (const Risk& r : risks) early_ok += r.t < 1.0 && r.r.verdict == msg::CollisionRisk::OK;
+  EXPECT_GE(early_ok, 5) << risks.front().r.reason;
   double early_speed = 0;
   for (const State& s : states)
     if (s.t < 1.5) early_speed = std::max(early_speed, std::abs(s.qd[1]));
