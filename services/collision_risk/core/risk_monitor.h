@@ -22,7 +22,9 @@
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
 // unknown, or (person_required) no person is tracked; SLOW_DOWN when within
 // a margin of either; OK otherwise. Without a usable prediction the monitor
-// runs degraded: separation only, at the ISO default human speed.
+// runs degraded: separation only, at the ISO default human speed. A person
+// seen only as depth points (no fresh skeleton, or no usable prediction) is
+// monitored on the points: risk_points.cc, point_risk.h.
 //
 // Frames and units: positions in the world frame (= robot base frame), m;
 // times are ns since the epoch on input and s relative to the evaluation in
@@ -59,8 +61,8 @@ struct RiskParams {
   double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
   double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
   /// No fresh skeleton and no fresh depth points mean protective stop: a
-  /// person no sensor sees could be anywhere. false: "no person seen" is clear (a cell whose perception
-  /// publishes nothing when nobody is there).
+  /// person no sensor sees could be anywhere. false: "no person seen" is
+  /// clear (a cell whose perception publishes nothing when nobody is there).
   bool person_required = true;
   /// rad (m for prismatic joints); a robot state further outside the joint
   /// limits is refused as corrupt (encoder noise and a stop's overshoot stay within)
