@@ -200,8 +200,11 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
             << stop->r.protective_separation << " m: " << stop->r.reason << "\n";
   EXPECT_GT(stop->r.min_separation, 0.3);
   // Every later verdict is a stop (the person comes and stays within S_p).
-  for (const Risk& r : risks)
-    if (r.t > stop->t) EXPECT_EQ(r.r.verdict, msg::CollisionRisk::PROTECTIVE_STOP) << "+" << r.t << ": " << r.r.reason;
+  for (const Risk& r : risks) {
+    if (r.t > stop->t) {
+      EXPECT_EQ(r.r.verdict, msg::CollisionRisk::PROTECTIVE_STOP) << "+" << r.t << ": " << r.r.reason;
+    }
+  }
   // The robot is at rest within its stopping time (0.3 s) plus a permit's
   // validity and delivery (0.3 s), and never touches the points.
   double closest = std::numeric_limits<double>::infinity(), late_speed = 0;
