@@ -195,6 +195,9 @@ TEST(HumanPointsStop, APersonSeenOnlyAsPointsStopsTheRobotBeforeContact) {
     break;
   }
   ASSERT_NE(stop, nullptr) << "never stopped for the points";
+  double risk_gap = 0;  // the monitor's longest silence: > stale_after means it was starved, not the points lost
+  for (std::size_t i = 1; i < risks.size(); ++i) risk_gap = std::max(risk_gap, risks[i].t - risks[i - 1].t);
+  std::cout << "longest gap between collision-risk messages " << risk_gap << " s\n";
   std::cout << "first protective stop for the points at +" << stop->t << " s (" << stale_stops
             << " stops before for late points): separation " << stop->r.min_separation << " m, S_p "
             << stop->r.protective_separation << " m: " << stop->r.reason << "\n";
