@@ -61,6 +61,10 @@ class CollisionRiskService : public framework::Service {
                      }
                      node.CountRejection("skeleton", monitor_->UpdateSkeleton(m.body_id, msg::ToNanoseconds(m.header.stamp), names, p));
                    }));
+    node.Subscribe(framework::topics::HumanPoints(),
+                   std::function<void(const msg::HumanPoints&, SI)>([this, &node](const msg::HumanPoints& m, SI) {
+                     OnHumanPoints(node, m);
+                   }));
     node.Subscribe(framework::topics::HumanPrediction(),
                    std::function<void(const msg::HumanPrediction&, SI)>([this, &node](const msg::HumanPrediction& m, SI) {
                      OnPrediction(node, m);
@@ -84,6 +88,20 @@ class CollisionRiskService : public framework::Service {
   }
 
  private:
+  // The depth camera's view of the person (stands in for the skeleton and
+  // the prediction while they are missing: core/risk_points.cc).
+  void OnHumanPoints(Node& node, const msg::HumanPoints& m) {
+    Eigen::Matrix3Xd means(3, static_cast<Eigen::Index>(m.points.size()));
+    std::vector<Eigen::Matrix3d> covariances(m.points.size());
+    for (std::size_t i = 0; i < m.points.size(); ++i) {
+      const auto& p = m.points[i];
+      means.col(static_cast<Eigen::Index>(i)) = Eigen::Vector3d(p.mean.x, p.mean.y, p.mean.z);
+      covariances[i] = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(p.covariance.data());
+    }
+    node.CountRejection("human_points",
+                        monitor_->UpdateHumanPoints(msg::ToNanoseconds(m.header.stamp), m.voxel_size, means, covariances));
+  }
+
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {
     const PredictionInput in = services::ToJointMixture(m);
     const auto rejection = monitor_->UpdatePrediction(m.body_id, in);

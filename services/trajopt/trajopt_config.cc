@@ -15,6 +15,7 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   c.planner_overrides = config.ReadParamsFile("planner", "planner.yaml", &c.planner_file);
   config.Read("use_prediction", &c.use_prediction);
   config.Read("replan_on_prediction", &c.replan_on_prediction);
+  config.Read("obstacle_timeout", &c.obstacle_timeout, framework::InRange(0.1, 60.0));
   core::ReadParams(config, &c.replanner);  // ranges: ReplannerParams::Validate
   c.robot_file = config.ResolvePath(robot_file);
   c.human_body_file = config.ResolvePath(body_file);

@@ -27,12 +27,15 @@ struct TrajoptConfig {
   /// true: a cycle starts when a prediction arrives (and on the planning
   /// step's tick when none does); false: only on the tick.
   bool replan_on_prediction = true;
+  /// s a box of /iplan/obstacles stays in the plan's scene after it was
+  /// last seen (core/obstacle_set.h).
+  double obstacle_timeout = 2.0;
 };
 
 /// Reads `section` (trajopt); every problem, ReplannerParams::Validate()'s
 /// included, is recorded in the configuration (reported by Finish()). Keys:
 /// robot, human_body, scene, planner (file names, relative to the
-/// configuration file), use_prediction and ReplannerParams::Serialize's.
+/// configuration file), use_prediction, replan_on_prediction, obstacle_timeout and ReplannerParams::Serialize's.
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& section);
 
 /// Loads the robot model, static scene and planner parameters named by

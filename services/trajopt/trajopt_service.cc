@@ -8,6 +8,7 @@
 #include <stdexcept>
 
 #include "common/adapters.h"
+#include "core/obstacle_set.h"
 #include "iplan/framework/service.h"
 #include "trajopt_config.h"
 
@@ -25,6 +26,7 @@ class TrajoptService : public framework::Service {
     planning_step_ = c.replanner.planning_step;
     use_prediction_ = c.use_prediction;
     replan_on_prediction_ = c.replan_on_prediction;
+    obstacles_ = ObstacleSet(c.obstacle_timeout);
     if (!use_prediction_) node.log().warn("trajopt.use_prediction is false: plans ignore the person (ablation)");
     try {
       planner_ = MakePlanner(c);
@@ -53,6 +55,10 @@ class TrajoptService : public framework::Service {
                      // ran less than half a planning step ago.
                      const auto now = std::chrono::steady_clock::now();
                      if (replan_on_prediction_ && active_ && now - last_cycle_ >= MinCycleGap()) Step(node);
+                   }));
+    node.Subscribe(framework::topics::Obstacles(),
+                   std::function<void(const msg::ObstacleArray&, SI)>([this, &node](const msg::ObstacleArray& m, SI) {
+                     OnObstacles(node, m);
                    }));
     // The supervisor's permit tells whether the cell is stopped (its stop
     // covers the collision-risk verdict too): stop time counts as delay.
@@ -94,6 +100,27 @@ class TrajoptService : public framework::Service {
   }
 
  private:
+  // A changed obstacle set replans at once: a box put in the robot's path
+  // must not wait for the next tick.
+  void OnObstacles(Node& node, const msg::ObstacleArray& m) {
+    std::vector<ObstacleBox> boxes;
+    for (const auto& o : m.obstacles) {
+      ObstacleBox b;
+      b.id = o.id;
+      b.centre = {o.centre.x, o.centre.y, o.centre.z};
+      b.half_extents = {o.half_extents[0], o.half_extents[1], o.half_extents[2]};
+      boxes.push_back(b);
+    }
+    bool changed = false;
+    const auto why = obstacles_.Update(msg::ToNanoseconds(m.header.stamp), boxes, &changed);
+    node.CountRejection("obstacles", why);
+    if (why || !changed) return;
+    replanner_->SetObstacles(obstacles_.SceneObjects());
+    node.SetDiagnosticValue("obstacles", std::to_string(obstacles_.size()));
+    node.log().info("{} obstacle(s) in the scene: replanning", obstacles_.size());
+    if (active_) Step(node);
+  }
+
   void OnCommand(Node& node, const msg::TaskCommand& m) {
     const int64_t now = msg::ToNanoseconds(msg::Now());
     if (m.command == msg::TaskCommand::CANCEL) {
@@ -171,6 +198,11 @@ class TrajoptService : public framework::Service {
     const auto t0 = std::chrono::steady_clock::now();
     last_cycle_ = t0;
     const int64_t cycle_start_ns = msg::ToNanoseconds(msg::Now());
+    if (obstacles_.Expire(cycle_start_ns)) {
+      replanner_->SetObstacles(obstacles_.SceneObjects());
+      node.SetDiagnosticValue("obstacles", std::to_string(obstacles_.size()));
+      node.log().info("obstacle(s) no longer seen: {} left in the scene", obstacles_.size());
+    }
     const CycleResult r = replanner_->Cycle(cycle_start_ns);
     msg::PlanStatus status;
     if (r.publish) {
@@ -224,6 +256,7 @@ class TrajoptService : public framework::Service {
   std::unique_ptr<planning::Planner> planner_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   std::unique_ptr<Replanner> replanner_;
+  ObstacleSet obstacles_;  // the boxes of /iplan/obstacles the plans keep clear of
   dds::Writer<msg::JointTrajectory>* trajectory_writer_ = nullptr;
   dds::Writer<msg::TaskOutcome>* outcome_writer_ = nullptr;
   dds::Writer<msg::PlanStatus>* status_writer_ = nullptr;

@@ -84,7 +84,7 @@ void PlannerModel::AddLimitCost(const Problem& at, Workspace* ws, CostTerms* ev,
 void PlannerModel::AddObstacleCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const {
   const double w = params.weights.obstacle, margin = params.obstacle_margin;
   const int S = static_cast<int>(radii.size());
-  const int NO = static_cast<int>(objects.size());
+  const int NO = NumObjects(at);
   const int NG = static_cast<int>(link_groups.size());
   ws->far.resize(static_cast<std::size_t>(NG) * NO);
   for (int i = at.k; i < at.n; ++i) {
@@ -93,7 +93,7 @@ void PlannerModel::AddObstacleCost(const Problem& at, Workspace* ws, CostTerms* 
       Eigen::Vector3d c;
       const double cover = LinkBall(d, link_groups[g], &c);
       for (int o = 0; o < NO; ++o) {
-        const auto& ob = objects[o];
+        const auto& ob = Object(at, o);
         double lower_bound = (c - ob.centre_W).norm() - ob.bounding_radius - cover;
         if (lower_bound < margin + 1e-9) lower_bound = PointSignedDistance(ob, c, nullptr) - cover;
         ws->far[g * NO + o] = lower_bound >= margin + 1e-9;
@@ -104,8 +104,8 @@ void PlannerModel::AddObstacleCost(const Problem& at, Workspace* ws, CostTerms* 
       Eigen::Vector3d gp = Eigen::Vector3d::Zero();
       bool any = false;
       for (int o = 0; o < NO; ++o) {
-        if (!checked[s][o] || ws->far[sphere_group[s] * NO + o]) continue;
-        const auto& ob = objects[o];
+        if (!Checked(s, o) || ws->far[sphere_group[s] * NO + o]) continue;
+        const auto& ob = Object(at, o);
         if ((p - ob.centre_W).norm() - ob.bounding_radius - radii[s] >= margin) continue;
         // The normal only for spheres within the margin (the same distance).
         const double dist = PointSignedDistance(ob, p, nullptr) - radii[s];

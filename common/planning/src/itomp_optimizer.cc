@@ -30,7 +30,7 @@ void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, 
       q = Q.col(i) + (static_cast<double>(s) / sub) *
                          (i < at.n ? Eigen::VectorXd(Q.col(i + 1) - Q.col(i)) : Eigen::VectorXd::Zero(at.nq));
       collision::CalcForwardKinematics(robot, q, &d);
-      clear = std::min(clear, Clearance(d));
+      clear = std::min(clear, Clearance(d, &at.obstacles));
     }
   }
   c->min_clearance = clear;

@@ -112,13 +112,17 @@ IkResult Planner::SolveIk(const Eigen::Vector3d& p_WE, const Eigen::Quaterniond&
   return planning::SolveIk(*I.chains, I.ee_link, I.ee_offset, X, q_seed, opt, &rng);
 }
 
-double Planner::CalcClearance(const Eigen::VectorXd& q) const {
+double Planner::CalcClearance(const Eigen::VectorXd& q) const { return CalcClearance(q, {}); }
+
+double Planner::CalcClearance(const Eigen::VectorXd& q, const std::vector<collision::SceneObject>& obstacles) const {
   if (q.size() != impl_->robot.nq || !q.allFinite())
     throw std::invalid_argument("CalcClearance: q must have " + std::to_string(impl_->robot.nq) +
                                 " finite values, got " + internal::VectorText(q));
   collision::RobotData d(impl_->robot);
   collision::CalcForwardKinematics(impl_->robot, q, &d);
-  return impl_->Clearance(d);
+  std::vector<internal::ClearanceObject> extra;
+  for (const auto& o : obstacles) extra.push_back(internal::MakeClearanceObject(o));
+  return impl_->Clearance(d, &extra);
 }
 
 std::vector<int> Planner::CheckedSpheres(int object) const {
@@ -235,7 +239,7 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     return result;
   }
   result.goal_q = q_goal;
-  if (const double c = CalcClearance(q_goal); c < P.min_clearance) {
+  if (const double c = CalcClearance(q_goal, req.obstacles); c < P.min_clearance) {
     result.status = PlanStatus::kGoalInCollision;
     result.reason = "goal configuration has clearance " + std::to_string(c) + " m < " +
                     std::to_string(P.min_clearance) + " m";

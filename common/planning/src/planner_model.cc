@@ -92,17 +92,19 @@ double PlannerModel::LinkBall(const collision::RobotData& data, const std::vecto
   return cover;
 }
 
-double PlannerModel::Clearance(const collision::RobotData& data) const {
+double PlannerModel::Clearance(const collision::RobotData& data, const std::vector<ClearanceObject>* obstacles) const {
   // Per link, a ball around its spheres first (the signed distance is
   // 1-Lipschitz; 1e-9 against rounding): links that cannot go below the
   // best so far are skipped. The minimum is the same.
   double best = std::numeric_limits<double>::infinity();
+  const int ns = static_cast<int>(objects.size());
+  const int no = ns + (obstacles ? static_cast<int>(obstacles->size()) : 0);
   for (const std::vector<int>& grp : link_groups) {
     Eigen::Vector3d c;
     const double cover = LinkBall(data, grp, &c);
-    for (int o = 0; o < static_cast<int>(objects.size()); ++o) {
-      if (!checked[grp[0]][o]) continue;  // allowed pairs are per link
-      const auto& ob = objects[o];
+    for (int o = 0; o < no; ++o) {
+      if (!Checked(grp[0], o)) continue;  // allowed pairs are per link
+      const auto& ob = o < ns ? objects[o] : (*obstacles)[o - ns];
       if ((c - ob.centre_W).norm() - ob.bounding_radius - cover >= best + 1e-9) continue;
       if (PointSignedDistance(ob, c, nullptr) - cover >= best + 1e-9) continue;
       for (int s : grp) {

@@ -64,6 +64,9 @@ struct Problem {
     std::vector<int> steps;
   };
   std::vector<Person> people;  // empty: nobody
+  // PlanningRequest::obstacles, checked against every robot sphere; their
+  // object indices follow the scene's (PlannerModel::NumObjects).
+  std::vector<ClearanceObject> obstacles;
   // Exact bounds of the waypoints no optimiser changes (the frozen prefix
   // 0..k-1 and the goal n; size n+1, free entries unused), computed once
   // per attempt by FixBounds.
@@ -154,8 +157,16 @@ struct PlannerModel {
   // spheres' mean) and its radius, which covers every sphere. Distances
   // are 1-Lipschitz, so the ball's distance bounds all its spheres'.
   double LinkBall(const collision::RobotData& data, const std::vector<int>& group, Eigen::Vector3d* c) const;
-  // Minimum signed distance of all checked spheres at the FK in `data`.
-  double Clearance(const collision::RobotData& data) const;
+  // Minimum signed distance of all checked spheres at the FK in `data` to
+  // the scene and to `obstacles` (may be null; every sphere is checked).
+  double Clearance(const collision::RobotData& data, const std::vector<ClearanceObject>* obstacles = nullptr) const;
+  // The scene's objects, then the attempt's obstacles, by one index.
+  int NumObjects(const Problem& at) const { return static_cast<int>(objects.size() + at.obstacles.size()); }
+  const ClearanceObject& Object(const Problem& at, int o) const {
+    const int ns = static_cast<int>(objects.size());
+    return o < ns ? objects[o] : at.obstacles[o - ns];
+  }
+  bool Checked(int sphere, int o) const { return o >= static_cast<int>(objects.size()) || checked[sphere][o]; }
 
   // --- problem.cc -----------------------------------------------------------
   /// Throws std::invalid_argument "Plan: ..." for bad requests.

@@ -49,6 +49,9 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
     if (!(person.dt > 0.0) || !std::isfinite(person.dt)) Bad(who + "dt must be > 0, got " + std::to_string(person.dt));
     if (!std::isfinite(person.start)) Bad(who + "start must be finite, got " + std::to_string(person.start));
   }
+  if (!req.obstacles.empty()) {
+    if (const std::string why = collision::SceneParams{req.obstacles}.Validate(); !why.empty()) Bad("obstacles: " + why);
+  }
   if (!(req.time_budget >= 0.0) || !std::isfinite(req.time_budget))
     Bad("time_budget must be finite and >= 0, got " + std::to_string(req.time_budget));
   if (req.goal.kind == Goal::Kind::kJoint) {
@@ -68,6 +71,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   Problem at;
   at.nq = nq;
   at.dt = P.dt;
+  for (const auto& o : req.obstacles) at.obstacles.push_back(MakeClearanceObject(o));
   const int horizon_n = std::max(2, static_cast<int>(std::lround(P.horizon / P.dt)));
   at.n = horizon_n;
   // A warm start longer than the horizon (it contains earlier waits) keeps

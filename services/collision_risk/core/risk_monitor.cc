@@ -31,7 +31,7 @@ std::string RiskParams::Validate() const {
   }
   if (!(s.speed_window > 0)) return "speed_window must be > 0";
   if (!(s.stopping_speed > 0)) return "stopping_speed must be > 0";
-  return "";
+  return human_points.Validate();
 }
 
 RiskMonitor::RiskMonitor(collision::RobotModel robot, collision::HumanBodyParams body, RiskParams params)
@@ -160,9 +160,15 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
     if (now_ns - e.stamp_ns <= stale && (!pred || now_ns - pred->stamp_ns > stale))
       in.degraded = params_.ssm.degrade_without_prediction;
   }
+  in.points = points_stamp_ns_ > 0 && now_ns - points_stamp_ns_ <= stale;
   r.trajectory_stamp_ns = trajectory_.empty() ? 0 : trajectory_.start_ns;
   EvaluateSeparation(now_ns, in, &r);
-  if (in.predicted) EvaluateBound(now_ns, &r);
+  if (!in.person && in.points) EvaluateSeparationFromPoints(now_ns, &r);
+  if (in.predicted) {
+    EvaluateBound(now_ns, &r);
+  } else if (in.points) {
+    EvaluateBoundFromPoints(now_ns, &r);
+  }
   DecideVerdict(now_ns, in, &r);
   return r;
 }
@@ -354,12 +360,14 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   const std::string likeliest = r.num_predicted > 1 ? " (body " + std::to_string(r.max_body_id) + " of " +
                                                           std::to_string(r.num_predicted) + ")"
                                                     : "";
-  if (!in.person && params_.person_required) {
+  const bool seen = in.person || in.points;  // fresh points: the depth camera tracks the person
+  if (!seen && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
-    r.reason = last_skeleton_ns_ == 0 ? "no person tracked yet (no skeleton): the person could be anywhere"
-                                      : "person no longer tracked (no skeleton for " +
-                                            Fmt((now_ns - last_skeleton_ns_) * 1e-9) + " s): the person could be anywhere";
-  } else if (in.person && margin < 0) {
+    const int64_t last_seen = std::max(last_skeleton_ns_, points_stamp_ns_);
+    r.reason = last_seen == 0 ? "no person tracked yet (no skeleton, no depth points): the person could be anywhere"
+                              : "person no longer tracked (no skeleton or depth points for " +
+                                    Fmt((now_ns - last_seen) * 1e-9) + " s): the person could be anywhere";
+  } else if (seen && margin < 0) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
                (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") +
@@ -379,13 +387,15 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold) + likeliest;
-  } else if (in.person && margin < params_.slow_down_margin) {
+  } else if (seen && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
                " m of the protective separation" + nearest;
   } else {
     r.verdict = Verdict::kOk;
-    r.reason = !in.person    ? "no person seen"
+    r.reason = !seen         ? "no person seen"
+               : !in.person   ? (r.binding_separation ? "clear (depth points only; separation at the default human speed)"
+                                                      : "no person seen (depth: no points)")
                : in.predicted ? "clear"
                : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
                               : "clear (separation only: no current prediction)";

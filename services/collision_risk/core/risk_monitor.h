@@ -22,7 +22,9 @@
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
 // unknown, or (person_required) no person is tracked; SLOW_DOWN when within
 // a margin of either; OK otherwise. Without a usable prediction the monitor
-// runs degraded: separation only, at the ISO default human speed.
+// runs degraded: separation only, at the ISO default human speed. A person
+// seen only as depth points (no fresh skeleton, or no usable prediction) is
+// monitored on the points: risk_points.cc, point_risk.h.
 //
 // Several people (skeletons and predictions carry a body id): each body's
 // skeleton history and newest prediction are kept apart (cell::PerBody:
@@ -58,6 +60,7 @@
 #include "iplan/collision/joint_mixture.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/trajectory_bound.h"
+#include "point_risk.h"
 
 namespace iplan::collision_risk {
 
@@ -70,14 +73,16 @@ struct RiskParams {
   double slow_down_fraction = 0.5; ///< slow down above this fraction of 1 - delta_cl
   double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
   double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
-  /// No fresh skeleton means protective stop: a person no sensor sees could
-  /// be anywhere. false: "no person seen" is clear (a cell whose perception
-  /// publishes nothing when nobody is there).
+  /// No fresh skeleton and no fresh depth points mean protective stop: a
+  /// person no sensor sees could be anywhere. false: "no person seen" is
+  /// clear (a cell whose perception publishes nothing when nobody is there).
   bool person_required = true;
   /// rad (m for prismatic joints); a robot state further outside the joint
   /// limits is refused as corrupt (encoder noise and a stop's overshoot stay within)
   double joint_limit_tolerance = 0.05;
   SsmParams ssm;
+  /// The person seen only as points (/iplan/human/points): point_risk.h.
+  PointsParams human_points;
   /// Empty when valid, else the reason.
   std::string Validate() const;
 
@@ -90,9 +95,10 @@ struct RiskParams {
     a->Visit(IPLAN_NVP(slow_down_fraction, "slow down above this fraction of 1 - delta_cl, in (0, 1]"));
     a->Visit(IPLAN_NVP(slow_down_margin, "m; slow down within S_p + this, >= 0"));
     a->Visit(IPLAN_NVP(stale_after, "s; older skeletons, predictions, robot states are not used, > 0"));
-    a->Visit(IPLAN_NVP(person_required, "no fresh skeleton means protective stop"));
+    a->Visit(IPLAN_NVP(person_required, "no fresh skeleton or depth points means protective stop"));
     a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a robot state further outside the limits is refused, >= 0"));
     a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "ISO/TS 15066 speed and separation monitoring"));
+    a->Visit(core::MakeNameValue("human_points", &human_points, "the person seen only as depth points"));
   }
 };
 
@@ -157,6 +163,13 @@ class RiskMonitor {
   std::optional<std::string> UpdatePrediction(const PredictionInput& prediction) {
     return UpdatePrediction(1, prediction);
   }
+  /// The points of the people the depth camera sees (risk_points.cc): means
+  /// 3 x n (m, W), covariances (m^2), voxel_size (m, 0: not reduced). Fresh
+  /// points stand for the person while no fresh skeleton does (separation),
+  /// and for the prediction while none is usable (bound); an empty fresh set
+  /// means the camera sees nobody.
+  std::optional<std::string> UpdateHumanPoints(int64_t stamp_ns, double voxel_size, const Eigen::Matrix3Xd& means,
+                                               const std::vector<Eigen::Matrix3d>& covariances);
 
   /// Evaluates both layers at `now_ns`. Allocates (report vectors).
   RiskReport Evaluate(int64_t now_ns);
@@ -171,7 +184,12 @@ class RiskMonitor {
     bool predicted = false;  ///< a fresh prediction (of anyone)
     bool degraded = false;   ///< a person without a usable prediction (SsmParams::degrade_without_prediction)
     int64_t stale_ns = 0;    ///< RiskParams::stale_after
+    bool points = false;     ///< fresh human points (the depth camera's view)
   };
+  /// The points' layers (risk_points.cc): separation when no skeleton is
+  /// fresh, the bound along the executing trajectory when no prediction is.
+  void EvaluateSeparationFromPoints(int64_t now_ns, RiskReport* r);
+  void EvaluateBoundFromPoints(int64_t now_ns, RiskReport* r);
   /// The ISO/TS 15066 layer into r: separation and S_p per sphere pair.
   void EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* r);
   /// The prediction layer into r: bound along the executing trajectory.
@@ -211,6 +229,9 @@ class RiskMonitor {
   cell::PerBody<cell::TimedPrediction> predictions_;
   collision::TrajectoryBoundWorkspace workspace_;
   std::vector<collision::WaypointBound> bounds_;
+  // Latest human points and their stamp (0: none yet).
+  collision::GaussianPoints points_;
+  int64_t points_stamp_ns_ = 0;
 };
 
 }  // namespace iplan::collision_risk

@@ -231,6 +231,7 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_
   }
   req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
   req.time_budget = params_.cycle_budget;
+  req.obstacles = obstacles_;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
   predictions_.Expire(now_ns, stale);
   for (const auto& [id, e] : predictions_) {

@@ -16,6 +16,7 @@
 #include <cstdint>
 #include <optional>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include "iplan/core/name_value.h"
@@ -143,6 +144,9 @@ class Replanner {
   std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction) {
     return UpdatePrediction(1, prediction);
   }
+  /// The perceived obstacles (W) every later cycle keeps clear of
+  /// (PlanningRequest::obstacles; see obstacle_set.h).
+  void SetObstacles(std::vector<collision::SceneObject> obstacles) { obstacles_ = std::move(obstacles); }
 
   /// One planning step at `now_ns`.
   CycleResult Cycle(int64_t now_ns);
@@ -165,6 +169,7 @@ class Replanner {
   bool robot_stopped_ = false;
   std::vector<std::string> robot_joints_;
   cell::PerBody<cell::TimedPrediction> predictions_;  // newest per person, stamp: its observation
+  std::vector<collision::SceneObject> obstacles_;
   struct Active {
     TaskSpec spec;
     int64_t start_ns = 0;

@@ -5,6 +5,7 @@
 #include "core/replanner.h"
 
 #include <algorithm>
+#include <limits>
 
 #include <gtest/gtest.h>
 
@@ -300,6 +301,52 @@ TEST_F(ReplannerTest, UnreachablePoseFailsAndCancelEndsTheTask) {
   const auto cancelled = replanner_.CancelTask(11, t);
   ASSERT_TRUE(cancelled.has_value());
   EXPECT_EQ(cancelled->status, TaskStatus::kCancelled);
+}
+
+TEST_F(ReplannerTest, AnObstacleAppearingMidTaskIsPlannedAround) {
+  // Joint 1 sweeping the hand low across the table (as obstacle_avoidance_test).
+  Eigen::VectorXd start(7), goal(7);
+  start << 0.45, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8;
+  goal << -0.75, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8;
+  int64_t t = 100 * kSec;
+  SetState(t, start, Eigen::VectorXd::Zero(7));
+  ASSERT_EQ(replanner_.StartTask({1, "free", planning::Goal::Joint(goal), 0}, t), std::nullopt);
+  ASSERT_TRUE(Run(&t, 80).has_value());
+  // A box on the table under the hand where the free run was furthest from
+  // both its ends.
+  collision::RobotData d(planner_.robot());
+  const int hand_link = planner_.robot().FindLink("panda_hand");
+  auto hand_at = [&](const Eigen::VectorXd& q) {
+    collision::CalcForwardKinematics(planner_.robot(), q, &d);
+    return Eigen::Vector3d(d.X_WL[hand_link].translation());
+  };
+  const Eigen::Vector3d first = hand_at(visited_.front()), last = hand_at(visited_.back());
+  Eigen::Vector3d hand = first;
+  for (const auto& q : visited_) {
+    const Eigen::Vector3d p = hand_at(q);
+    if (std::min((p - first).norm(), (p - last).norm()) > std::min((hand - first).norm(), (hand - last).norm())) hand = p;
+  }
+  collision::SceneObject box;
+  box.name = "obstacle 1";
+  box.size = Eigen::Vector3d(0.12, 0.12, hand.z() - 0.05);
+  box.X_WO.translation() = Eigen::Vector3d(hand.x(), hand.y(), 0.5 * box.size.z());
+  double free_clearance = std::numeric_limits<double>::infinity();
+  for (const auto& q : visited_) free_clearance = std::min(free_clearance, planner_.CalcClearance(q, {box}));
+  ASSERT_LT(free_clearance, -0.02);
+  // The same task again; the box is seen after 0.2 s.
+  visited_.clear();
+  t += 10 * kSec;
+  SetState(t, start, Eigen::VectorXd::Zero(7));
+  ASSERT_EQ(replanner_.StartTask({2, "box", planning::Goal::Joint(goal), 0}, t), std::nullopt);
+  const int64_t appear = t + 2 * kSec / 10;
+  const auto o = Run(&t, 100, [&](int64_t now) {
+    if (now == appear) replanner_.SetObstacles({box});
+  });
+  ASSERT_TRUE(o.has_value()) << "no outcome in 10 s";
+  EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
+  double clearance = std::numeric_limits<double>::infinity();
+  for (const auto& q : visited_) clearance = std::min(clearance, planner_.CalcClearance(q, {box}));
+  EXPECT_GE(clearance, 0.0);
 }
 
 TEST(ReplannerParams, TheDocumentedDefaultsAreTheDeclaredOnes) {

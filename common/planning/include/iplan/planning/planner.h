@@ -100,6 +100,11 @@ struct PlanningRequest {
   /// budget_exhausted tells. Results then depend on timing; without a budget
   /// they are bit-identical for the same request, parameters and seed.
   double time_budget = 0.0;
+  /// Obstacles perceived at run time (W, m; e.g. the boxes of
+  /// /iplan/obstacles) that join the scene for this request: every robot
+  /// sphere is kept clear of them like of the scene's objects (obstacle cost,
+  /// clearance check, goal check). Each must pass SceneParams::Validate.
+  std::vector<collision::SceneObject> obstacles;
 };
 
 enum class PlanStatus {
@@ -173,6 +178,8 @@ class Planner {
   /// skipping allowed collisions (analytic box/cylinder distances, the same
   /// as the optimiser uses). Thread-safe; allocates.
   double CalcClearance(const Eigen::VectorXd& q) const;
+  /// The same including perceived `obstacles` (PlanningRequest::obstacles).
+  double CalcClearance(const Eigen::VectorXd& q, const std::vector<collision::SceneObject>& obstacles) const;
 
   /// Sphere indices that are checked against object `object` (allowed
   /// collisions removed). For independent verification (e.g. with FCL).

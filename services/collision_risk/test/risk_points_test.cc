@@ -1,0 +1,130 @@
+// The risk monitor with a person seen only as depth points
+// (RiskMonitor::UpdateHumanPoints, risk_points.cc): the separation and S_p
+// numbers, the bound's growth, and what counts as a tracked person.
+#include <gtest/gtest.h>
+
+#include "core/risk_monitor.h"
+
+namespace iplan::collision_risk {
+namespace {
+
+constexpr int64_t kSec = 1000000000;
+const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                               "panda_joint5", "panda_joint6", "panda_joint7"};
+const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+
+class RiskPointsTest : public ::testing::Test {
+ protected:
+  RiskPointsTest()
+      : robot_(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml")),
+        monitor_(robot_, collision::HumanBodyParams::DefaultUpperBody(), RiskParams{}) {
+    collision::RobotData d(robot_);
+    Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(kReady.data(), 7);
+    collision::CalcForwardKinematics(robot_, q, &d);
+    spheres_ = d.p_WS;
+    // The sphere whose surface reaches furthest along +x (towards the person).
+    for (int k = 0; k < spheres_.cols(); ++k)
+      if (front_ < 0 || spheres_(0, k) + robot_.spheres[k].radius > spheres_(0, front_) + robot_.spheres[front_].radius)
+        front_ = k;
+  }
+  void RobotAtReady(int64_t t) { ASSERT_EQ(monitor_.UpdateRobotState(t, kRobotJoints, kReady), std::nullopt); }
+  // Points (sigma `sigma`, voxel 1 cm: r_p = 5 mm) in front of the front
+  // sphere: the first `gap` m from its surface along +x (so no other sphere
+  // is nearer), the others 1 m further on, spread over 0.4 m x 0.4 m.
+  void SeePoints(int64_t t, double gap, int n = 1, double sigma = 0.005) {
+    const Eigen::Vector3d c = spheres_.col(front_);
+    Eigen::Matrix3Xd mu(3, n);
+    mu.col(0) = c + Eigen::Vector3d(robot_.spheres[front_].radius + 0.005 + gap, 0, 0);
+    for (int i = 1; i < n; ++i)
+      mu.col(i) = mu.col(0) + Eigen::Vector3d(1.0, 0.4 * (i % 10) / 9.0 - 0.2, 0.4 * (i / 10 % 10) / 9.0 - 0.2);
+    ASSERT_EQ(monitor_.UpdateHumanPoints(t, 0.01, mu, std::vector<Eigen::Matrix3d>(n, sigma * sigma * Eigen::Matrix3d::Identity())),
+              std::nullopt);
+  }
+  collision::RobotModel robot_;
+  RiskMonitor monitor_;
+  Eigen::Matrix3Xd spheres_;
+  int front_ = -1;
+};
+
+TEST_F(RiskPointsTest, PointsAtAKnownDistanceGiveTheSeparationAndSp) {
+  // A still robot (v_r = 0: S_s = 0) and points without a speed (v_h = 1.6
+  // m/s): S_p = 1.6 (0.1 + 0.3) + 0.1 + 0.05 + 0.02 = 0.81 m.
+  const int64_t t = 100 * kSec;
+  struct Case {
+    double gap;
+    Verdict verdict;
+  };
+  for (const Case c : {Case{1.2, Verdict::kOk}, Case{0.9, Verdict::kSlowDown}, Case{0.4, Verdict::kProtectiveStop}}) {
+    SCOPED_TRACE("gap " + std::to_string(c.gap));
+    RobotAtReady(t);
+    SeePoints(t, c.gap, 100);
+    const RiskReport r = monitor_.Evaluate(t + kSec / 100);
+    ASSERT_TRUE(r.min_separation.has_value()) << r.reason;
+    EXPECT_NEAR(*r.min_separation, c.gap, 1e-9);
+    EXPECT_EQ(r.separation_human_segment, "points");
+    EXPECT_NEAR(r.protective_separation, 0.81, 1e-12);
+    EXPECT_DOUBLE_EQ(r.human_speed, 1.6);
+    EXPECT_DOUBLE_EQ(r.robot_speed, 0.0);
+    EXPECT_NEAR(*r.separation_margin, c.gap - 0.81, 1e-9);
+    EXPECT_EQ(r.verdict, c.verdict) << r.reason;
+  }
+}
+
+TEST_F(RiskPointsTest, TheBoundGrowsAsThePointsApproach) {
+  const int64_t t = 100 * kSec;
+  double previous = 0;
+  // One point, sigma 1 cm: bounds about 1e-6, 3e-4, 0.02, 0.16.
+  for (double gap : {0.06, 0.05, 0.04, 0.035}) {
+    SCOPED_TRACE("gap " + std::to_string(gap));
+    RobotAtReady(t);
+    SeePoints(t, gap, 1, 0.01);
+    const RiskReport r = monitor_.Evaluate(t);
+    ASSERT_EQ(r.waypoint_bounds.size(), 15u);  // 1.5 s horizon at 0.1 s
+    EXPECT_DOUBLE_EQ(r.waypoint_times.front(), 0.1);
+    EXPECT_EQ(r.max_human_segment, "points");
+    EXPECT_EQ(r.prediction_stamp_ns, 0);
+    EXPECT_GT(r.max_bound, previous);
+    previous = r.max_bound;
+  }
+  EXPECT_GT(previous, 0.05);  // 3.5 cm at 1 cm noise: far from negligible
+}
+
+TEST_F(RiskPointsTest, FreshPointsCountAsATrackedPersonStaleOnesDoNot) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  RiskReport r = monitor_.Evaluate(t);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);  // person_required, nothing seen
+  EXPECT_EQ(r.reason.rfind("no person tracked yet", 0), 0u) << r.reason;
+  // The camera sees nobody: an empty, fresh set of points.
+  ASSERT_EQ(monitor_.UpdateHumanPoints(t, 0.01, Eigen::Matrix3Xd(3, 0), {}), std::nullopt);
+  r = monitor_.Evaluate(t + kSec / 10);
+  EXPECT_EQ(r.verdict, Verdict::kOk) << r.reason;
+  EXPECT_EQ(r.reason, "no person seen (depth: no points)");
+  EXPECT_FALSE(r.min_separation.has_value());
+  SeePoints(t, 1.5);
+  RobotAtReady(t + kSec);
+  r = monitor_.Evaluate(t + kSec);  // the points are 1 s old (stale_after 0.5 s)
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop);
+  EXPECT_EQ(r.reason.rfind("person no longer tracked", 0), 0u) << r.reason;
+}
+
+TEST_F(RiskPointsTest, BadPointsAreRefusedAndLeaveTheLastGoodOnes) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  SeePoints(t, 1.2, 50);
+  Eigen::Matrix3Xd mu = Eigen::Matrix3Xd::Constant(3, 1, 5.0);
+  auto why = monitor_.UpdateHumanPoints(t, 0.01, mu, {-1e-4 * Eigen::Matrix3d::Identity()});
+  ASSERT_TRUE(why.has_value());
+  EXPECT_NE(why->find("not positive definite"), std::string::npos) << *why;
+  EXPECT_NE(monitor_.UpdateHumanPoints(t, -1.0, mu, {1e-4 * Eigen::Matrix3d::Identity()}), std::nullopt);
+  RiskReport r = monitor_.Evaluate(t);
+  ASSERT_TRUE(r.min_separation.has_value());
+  EXPECT_NEAR(*r.min_separation, 1.2, 1e-9);
+  // Noise-free points (zero covariance, semi-definite) get the 1 mm floor.
+  EXPECT_EQ(monitor_.UpdateHumanPoints(t, 0.01, mu, {Eigen::Matrix3d::Zero()}), std::nullopt);
+  r = monitor_.Evaluate(t);
+  EXPECT_GT(*r.min_separation, 4.0);
+}
+
+}  // namespace
+}  // namespace iplan::collision_risk
