@@ -45,6 +45,14 @@ QosProfile QosProfile::Relaxed() {
   return q;
 }
 
+QosProfile QosProfile::AcceptingAnyWriter() const {
+  QosProfile q = *this;
+  q.deadline = std::chrono::nanoseconds(0);
+  q.liveliness_lease = std::chrono::nanoseconds(0);
+  q.durability = Durability::kVolatile;
+  return q;
+}
+
 QosProfile QosProfile::RelaxedFor() const {
   QosProfile q = Relaxed();
   if (durability == Durability::kTransientLocal) {

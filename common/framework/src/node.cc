@@ -82,6 +82,9 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
   for (const auto& [id, t] : timers_) {
     wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(t.next - now, std::chrono::nanoseconds(0)));
   }
+  if (const auto due = CheckDeadlines()) {
+    wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(*due - now, std::chrono::nanoseconds(0)));
+  }
   if (wait.count() > 0 || !subscriptions_.empty()) {
     participant_.Wait(std::max(wait, std::chrono::nanoseconds(1)), &ready_);
   }
@@ -91,6 +94,7 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
     HandleEvents(*it->second);
     it->second->Dispatch(*this);
   }
+  CheckDeadlines();
   RunTimers();
 }
 
@@ -101,8 +105,34 @@ void Node::SpinUntil(const std::function<bool()>& stop, const std::function<void
   }
 }
 
+std::optional<std::chrono::steady_clock::time_point> Node::CheckDeadlines() {
+  const auto now = std::chrono::steady_clock::now();
+  std::optional<std::chrono::steady_clock::time_point> next;
+  // By index: an event callback may subscribe to more topics.
+  for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
+    SubscriptionBase& sub = *subscriptions_[i];
+    if (sub.deadline.count() <= 0 || !sub.last_sample) continue;
+    auto due = *sub.last_sample + sub.deadline * (sub.missed_periods + 1);
+    if (now >= due) {
+      // One event per period without a sample, as the DDS policy reports.
+      const int periods = static_cast<int>((now - *sub.last_sample) / sub.deadline);
+      const int change = std::max(1, periods - sub.missed_periods);
+      sub.missed_periods += change;
+      sub.deadline_misses_total += change;
+      HandleEvent(sub, dds::ReaderEvent{dds::EventKind::kDeadlineMissed, sub.deadline_misses_total, change, 0});
+      due = *sub.last_sample + sub.deadline * (sub.missed_periods + 1);
+    }
+    if (!next || due < *next) next = due;
+  }
+  return next;
+}
+
 void Node::HandleEvents(SubscriptionBase& sub) {
-  for (const dds::ReaderEvent& e : sub.reader->TakeEvents()) {
+  for (const dds::ReaderEvent& e : sub.reader->TakeEvents()) HandleEvent(sub, e);
+}
+
+void Node::HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e) {
+  {
     const std::string& topic = sub.reader->topic();
     switch (e.kind) {
       case dds::EventKind::kDeadlineMissed:

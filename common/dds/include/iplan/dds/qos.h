@@ -45,6 +45,11 @@ struct QosProfile {
   /// The same profile with the reader's durability raised to transient-local
   /// when the writer's profile is latched (for tools echoing a latched topic).
   QosProfile RelaxedFor() const;
+  /// The reader side that matches every writer this profile's writers would,
+  /// and a ROS 2 default publisher too: the reader's reliability, no
+  /// deadline, infinite lease, volatile (a late joiner waits for the next
+  /// sample). The caller watches the deadline itself (framework::Node).
+  QosProfile AcceptingAnyWriter() const;
 
   /// Empty when the profile is consistent, else the reason.
   std::string Validate() const;

@@ -18,7 +18,14 @@
 //     samples the writer's clock is taken to have stepped back and the
 //     ordering restarts from the new stamp (logged).
 // A failing message is rejected, counted per topic, logged once (then every
-// 100th), and reported in diagnostics. A callback that throws is logged and
+// 100th), and reported in diagnostics.
+//
+// Readers accept what any writer offers, a ROS 2 default publisher included
+// (no DEADLINE, infinite LIVELINESS lease, volatile): a reader that requested
+// the topic's deadline or lease would not match such a writer at all. The
+// node watches the topic's deadline itself instead: after the first sample,
+// every deadline period without one is a kDeadlineMissed event, as the DDS
+// policy would report it. Liveliness is tracked with each writer's own lease. A callback that throws is logged and
 // counted; it never takes the service down.
 //
 // Threading: all callbacks and timers run on the thread that calls
@@ -164,6 +171,11 @@ class Node {
       int64_t last_ns = 0;
       int backwards = 0;  // consecutive backwards samples
     };
+    // The topic's deadline, watched here (see the file comment).
+    std::chrono::nanoseconds deadline{0};
+    std::optional<std::chrono::steady_clock::time_point> last_sample;  // any sample taken
+    int missed_periods = 0;  // since the last sample
+    int32_t deadline_misses_total = 0;
     std::map<uint64_t, WriterClock> clocks;  // per writer
     std::set<std::string> ignored_names;     // logged once each
   };
@@ -176,6 +188,10 @@ class Node {
   };
 
   void HandleEvents(SubscriptionBase& sub);
+  /// Reports a missed deadline period of `sub` (counted, logged, on_event_).
+  void HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e);
+  /// Emits the deadline misses due by now; returns the time of the next one.
+  std::optional<std::chrono::steady_clock::time_point> CheckDeadlines();
   void Reject(SubscriptionBase& sub, const std::string& why);
   /// True when the writer may write this topic (else counts and logs it).
   bool AcceptWriter(SubscriptionBase& sub, const dds::SampleInfo& info);
@@ -235,6 +251,8 @@ struct Node::Subscription : Node::SubscriptionBase {
         continue;
       }
       if (!took) break;
+      last_sample = std::chrono::steady_clock::now();
+      missed_periods = 0;
       if (!node.AcceptWriter(*this, info)) continue;
       if (auto why = msg::Check(msg)) {
         node.Reject(*this, *why);
@@ -261,7 +279,8 @@ void Node::Subscribe(const Topic<T>& topic, std::function<void(const T&, const d
   sub->options = options;
   sub->entitled = EntitledWriters(topic.name, topic.writers);
   sub->check_frame = topic.in_cell_frame;
-  sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos);
+  sub->deadline = topic.qos.deadline;
+  sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos.AcceptingAnyWriter());
   by_reader_[sub->reader.get()] = sub.get();
   subscriptions_.push_back(std::move(sub));
 }
