@@ -20,13 +20,19 @@
 // A failing message is rejected, counted per topic, logged once (then every
 // 100th), and reported in diagnostics.
 //
+// A callback that throws is logged and counted; it never takes the service
+// down.
+//
 // Readers accept what any writer offers, a ROS 2 default publisher included
 // (no DEADLINE, infinite LIVELINESS lease, volatile): a reader that requested
 // the topic's deadline or lease would not match such a writer at all. The
-// node watches the topic's deadline itself instead: after the first sample,
-// every deadline period without one is a kDeadlineMissed event, as the DDS
-// policy would report it. Liveliness is tracked with each writer's own lease. A callback that throws is logged and
-// counted; it never takes the service down.
+// node watches the topic's deadline itself instead: after the first accepted
+// sample (one that passed the checks above, so a stranger or a broken writer
+// cannot keep the topic fresh), every deadline period without one is a
+// kDeadlineMissed event, as the DDS policy would report it. Liveliness of
+// writers that offer the topic's lease (iplan's) is still reported by the
+// reader (dds::QosProfile::watched_lease); a writer that offers none (ROS 2
+// default) is watched by the deadline only.
 //
 // Threading: all callbacks and timers run on the thread that calls
 // SpinOnce()/SpinUntil(); the core of a service therefore needs no locks.
@@ -251,8 +257,6 @@ struct Node::Subscription : Node::SubscriptionBase {
         continue;
       }
       if (!took) break;
-      last_sample = std::chrono::steady_clock::now();
-      missed_periods = 0;
       if (!node.AcceptWriter(*this, info)) continue;
       if (auto why = msg::Check(msg)) {
         node.Reject(*this, *why);
@@ -266,6 +270,8 @@ struct Node::Subscription : Node::SubscriptionBase {
         }
       }
       ++stats.received;
+      last_sample = std::chrono::steady_clock::now();
+      missed_periods = 0;
       node.RunGuarded(this, "callback", [&] { on_message(msg, info); });
     }
   }
