@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "common/adapters.h"
 #include "core/replanner.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner.h"
@@ -27,6 +28,9 @@ struct TrajoptConfig {
   /// true: a cycle starts when a prediction arrives (and on the planning
   /// step's tick when none does); false: only on the tick.
   bool replan_on_prediction = true;
+  /// How trajectories are stamped and shaped (section trajopt.output: keys
+  /// zero_stamp, min_duration (s, >= 0), velocities).
+  services::TrajectoryOutput output;
 };
 
 /// Reads `section` (trajopt); every problem, ReplannerParams::Validate()'s

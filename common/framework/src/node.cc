@@ -219,9 +219,11 @@ bool Node::AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns)
 }
 
 std::vector<std::string> Node::EntitledWriters(const std::string& topic, const std::vector<std::string>& catalogue) const {
-  // Configuration keys may use the wire name ("rt/iplan/...") or the ROS name ("/iplan/...").
-  const std::string ros = topic.rfind("rt/", 0) == 0 ? topic.substr(2) : topic;
-  for (const std::string& key : {topic, ros}) {
+  // Configuration keys may use the wire name ("rt/iplan/...") or the ROS name
+  // ("/iplan/..."), remapped or the catalogue's.
+  const auto ros = [](const std::string& t) { return t.rfind("rt/", 0) == 0 ? t.substr(2) : t; };
+  const std::string catalogue_name = topics::CatalogueName(topic);
+  for (const std::string& key : {topic, ros(topic), catalogue_name, ros(catalogue_name)}) {
     if (auto it = options_.entitled_writers.find(key); it != options_.entitled_writers.end()) return it->second;
   }
   return catalogue;

@@ -2,11 +2,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "iplan/framework/service.h"
+#include "iplan/framework/topics.h"
 #include "realtime.h"
 #include "iplan/framework/systemd.h"
 
@@ -21,9 +23,40 @@ bool FileExists(const std::string& p) { return std::ifstream(p).good(); }
 
 // The service's file with the --set overrides applied, and the framework's
 // `node` section read from it. False (the problems printed) on a bad one.
+// The topic remappings: `node.remap` ({FROM: TO}), then the command line's
+// --remap FROM:=TO rules over it; applied to the catalogue. False (printed)
+// on a bad rule.
+bool ApplyRemappings(const std::string& name, ConfigSection& node_section, const std::vector<std::string>& rules) {
+  std::map<std::string, std::string> from_to;
+  ConfigSection remap = node_section.Section("remap");
+  for (const std::string& from : remap.Keys()) {
+    std::string to;
+    remap.Read(from, &to);
+    from_to[from] = to;
+  }
+  for (const std::string& rule : rules) {
+    std::string from, to, error;
+    if (!topics::ParseRemapRule(rule, &from, &to, &error)) {
+      std::cerr << "iplan-" << name << ": --remap: " << error << "\n";
+      return false;
+    }
+    from_to[from] = to;
+  }
+  // Config keys may be written without the leading slash; normalise.
+  std::map<std::string, std::string> normalised;
+  for (const auto& [from, to] : from_to) {
+    normalised[from.empty() || from[0] == '/' ? from : "/" + from] = to;
+  }
+  if (const std::string why = topics::SetRemappings(normalised); !why.empty()) {
+    std::cerr << "iplan-" << name << ": " << why << "\n";
+    return false;
+  }
+  return true;
+}
+
 bool LoadConfiguration(const std::string& name, const std::string& config_file,
-                       const std::vector<std::string>& overrides, std::unique_ptr<ConfigSection>* config,
-                       NodeOptions* nopts) {
+                       const std::vector<std::string>& overrides, const std::vector<std::string>& remaps,
+                       std::unique_ptr<ConfigSection>* config, NodeOptions* nopts) {
   try {
     *config = std::make_unique<ConfigSection>(
         config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
@@ -48,6 +81,7 @@ bool LoadConfiguration(const std::string& name, const std::string& config_file,
       entitled.Read(topic, &names);
       nopts->entitled_writers[topic] = names;
     }
+    if (!ApplyRemappings(name, node_section, remaps)) return false;
   } catch (const ConfigError& e) {
     std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
     return false;
@@ -148,6 +182,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   std::string log_level = "info";
   bool check_only = false;
   std::vector<std::string> overrides;
+  std::vector<std::string> remaps;
   app.add_option("-c,--config", config_file, "YAML configuration file")
       ->capture_default_str();
   app.add_option("--dds", vendor_text,
@@ -161,6 +196,9 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
                  "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable); "
                  "a key may continue into a parameter file the configuration names, e.g. "
                  "--set trajopt.planner.max_iterations=30 (docs/configuration.md)");
+  app.add_option("-r,--remap", remaps,
+                 "rename a topic, ROS 2's FROM:=TO, e.g. --remap /iplan/robot/trajectory:=/arm_controller/"
+                 "joint_trajectory (repeatable; over node.remap of the configuration; docs/topics.md)");
   app.add_flag("--check-config", check_only,
                "read the configuration and every parameter file it names as the service would (all "
                "keys, types and ranges, Validate() included), print the problems and exit: 0 valid, "
@@ -179,7 +217,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
-  if (!LoadConfiguration(info.name, config_file, overrides, &config, &nopts)) return kExitConfigError;
+  if (!LoadConfiguration(info.name, config_file, overrides, remaps, &config, &nopts)) return kExitConfigError;
 
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);

@@ -1,0 +1,111 @@
+// ROS 2-style robot stack on Fast DDS's C++ API, with the classes fastddsgen
+// generated from its own ROS 2 IDL (ros2_interfaces.idl, without
+// -typeobject, as rmw_fastrtps announces no type object either). It does
+// not read /tf_static: fastddsgen refuses rosidl's geometry_msgs IDL
+// (ros2_tf.idl says why). See ros2_client_common.h for what it does.
+#include <thread>
+
+#include <fastdds/dds/domain/DomainParticipant.hpp>
+#include <fastdds/dds/domain/DomainParticipantFactory.hpp>
+#include <fastdds/dds/publisher/DataWriter.hpp>
+#include <fastdds/dds/publisher/Publisher.hpp>
+#include <fastdds/dds/subscriber/DataReader.hpp>
+#include <fastdds/dds/subscriber/SampleInfo.hpp>
+#include <fastdds/dds/subscriber/Subscriber.hpp>
+#include <fastdds/dds/topic/TypeSupport.hpp>
+
+#include "ros2_client_common.h"
+#include "ros2_interfaces.h"
+#include "ros2_interfacesPubSubTypes.h"
+
+namespace {
+
+using namespace ros2_client;
+namespace fdds = eprosima::fastdds::dds;
+using RC = eprosima::fastrtps::types::ReturnCode_t;
+using sensor_msgs::msg::dds_::JointState_;
+using trajectory_msgs::msg::dds_::JointTrajectory_;
+
+template <class T>
+T* Check(T* p, const char* what) {
+  if (!p) {
+    std::fprintf(stderr, "ros2_client_fastdds: cannot create the %s\n", what);
+    std::exit(1);
+  }
+  return p;
+}
+
+// ROS 2's default QoS (rmw_qos_profile_default): reliable, volatile, keep
+// last 10; DEADLINE and LIVELINESS lease left infinite (Fast DDS's defaults).
+template <class Qos>
+void Ros2Default(Qos* q) {
+  q->reliability().kind = fdds::RELIABLE_RELIABILITY_QOS;
+  q->durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+  q->history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+  q->history().depth = 10;
+}
+
+void OnTrajectory(const JointTrajectory_& t) {
+  std::vector<std::vector<double>> pos;
+  std::vector<double> times;
+  std::size_t with_velocities = 0;
+  for (const auto& p : t.points_()) {
+    pos.push_back(p.positions_());
+    times.push_back(p.time_from_start_().sec_() + 1e-9 * p.time_from_start_().nanosec_());
+    if (!p.velocities_().empty() && p.velocities_().size() == p.positions_().size()) ++with_velocities;
+  }
+  ReportTrajectory(t.header_().stamp_().sec_(), t.header_().stamp_().nanosec_(), t.joint_names_(), pos, times,
+                   with_velocities);
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+  Options o;
+  if (const int rc = Parse(argc, argv, "Fast DDS", &o); rc >= 0) return rc;
+  auto* factory = fdds::DomainParticipantFactory::get_instance();
+  fdds::DomainParticipant* dp = Check(factory->create_participant(o.domain, factory->get_default_participant_qos()),
+                                      "participant");
+  fdds::TypeSupport js_type(new sensor_msgs::msg::dds_::JointState_PubSubType());
+  fdds::TypeSupport tr_type(new trajectory_msgs::msg::dds_::JointTrajectory_PubSubType());
+  js_type.register_type(dp);
+  tr_type.register_type(dp);
+  fdds::Topic* js_topic = Check(dp->create_topic(Wire(o.joint_states_topic), js_type.get_type_name(),
+                                                 fdds::TOPIC_QOS_DEFAULT), "topic");
+  fdds::Topic* tr_topic = Check(dp->create_topic(Wire(o.trajectory_topic), tr_type.get_type_name(),
+                                                 fdds::TOPIC_QOS_DEFAULT), "topic");
+  fdds::Publisher* pub = Check(dp->create_publisher(fdds::PUBLISHER_QOS_DEFAULT), "publisher");
+  fdds::Subscriber* sub = Check(dp->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT), "subscriber");
+  fdds::DataWriterQos wq = pub->get_default_datawriter_qos();
+  Ros2Default(&wq);
+  fdds::DataReaderQos rq = sub->get_default_datareader_qos();
+  Ros2Default(&rq);
+  fdds::DataWriter* writer = Check(pub->create_datawriter(js_topic, wq), "writer");
+  fdds::DataReader* reader = Check(sub->create_datareader(tr_topic, rq), "reader");
+
+  JointState_ js;
+  js.name_() = JointNames(o.positions.size());
+  js.position_() = o.positions;
+  js.velocity_() = std::vector<double>(o.positions.size(), 0.0);
+  std::printf("publishing %s\n", o.joint_states_topic.c_str());
+  std::fflush(stdout);
+  int trajectories = 0;
+  const auto period = std::chrono::duration<double>(1.0 / o.rate);
+  const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout);
+  JointTrajectory_ t;
+  fdds::SampleInfo info;
+  while (std::chrono::steady_clock::now() < end && trajectories < o.trajectories) {
+    Now(&js.header_().stamp_().sec_(), &js.header_().stamp_().nanosec_());
+    writer->write(&js);
+    while (reader->take_next_sample(&t, &info) == RC::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      OnTrajectory(t);
+      ++trajectories;
+    }
+    std::this_thread::sleep_for(period);
+  }
+  std::printf("done trajectories=%d transforms=-\n", trajectories);
+  dp->delete_contained_entities();
+  factory->delete_participant(dp);
+  return trajectories >= o.trajectories ? 0 : 1;
+}
