@@ -236,8 +236,7 @@ TEST(TrajoptService, ReachesTheGoalWithZeroStampedTrajectories) {
   for (std::size_t j = 0; j < kGoal.size(); ++j) EXPECT_NEAR(r.last_waypoint[j], kGoal[j], 0.01) << "joint " << j;
   EXPECT_LT(r.outcome->duration, 10.0);
   EXPECT_EQ(r.contacts, "0");
-  std::cout << "zero-stamped: goal reached in " << r.outcome->duration << " s, " << r.trajectories << " trajectories
-";
+  std::cout << "zero-stamped: goal reached in " << r.outcome->duration << " s, " << r.trajectories << " trajectories\n";
 }
 
 TEST(TrajoptService, PersonOnTheGoalIsReportedAsWaitAndDelayNotContact) {
