@@ -67,7 +67,9 @@ bool WaitForEvent(dds::Participant& p, dds::AnyReader& r, Clock::duration timeou
 }
 
 // The reader accepts any writer, as a node's readers do (no requested
-// lease, framework/node.h): liveliness is tracked with the writer's lease.
+// lease, framework/node.h): liveliness of writers offering the topic's lease
+// is still reported (Cyclone tracks the writer's own lease; on Fast DDS a
+// second, data-less reader requests it: QosProfile::watched_lease).
 TEST_P(DdsEvents, KillNineIsReportedAsLivelinessLossWithinLease) {
   const int domain = Domain(1);
   auto p = MakeParticipant(domain);

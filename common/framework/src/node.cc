@@ -132,37 +132,35 @@ void Node::HandleEvents(SubscriptionBase& sub) {
 }
 
 void Node::HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e) {
-  {
-    const std::string& topic = sub.reader->topic();
-    switch (e.kind) {
-      case dds::EventKind::kDeadlineMissed:
-        sub.stats.deadline_misses += static_cast<uint64_t>(e.count_change);
-        if (sub.stats.deadline_misses == static_cast<uint64_t>(e.count_change) || sub.stats.deadline_misses % 100 == 0) {
-          log_->warn("{}: deadline missed ({} so far)", topic, sub.stats.deadline_misses);
-        }
-        break;
-      case dds::EventKind::kLivelinessLost:
-        sub.stats.liveliness_lost += static_cast<uint64_t>(e.count_change);
-        sub.stats.alive_writers = e.current;
-        log_->warn("{}: a writer lost liveliness ({} alive)", topic, e.current);
-        break;
-      case dds::EventKind::kLivelinessRegained:
-        sub.stats.alive_writers = e.current;
-        log_->info("{}: writer alive ({} alive)", topic, e.current);
-        break;
-      case dds::EventKind::kIncompatibleQos:
-        sub.stats.incompatible_qos += static_cast<uint64_t>(e.count_change);
-        log_->error("{}: a writer offers incompatible QoS (policy id {})", topic, e.current);
-        break;
-      case dds::EventKind::kMatched:
-      case dds::EventKind::kUnmatched:
-        log_->debug("{}: {} ({} matched)", topic, dds::ToString(e.kind), e.current);
-        break;
-    }
-    if (on_event_) {
-      auto cb = on_event_;
-      RunGuarded(&sub, "event callback", [&] { cb(topic, e); });
-    }
+  const std::string& topic = sub.reader->topic();
+  switch (e.kind) {
+    case dds::EventKind::kDeadlineMissed:
+      sub.stats.deadline_misses += static_cast<uint64_t>(e.count_change);
+      if (sub.stats.deadline_misses == static_cast<uint64_t>(e.count_change) || sub.stats.deadline_misses % 100 == 0) {
+        log_->warn("{}: deadline missed ({} so far)", topic, sub.stats.deadline_misses);
+      }
+      break;
+    case dds::EventKind::kLivelinessLost:
+      sub.stats.liveliness_lost += static_cast<uint64_t>(e.count_change);
+      sub.stats.alive_writers = e.current;
+      log_->warn("{}: a writer lost liveliness ({} alive)", topic, e.current);
+      break;
+    case dds::EventKind::kLivelinessRegained:
+      sub.stats.alive_writers = e.current;
+      log_->info("{}: writer alive ({} alive)", topic, e.current);
+      break;
+    case dds::EventKind::kIncompatibleQos:
+      sub.stats.incompatible_qos += static_cast<uint64_t>(e.count_change);
+      log_->error("{}: a writer offers incompatible QoS (policy id {})", topic, e.current);
+      break;
+    case dds::EventKind::kMatched:
+    case dds::EventKind::kUnmatched:
+      log_->debug("{}: {} ({} matched)", topic, dds::ToString(e.kind), e.current);
+      break;
+  }
+  if (on_event_) {
+    auto cb = on_event_;
+    RunGuarded(&sub, "event callback", [&] { cb(topic, e); });
   }
 }
 

@@ -194,7 +194,8 @@ class Node {
   };
 
   void HandleEvents(SubscriptionBase& sub);
-  /// Reports a missed deadline period of `sub` (counted, logged, on_event_).
+  /// Counts, logs and passes on (on_event_) one event of `sub`: the reader's,
+  /// or a deadline miss the node found (CheckDeadlines).
   void HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e);
   /// Emits the deadline misses due by now; returns the time of the next one.
   std::optional<std::chrono::steady_clock::time_point> CheckDeadlines();
