@@ -6,8 +6,9 @@
 // /arm_controller/joint_trajectory as a joint_trajectory_controller listens,
 // with zero stamps ("start on receipt"), sends it trajectories that hold
 // the robot where the stack says it is, at least 1 s long, with velocities.
-// iplan-robot-sim (its joint states remapped away) publishes world -> base
-// on /tf_static, which the Cyclone stack reads as tf2's static listener.
+// iplan-robot-sim (its joint states remapped to /sim/joint_states, which
+// the stack reads with default QoS) publishes world -> base on /tf_static,
+// which the Cyclone stack reads as tf2's static listener.
 // The Cyclone stack's types carry XTypes type information with rosidl's
 // member names (header_): iplan sends none, so they match. All four vendor
 // pairings.
@@ -71,7 +72,7 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
   }
   const std::string binary = p.client == "cyclonedds" ? "ros2_client_cyclone" : "ros2_client_fastdds";
   std::vector<std::string> argv = {TestBinPath(binary), "--domain", d, "--trajectories", "5",
-                                   "--timeout", "60", "--positions"};
+                                   "--timeout", "60", "--read-joint-states", "/sim/joint_states", "--positions"};
   for (double x : kPositions) argv.push_back(std::to_string(x));
   Process client(argv, env);
   const auto rc = client.Wait(90s);
@@ -79,7 +80,7 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
   ASSERT_TRUE(rc.has_value()) << "the ROS 2-style client did not finish\n" << out << client.Stderr();
   EXPECT_EQ(*rc, 0) << out << client.Stderr() << "\ntrajopt:\n" << trajopt.Stderr();
 
-  int trajectories = 0, transforms = 0;
+  int trajectories = 0, transforms = 0, states = 0;
   std::istringstream lines(out);
   std::string line;
   while (std::getline(lines, line)) {
@@ -99,6 +100,11 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
       EXPECT_GE(std::stod(f["duration"]), 0.9) << line;  // min_duration 1.0 s, less the part already past
       EXPECT_GT(std::stod(f["first_time"]), 0.0) << line;
       EXPECT_EQ(f["velocities"], f["points"]) << line;
+    } else if (line.rfind("joint_state ", 0) == 0) {
+      // The simulator's joint states, read with ROS 2's default QoS and types.
+      ++states;
+      EXPECT_EQ(f["names"], "panda_joint1,panda_joint2,panda_joint3,panda_joint4,panda_joint5,panda_joint6,panda_joint7");
+      EXPECT_EQ(Numbers(f["positions"]).size(), 7u) << line;
     } else if (line.rfind("tf ", 0) == 0) {
       ++transforms;
       EXPECT_EQ(f["parent"], "world");
@@ -108,11 +114,12 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
     }
   }
   EXPECT_EQ(trajectories, 5) << out;
+  EXPECT_EQ(states, 3) << out;
   if (p.client == "cyclonedds") {
     EXPECT_GE(transforms, 1) << out;
   }
   std::cout << "client (" << p.client << ") <-> cell (" << p.cell << "): " << trajectories << " trajectories, "
-            << transforms << " static transforms\n";
+            << transforms << " static transforms, " << states << " joint states read\n";
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPairings, Ros2Client,

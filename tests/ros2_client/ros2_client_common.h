@@ -18,10 +18,13 @@ struct Options {
   std::string joint_states_topic = "/joint_states";
   std::string trajectory_topic = "/arm_controller/joint_trajectory";
   std::string tf_static_topic = "/tf_static";
+  /// Joint states of another robot to read (default QoS), e.g. the cell's
+  /// simulator; empty: none.
+  std::string read_joint_states_topic;
   std::vector<double> positions = {0.0, -0.5, 0.0, -2.0, 0.0, 1.5, 0.8};  ///< rad, published as the robot's state
   double rate = 100;      ///< Hz of joint states
   double timeout = 30;    ///< s
-  int trajectories = 5;   ///< stop after this many trajectories (and one /tf_static)
+  int trajectories = 5;   ///< stop after this many trajectories (and one /tf_static, 3 joint states read)
 };
 
 inline int Parse(int argc, char** argv, const char* what, Options* o) {
@@ -35,6 +38,8 @@ inline int Parse(int argc, char** argv, const char* what, Options* o) {
   app.add_option("--joint-states", o->joint_states_topic, "ROS topic of the joint states")->capture_default_str();
   app.add_option("--trajectory", o->trajectory_topic, "ROS topic of the trajectories")->capture_default_str();
   app.add_option("--tf-static", o->tf_static_topic, "ROS topic of the static transforms")->capture_default_str();
+  app.add_option("--read-joint-states", o->read_joint_states_topic,
+                 "also subscribe to joint states on this ROS topic (default QoS) and report them");
   app.add_option("--positions", o->positions, "joint positions to report, rad")->expected(1, 64);
   app.add_option("--rate", o->rate, "joint states per second")->check(CLI::Range(1.0, 1000.0));
   app.add_option("--timeout", o->timeout, "give up after this many seconds")->check(CLI::Range(0.1, 600.0));
@@ -88,6 +93,12 @@ inline void ReportTrajectory(int32_t sec, uint32_t nanosec, const std::vector<st
               positions.empty() ? "" : Join(positions.front()).c_str(),
               positions.empty() ? "" : Join(positions.back()).c_str(), points_with_velocities,
               times.empty() ? 0.0 : times.front());
+  std::fflush(stdout);
+}
+
+/// "joint_state names=a,b positions=x,y" (the first few only: see the caller).
+inline void ReportJointState(const std::vector<std::string>& names, const std::vector<double>& positions) {
+  std::printf("joint_state names=%s positions=%s\n", Join(names).c_str(), Join(positions).c_str());
   std::fflush(stdout);
 }
 

@@ -71,9 +71,15 @@ int main(int argc, char** argv) {
   const dds_entity_t writer = Check(dds_create_writer(dp, js_topic, def, nullptr), "writer");
   const dds_entity_t tr_reader = Check(dds_create_reader(dp, tr_topic, def, nullptr), "reader");
   const dds_entity_t tf_reader = Check(dds_create_reader(dp, tf_topic, stat, nullptr), "reader");
+  dds_entity_t js_reader = 0;
+  if (!o.read_joint_states_topic.empty()) {
+    const dds_entity_t t = Check(dds_create_topic(dp, &sensor_msgs_msg_dds__JointState__desc,
+                                                  Wire(o.read_joint_states_topic).c_str(), nullptr, nullptr), "topic");
+    js_reader = Check(dds_create_reader(dp, t, def, nullptr), "reader");
+  }
+
   dds_delete_qos(def);
   dds_delete_qos(stat);
-
   std::vector<std::string> names = JointNames(o.positions.size());
   std::vector<char*> name_ptrs;
   for (auto& n : names) name_ptrs.push_back(n.data());
@@ -86,10 +92,12 @@ int main(int argc, char** argv) {
 
   std::printf("publishing %s\n", o.joint_states_topic.c_str());
   std::fflush(stdout);
-  int trajectories = 0, transforms = 0;
+  int trajectories = 0, transforms = 0, states = 0;
+  const int states_wanted = js_reader ? 3 : 0;
   const auto period = std::chrono::duration<double>(1.0 / o.rate);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout);
-  while (std::chrono::steady_clock::now() < end && (trajectories < o.trajectories || transforms < 1)) {
+  while (std::chrono::steady_clock::now() < end &&
+         (trajectories < o.trajectories || transforms < 1 || states < states_wanted)) {
     Now(&js.header_.stamp_.sec_, &js.header_.stamp_.nanosec_);
     dds_write(writer, &js);
     void* samples[1] = {nullptr};
@@ -113,9 +121,17 @@ int main(int argc, char** argv) {
       }
       dds_return_loan(tf_reader, samples, 1);
     }
+    while (js_reader && dds_take(js_reader, samples, &info, 1, 1) > 0) {
+      if (info.valid_data && states++ < states_wanted) {
+        const auto& m = *static_cast<sensor_msgs_msg_dds__JointState_*>(samples[0]);
+        ReportJointState(std::vector<std::string>(m.name_._buffer, m.name_._buffer + m.name_._length),
+                         std::vector<double>(m.position_._buffer, m.position_._buffer + m.position_._length));
+      }
+      dds_return_loan(js_reader, samples, 1);
+    }
     std::this_thread::sleep_for(period);
   }
-  std::printf("done trajectories=%d transforms=%d\n", trajectories, transforms);
+  std::printf("done trajectories=%d transforms=%d joint_states=%d\n", trajectories, transforms, states);
   dds_delete(dp);
-  return trajectories >= o.trajectories && transforms >= 1 ? 0 : 1;
+  return trajectories >= o.trajectories && transforms >= 1 && states >= states_wanted ? 0 : 1;
 }

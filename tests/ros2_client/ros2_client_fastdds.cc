@@ -82,6 +82,13 @@ int main(int argc, char** argv) {
   Ros2Default(&rq);
   fdds::DataWriter* writer = Check(pub->create_datawriter(js_topic, wq), "writer");
   fdds::DataReader* reader = Check(sub->create_datareader(tr_topic, rq), "reader");
+  fdds::DataReader* js_reader = nullptr;
+  if (!o.read_joint_states_topic.empty()) {
+    fdds::Topic* t = Check(dp->create_topic(Wire(o.read_joint_states_topic), js_type.get_type_name(),
+                                            fdds::TOPIC_QOS_DEFAULT), "topic");
+    js_reader = Check(sub->create_datareader(t, rq), "reader");
+  }
+  const int states_wanted = js_reader ? 3 : 0;
 
   JointState_ js;
   js.name_() = JointNames(o.positions.size());
@@ -89,12 +96,12 @@ int main(int argc, char** argv) {
   js.velocity_() = std::vector<double>(o.positions.size(), 0.0);
   std::printf("publishing %s\n", o.joint_states_topic.c_str());
   std::fflush(stdout);
-  int trajectories = 0;
+  int trajectories = 0, states = 0;
   const auto period = std::chrono::duration<double>(1.0 / o.rate);
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout);
   JointTrajectory_ t;
   fdds::SampleInfo info;
-  while (std::chrono::steady_clock::now() < end && trajectories < o.trajectories) {
+  while (std::chrono::steady_clock::now() < end && (trajectories < o.trajectories || states < states_wanted)) {
     Now(&js.header_().stamp_().sec_(), &js.header_().stamp_().nanosec_());
     writer->write(&js);
     while (reader->take_next_sample(&t, &info) == RC::RETCODE_OK) {
@@ -102,10 +109,14 @@ int main(int argc, char** argv) {
       OnTrajectory(t);
       ++trajectories;
     }
+    JointState_ other;
+    while (js_reader && js_reader->take_next_sample(&other, &info) == RC::RETCODE_OK) {
+      if (info.valid_data && states++ < states_wanted) ReportJointState(other.name_(), other.position_());
+    }
     std::this_thread::sleep_for(period);
   }
-  std::printf("done trajectories=%d transforms=-\n", trajectories);
+  std::printf("done trajectories=%d transforms=- joint_states=%d\n", trajectories, states);
   dp->delete_contained_entities();
   factory->delete_participant(dp);
-  return trajectories >= o.trajectories ? 0 : 1;
+  return trajectories >= o.trajectories && states >= states_wanted ? 0 : 1;
 }
