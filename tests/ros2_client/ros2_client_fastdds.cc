@@ -1,8 +1,9 @@
 // ROS 2-style robot stack on Fast DDS's C++ API, with the classes fastddsgen
 // generated from its own ROS 2 IDL (ros2_interfaces.idl, without
-// -typeobject, as rmw_fastrtps announces no type object either). It does
-// not read /tf_static: fastddsgen refuses rosidl's geometry_msgs IDL
-// (ros2_tf.idl says why). See ros2_client_common.h for what it does.
+// -typeobject, as rmw_fastrtps announces no type object either), and
+// /tf_static through DynamicTypes (fastddsgen refuses rosidl's
+// geometry_msgs IDL: ros2_tf.idl says why; fastdds_tf_dynamic.h). See
+// ros2_client_common.h for what it does.
 #include <thread>
 
 #include <fastdds/dds/domain/DomainParticipant.hpp>
@@ -14,6 +15,7 @@
 #include <fastdds/dds/subscriber/Subscriber.hpp>
 #include <fastdds/dds/topic/TypeSupport.hpp>
 
+#include "fastdds_tf_dynamic.h"
 #include "ros2_client_common.h"
 #include "ros2_interfaces.h"
 #include "ros2_interfacesPubSubTypes.h"
@@ -89,6 +91,21 @@ int main(int argc, char** argv) {
     js_reader = Check(sub->create_datareader(t, rq), "reader");
   }
   const int states_wanted = js_reader ? 3 : 0;
+  // /tf_static as tf2's static listener: reliable, transient local, keep last 1.
+  const dyn::DynamicType_ptr tf_type = TfMessageType();
+  auto* tf_support = new dyn::DynamicPubSubType(tf_type);
+  fdds::TypeSupport tf_ts(tf_support);
+  tf_ts->auto_fill_type_information(false);
+  tf_ts->auto_fill_type_object(false);
+  tf_ts.register_type(dp);
+  fdds::Topic* tf_topic = Check(dp->create_topic(Wire(o.tf_static_topic), tf_ts.get_type_name(),
+                                                 fdds::TOPIC_QOS_DEFAULT), "topic");
+  fdds::DataReaderQos sq = rq;
+  sq.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  sq.history().depth = 1;
+  fdds::DataReader* tf_reader = Check(sub->create_datareader(tf_topic, sq), "reader");
+  dyn::DynamicData* tf_data = dyn::DynamicDataFactory::get_instance()->create_data(tf_type);
+  int transforms = 0;
 
   JointState_ js;
   js.name_() = JointNames(o.positions.size());
@@ -101,7 +118,8 @@ int main(int argc, char** argv) {
   const auto end = std::chrono::steady_clock::now() + std::chrono::duration<double>(o.timeout);
   JointTrajectory_ t;
   fdds::SampleInfo info;
-  while (std::chrono::steady_clock::now() < end && (trajectories < o.trajectories || states < states_wanted)) {
+  while (std::chrono::steady_clock::now() < end &&
+         (trajectories < o.trajectories || transforms < 1 || states < states_wanted)) {
     Now(&js.header_().stamp_().sec_(), &js.header_().stamp_().nanosec_());
     writer->write(&js);
     while (reader->take_next_sample(&t, &info) == RC::RETCODE_OK) {
@@ -113,10 +131,19 @@ int main(int argc, char** argv) {
     while (js_reader && js_reader->take_next_sample(&other, &info) == RC::RETCODE_OK) {
       if (info.valid_data && states++ < states_wanted) ReportJointState(other.name_(), other.position_());
     }
+    while (tf_reader->take_next_sample(tf_data, &info) == RC::RETCODE_OK) {
+      if (!info.valid_data) continue;
+      ForEachTransform(*tf_data, [&](const std::string& parent, const std::string& child, double x, double y,
+                                     double z, double w) {
+        ReportTransform(parent, child, x, y, z, w);
+        ++transforms;
+      });
+    }
     std::this_thread::sleep_for(period);
   }
-  std::printf("done trajectories=%d transforms=- joint_states=%d\n", trajectories, states);
+  std::printf("done trajectories=%d transforms=%d joint_states=%d\n", trajectories, transforms, states);
+  dyn::DynamicDataFactory::get_instance()->delete_data(tf_data);
   dp->delete_contained_entities();
   factory->delete_participant(dp);
-  return trajectories >= o.trajectories && states >= states_wanted ? 0 : 1;
+  return trajectories >= o.trajectories && transforms >= 1 && states >= states_wanted ? 0 : 1;
 }
