@@ -45,11 +45,12 @@ class CollisionRiskService : public framework::Service {
                      node.CountRejection("joint_states", monitor_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position));
                    }));
     node.Subscribe(framework::topics::RobotTrajectory(),
-                   std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
+                   std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI info) {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
                      services::FromTrajectory(m, &times, &pos);
-                     node.CountRejection("trajectory", monitor_->UpdateTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
+                     node.CountRejection("trajectory", monitor_->UpdateTrajectory(services::TrajectoryStartNs(m, info.reception_ns),
+                                                                                 m.joint_names, times, pos));
                    }));
     node.Subscribe(framework::topics::HumanSkeleton(),
                    std::function<void(const msg::HumanSkeleton&, SI)>([this, &node](const msg::HumanSkeleton& m, SI) {

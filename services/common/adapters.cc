@@ -1,5 +1,8 @@
 #include "adapters.h"
 
+#include <algorithm>
+
+#include "iplan/cell/joint_trajectory.h"
 #include "iplan/msg/time.h"
 
 namespace iplan::services {
@@ -37,19 +40,50 @@ void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,
   }
 }
 
-msg::JointTrajectory ToTrajectory(const msg::Time& start, const std::vector<std::string>& joint_names,
-                                  const Eigen::MatrixXd& positions, double dt) {
+msg::JointTrajectory ToTrajectory(int64_t start_ns, const std::vector<std::string>& joint_names,
+                                  const Eigen::MatrixXd& positions, double dt, const TrajectoryOutput& out,
+                                  int64_t publish_ns) {
   msg::JointTrajectory t;
-  t.header.stamp = start;
+  t.header.stamp = out.zero_stamp ? msg::Time{} : msg::TimeFromNanoseconds(start_ns);
   t.header.frame_id = "world";
   t.joint_names = joint_names;
-  t.points.resize(static_cast<std::size_t>(positions.cols()));
-  for (Eigen::Index i = 0; i < positions.cols(); ++i) {
-    auto& p = t.points[static_cast<std::size_t>(i)];
-    p.positions.assign(positions.col(i).data(), positions.col(i).data() + positions.rows());
-    p.time_from_start = msg::DurationFromSeconds(static_cast<double>(i) * dt);
+  const Eigen::Index n = positions.cols();
+  if (n == 0) return t;
+  Eigen::MatrixXd segment;  // forward differences, one per segment
+  if (n >= 2) cell::FiniteDifferenceVelocities(positions, dt, &segment);
+  Eigen::Index total = n;  // with the held last position
+  while (static_cast<double>(total - 1) * dt < out.min_duration - 1e-9) ++total;
+  const double t0 = out.zero_stamp ? 1e-9 * static_cast<double>(start_ns - publish_ns) : 0.0;
+  for (Eigen::Index i = 0; i < total; ++i) {
+    const double time = t0 + static_cast<double>(i) * dt;
+    // Starting on receipt, the points already past are dropped (the
+    // controller moves from where the robot is to the first one).
+    if (out.zero_stamp && time <= 0.0 && i + 1 < total) continue;
+    msg::JointTrajectoryPoint p;
+    const Eigen::Index k = std::min(i, n - 1);
+    p.positions.assign(positions.col(k).data(), positions.col(k).data() + positions.rows());
+    if (out.velocities) {
+      Eigen::VectorXd v = Eigen::VectorXd::Zero(positions.rows());
+      if (n >= 2 && i < n) {
+        if (i == 0) {
+          v = segment.col(0);
+        } else if (i < n - 1) {
+          v = 0.5 * (segment.col(i - 1) + segment.col(i));
+        } else if (total == n) {
+          v = segment.col(n - 2);  // the end, one-sided; held after it: stays zero
+        }
+      }
+      p.velocities.assign(v.data(), v.data() + v.size());
+    }
+    p.time_from_start = msg::DurationFromSeconds(std::max(time, 0.0));
+    t.points.push_back(std::move(p));
   }
   return t;
+}
+
+int64_t TrajectoryStartNs(const msg::JointTrajectory& m, int64_t reception_ns) {
+  const int64_t stamp = msg::ToNanoseconds(m.header.stamp);
+  return stamp == 0 ? reception_ns : stamp;
 }
 
 double ToWire(const cell::Separation& s) { return s.value_or(kWireNoPerson); }

@@ -22,10 +22,33 @@ collision::JointMixture ToJointMixture(const msg::HumanPrediction& m);
 void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,
                     std::vector<std::vector<double>>* positions);
 
-/// A trajectory message: `positions` is nq x (n + 1), waypoint i at i * dt
-/// after `start`.
-msg::JointTrajectory ToTrajectory(const msg::Time& start, const std::vector<std::string>& joint_names,
-                                  const Eigen::MatrixXd& positions, double dt);
+/// How trajectories go out (trajopt's `output` settings, docs/topics.md).
+struct TrajectoryOutput {
+  /// header.stamp 0: "start on receipt", ros2_control's
+  /// joint_trajectory_controller convention (robust to latency and to a
+  /// controller on sim time); the points are re-timed from the publication
+  /// time and those already past dropped. false: header.stamp is the time of
+  /// waypoint 0 (iplan's convention, exact on synchronised clocks).
+  bool zero_stamp = false;
+  /// s; a shorter trajectory (e.g. a hold, 2 points over 0.1 s) is extended
+  /// by holding its last position, at the same step, until this long, so a
+  /// controller does not drop it as ended with a little latency.
+  double min_duration = 0.0;
+  /// Fill velocities (rad/s) from the positions (central differences inside,
+  /// one-sided at the ends, zero where the last position is held).
+  bool velocities = true;
+};
+
+/// A trajectory message: `positions` is nq x (n + 1), waypoint i at
+/// `start_ns` + i * dt (ns since the epoch; dt in s), shaped by `out`;
+/// `publish_ns` is the publication time (used when out.zero_stamp).
+msg::JointTrajectory ToTrajectory(int64_t start_ns, const std::vector<std::string>& joint_names,
+                                  const Eigen::MatrixXd& positions, double dt, const TrajectoryOutput& out,
+                                  int64_t publish_ns);
+
+/// When a received trajectory's waypoint 0 is (ns since the epoch): its
+/// header.stamp, or `reception_ns` when that is zero ("start on receipt").
+int64_t TrajectoryStartNs(const msg::JointTrajectory& m, int64_t reception_ns);
 
 /// The separation fields of CollisionRisk on the wire: metres, or
 /// kWireNoPerson when no person is seen (idl/iplan_msgs.idl).

@@ -3,6 +3,7 @@
 // it holds a fresh permit from every configured monitor
 // (/iplan/safety/permit, iplan/safety/permit_gate.h), and counts true
 // contacts with the simulated person's true body (/iplan/sim/human_truth).
+// Publishes world -> robot base on /tf_static for RViz and Foxglove.
 #include <chrono>
 #include <filesystem>
 
@@ -43,14 +44,15 @@ class RobotSimService : public framework::Service {
       return Result::Fail(e.what());
     }
     joint_writer_ = &node.Advertise(framework::topics::JointStates());
+    tf_writer_ = &node.Advertise(framework::topics::TfStatic());
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::RobotTrajectory(),
-                   std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI) {
+                   std::function<void(const msg::JointTrajectory&, SI)>([this, &node](const msg::JointTrajectory& m, SI info) {
                      std::vector<double> times;
                      std::vector<std::vector<double>> pos;
                      services::FromTrajectory(m, &times, &pos);
-                     node.CountRejection("trajectory",
-                                         sim_->SetTrajectory(msg::ToNanoseconds(m.header.stamp), m.joint_names, times, pos));
+                     node.CountRejection("trajectory", sim_->SetTrajectory(services::TrajectoryStartNs(m, info.reception_ns),
+                                                                           m.joint_names, times, pos));
                    }));
     // Permits count only from the configured monitors' writers.
     auto permit_topic = framework::topics::SafetyPermit();
@@ -82,6 +84,7 @@ class RobotSimService : public framework::Service {
   }
 
   Result OnActivate(Node& node) override {
+    PublishStaticTransform(node);
     last_ = msg::ToNanoseconds(msg::Now());
     const auto period = std::chrono::nanoseconds(static_cast<int64_t>(1e9 / control_rate_hz_));
     const int publish_every = std::max(1, static_cast<int>(std::lround(control_rate_hz_ / publish_rate_hz_)));
@@ -121,6 +124,21 @@ class RobotSimService : public framework::Service {
   }
 
  private:
+  // world -> the robot's base link on /tf_static, once (transient local:
+  // late joiners get it). The cell frame is the robot base frame
+  // (config/scenes/cell.yaml), so the transform is the identity.
+  void PublishStaticTransform(Node& node) {
+    msg::TFMessage tf;
+    msg::TransformStamped t;
+    t.header.stamp = msg::Now();
+    t.header.frame_id = "world";
+    t.child_frame_id = sim_->robot().link_names.at(0);
+    t.transform.rotation.w = 1.0;
+    tf.transforms.push_back(t);
+    std::string error;
+    if (!tf_writer_->Write(tf, &error)) node.log().warn("/tf_static not published: {}", error);
+  }
+
   // Stop at once when any permit is missing, lapsed or a stop; resume when
   // every monitor permits again (their own hysteresis decides when).
   void ApplyPermits(Node& node, int64_t now_ns) {
@@ -144,6 +162,7 @@ class RobotSimService : public framework::Service {
   std::unique_ptr<RobotSimulator> sim_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   dds::Writer<msg::JointState>* joint_writer_ = nullptr;
+  dds::Writer<msg::TFMessage>* tf_writer_ = nullptr;
   int timer_ = 0;
   int64_t last_ = 0;
   uint64_t steps_ = 0, stops_ = 0;

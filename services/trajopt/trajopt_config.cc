@@ -16,6 +16,10 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   config.Read("use_prediction", &c.use_prediction);
   config.Read("replan_on_prediction", &c.replan_on_prediction);
   config.Read("obstacle_timeout", &c.obstacle_timeout, framework::InRange(0.1, 60.0));
+  framework::ConfigSection output = config.Section("output");
+  output.Read("zero_stamp", &c.output.zero_stamp);
+  output.Read("min_duration", &c.output.min_duration, framework::InRange(0.0, 60.0));
+  output.Read("velocities", &c.output.velocities);
   core::ReadParams(config, &c.replanner);  // ranges: ReplannerParams::Validate
   c.robot_file = config.ResolvePath(robot_file);
   c.human_body_file = config.ResolvePath(body_file);

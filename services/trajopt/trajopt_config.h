@@ -7,6 +7,7 @@
 #include <memory>
 #include <string>
 
+#include "common/adapters.h"
 #include "core/replanner.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner.h"
@@ -30,6 +31,9 @@ struct TrajoptConfig {
   /// s a box of /iplan/obstacles stays in the plan's scene after it was
   /// last seen (core/obstacle_set.h).
   double obstacle_timeout = 2.0;
+  /// How trajectories are stamped and shaped (section trajopt.output: keys
+  /// zero_stamp, min_duration (s, >= 0), velocities).
+  services::TrajectoryOutput output;
 };
 
 /// Reads `section` (trajopt); every problem, ReplannerParams::Validate()'s

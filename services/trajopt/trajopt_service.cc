@@ -27,6 +27,7 @@ class TrajoptService : public framework::Service {
     use_prediction_ = c.use_prediction;
     replan_on_prediction_ = c.replan_on_prediction;
     obstacles_ = ObstacleSet(c.obstacle_timeout);
+    output_ = c.output;
     if (!use_prediction_) node.log().warn("trajopt.use_prediction is false: plans ignore the person (ablation)");
     try {
       planner_ = MakePlanner(c);
@@ -206,8 +207,9 @@ class TrajoptService : public framework::Service {
     const CycleResult r = replanner_->Cycle(cycle_start_ns);
     msg::PlanStatus status;
     if (r.publish) {
-      trajectory_writer_->Write(services::ToTrajectory(msg::TimeFromNanoseconds(r.start_ns), replanner_->joint_names(),
-                                                       r.positions, r.dt));
+      const int64_t publish_ns = msg::ToNanoseconds(msg::Now());
+      trajectory_writer_->Write(services::ToTrajectory(r.start_ns, replanner_->joint_names(), r.positions, r.dt,
+                                                       output_, publish_ns));
       // End-to-end latency: from the observation behind the prediction this
       // plan avoided to the moment the plan is out.
       const int64_t published_ns = msg::ToNanoseconds(msg::Now());
@@ -245,6 +247,7 @@ class TrajoptService : public framework::Service {
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
 
+  services::TrajectoryOutput output_;
   double planning_step_ = 0.1;  // s
   bool replan_on_prediction_ = true;
   bool active_ = false;

@@ -66,11 +66,15 @@ bool WaitForEvent(dds::Participant& p, dds::AnyReader& r, Clock::duration timeou
   return false;
 }
 
+// The reader accepts any writer, as a node's readers do (no requested
+// lease, framework/node.h): liveliness of writers offering the topic's lease
+// is still reported (Cyclone tracks the writer's own lease; on Fast DDS a
+// second, data-less reader requests it: QosProfile::watched_lease).
 TEST_P(DdsEvents, KillNineIsReportedAsLivelinessLossWithinLease) {
   const int domain = Domain(1);
   auto p = MakeParticipant(domain);
   const auto topic = framework::topics::HumanSkeleton();
-  dds::Reader<msg::HumanSkeleton> reader(*p, topic.name, topic.qos);
+  dds::Reader<msg::HumanSkeleton> reader(*p, topic.name, topic.qos.AcceptingAnyWriter());
   auto writer = Stream(domain, {"--rate", "30"});
   int samples = 0;
   ASSERT_TRUE(WaitForEvent(*p, reader, 20s, [](const dds::ReaderEvent& e) {
@@ -123,6 +127,46 @@ TEST_P(DdsEvents, WriterThatStopsPublishingIsReportedAsDeadlineMiss) {
     return false;
   });
   EXPECT_EQ(lost, 0);
+}
+
+// A publisher with ROS 2's default QoS (no deadline, infinite lease,
+// volatile) matches the cell's readers (a reader that requested the topic's
+// deadline or lease would not match it), and the node still reports its
+// silence as deadline misses, within the topic's deadline.
+TEST_P(DdsEvents, Ros2DefaultPublisherMatchesAndItsSilenceIsADeadlineMiss) {
+  const int domain = Domain(5);
+  auto p = MakeParticipant(domain);
+  framework::NodeOptions opts;
+  opts.diagnostics_period = 0;
+  framework::Node node("ros2_compat_test", *p, opts);
+  const auto topic = framework::topics::HumanSkeleton();
+  int callbacks = 0;
+  std::optional<Clock::time_point> first_miss;
+  Clock::time_point paused{};
+  bool is_paused = false;
+  node.Subscribe(topic, std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                            [&](const msg::HumanSkeleton&, const dds::SampleInfo&) { ++callbacks; }));
+  node.OnReaderEvent([&](const std::string&, const dds::ReaderEvent& e) {
+    if (e.kind == dds::EventKind::kDeadlineMissed && is_paused && !first_miss) first_miss = Clock::now();
+  });
+  auto writer = Stream(domain, {"--rate", "30", "--publish-for", "1.5", "--duration", "20", "--ros2-default-qos"});
+  ASSERT_TRUE(writer->WaitForOutput("publishing", 20s)) << writer->Stderr();
+  const auto end = Clock::now() + 10s;
+  while (Clock::now() < end && !first_miss) {
+    node.SpinOnce(5ms);
+    if (!is_paused && writer->Stdout().find("paused") != std::string::npos) {
+      is_paused = true;
+      paused = Clock::now();
+    }
+  }
+  const framework::TopicStats st = node.stats(topic.name);
+  EXPECT_EQ(st.incompatible_qos, 0u);
+  EXPECT_GT(callbacks, 20) << "the ROS 2 default publisher did not reach the node";
+  ASSERT_TRUE(first_miss.has_value()) << "no deadline miss after the publisher fell silent";
+  const double seconds = std::chrono::duration<double>(*first_miss - paused).count();
+  std::cout << "deadline miss reported " << seconds << " s after a ROS 2 default publisher paused\n";
+  EXPECT_LE(seconds, std::chrono::duration<double>(topic.qos.deadline).count() + 0.1);
+  EXPECT_GT(st.deadline_misses, 0u);
 }
 
 struct Counts {

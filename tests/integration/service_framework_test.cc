@@ -116,6 +116,35 @@ TEST(ServiceFramework, MissingFileAndBadVendorAreRefused) {
   EXPECT_NE(check.Stdout().find("configuration is valid"), std::string::npos);
 }
 
+// --remap FROM:=TO and node.remap: accepted when well formed, refused with
+// the reason and exit code 2 otherwise (a typo must not leave a topic
+// silently unconnected).
+TEST(ServiceFramework, RemappingsAreCheckedAtStart) {
+  struct Case {
+    std::vector<std::string> args;
+    int code;
+    std::string says;
+  };
+  const std::vector<Case> cases = {
+      {{"--remap", "/joint_states:=/sim/joint_states"}, 0, "configuration is valid"},
+      {{"-r", "joint_states:=sim/joint_states", "-r", "/iplan/robot/trajectory:=/arm_controller/joint_trajectory"},
+       0, "configuration is valid"},
+      {{"--set", "node.remap./joint_states=/sim/joint_states"}, 0, "configuration is valid"},
+      {{"--remap", "/joint_state:=/x"}, 2, "remap: '/joint_state' is not a topic of the catalogue"},
+      {{"--remap", "/joint_states"}, 2, "--remap: remap '/joint_states' is not FROM:=TO"},
+      {{"--remap", "/joint_states:=/a//b"}, 2, "has an empty token ('//')"},
+      {{"--set", "node.remap./joint_states=/iplan/task/command"}, 2, "two topics would be named /iplan/task/command"},
+  };
+  for (const Case& c : cases) {
+    std::vector<std::string> argv = {BinPath("iplan-robot-sim"), "--check-config"};
+    argv.insert(argv.end(), c.args.begin(), c.args.end());
+    Process p(argv);
+    const std::string shown = c.args.front() + " " + c.args.at(1);
+    ASSERT_EQ(p.Wait(20s), c.code) << shown << "\n" << p.Stderr();
+    EXPECT_NE((p.Stdout() + p.Stderr()).find(c.says), std::string::npos) << shown << "\n" << p.Stdout() << p.Stderr();
+  }
+}
+
 // node.realtime_priority and node.lock_memory either take effect (the
 // process runs under SCHED_FIFO with its memory locked) or are refused with a
 // message saying what to grant; the service runs either way.

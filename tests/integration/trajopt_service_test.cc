@@ -45,6 +45,7 @@ struct Result {
   int outcomes = 0;
   std::vector<double> last_waypoint;  // of the last trajectory before the outcome
   int trajectories = 0;
+  int zero_stamped = 0;  // trajectories with header.stamp 0 ("start on receipt")
   double seconds = 0;
   std::string contacts;
 };
@@ -81,6 +82,7 @@ void Observe(framework::Node& node, const bool& started, Result* r) {
                      [&started, r](const msg::JointTrajectory& t, const dds::SampleInfo&) {
                        if (started && !r->outcome) {
                          ++r->trajectories;
+                         r->zero_stamped += t.header.stamp.sec == 0 && t.header.stamp.nanosec == 0;
                          if (!t.points.empty()) r->last_waypoint = t.points.back().positions;
                        }
                        EXPECT_EQ(t.joint_names.size(), 7u);
@@ -127,14 +129,16 @@ msg::TaskCommand StartCommand(const std::vector<double>& retreat) {
 }
 
 // Sends one task to the goal kGoal (with `retreat`, if any) while a person
-// stands on the goal for `block_for_s`.
-Result RunTask(double block_for_s, const std::vector<double>& retreat = {}) {
+// stands on the goal for `block_for_s`; `zero_stamp`: trajectories go out
+// the joint_trajectory_controller way (trajopt.output.zero_stamp).
+Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool zero_stamp = false) {
   const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10) + static_cast<int>(retreat.size()));
   Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
                "robot_sim.permits.monitors=[test_cell]"});
   Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
                "node.entitled_writers./iplan/task/command=[test_cell]", "--set",
-               "node.entitled_writers./iplan/human/prediction=[test_cell]"});
+               "node.entitled_writers./iplan/human/prediction=[test_cell]", "--set",
+               std::string("trajopt.output.zero_stamp=") + (zero_stamp ? "true" : "false")});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
   TestNode stranger("stranger", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
@@ -203,6 +207,7 @@ TEST(TrajoptService, ReachesTheGoalPublishingEveryCycle) {
   const Result r = RunTask(0.0);
   ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
   EXPECT_EQ(r.outcome->status, msg::TaskOutcome::SUCCEEDED) << r.outcome->reason;
+  EXPECT_EQ(r.zero_stamped, 0);  // the shipped default: the time of waypoint 0
   EXPECT_EQ(r.outcome->task_id, 42u);
   EXPECT_EQ(r.outcome->num_waits, 0u);
   EXPECT_EQ(r.outcome->delay, 0.0);
@@ -216,6 +221,22 @@ TEST(TrajoptService, ReachesTheGoalPublishingEveryCycle) {
   EXPECT_EQ(r.repeated->task_id, 42u);
   EXPECT_EQ(r.repeated->status, msg::TaskOutcome::SUCCEEDED);
   EXPECT_EQ(r.repeated->duration, r.outcome->duration);
+}
+
+// robot_sim executes trajectories stamped 0 ("start on receipt", as for a
+// joint_trajectory_controller) from their time of receipt: the task ends at
+// the goal as with planned stamps.
+TEST(TrajoptService, ReachesTheGoalWithZeroStampedTrajectories) {
+  const Result r = RunTask(0.0, {}, /*zero_stamp=*/true);
+  ASSERT_TRUE(r.outcome.has_value()) << "no outcome";
+  EXPECT_EQ(r.outcome->status, msg::TaskOutcome::SUCCEEDED) << r.outcome->reason;
+  EXPECT_GT(r.trajectories, 5);
+  EXPECT_EQ(r.zero_stamped, r.trajectories);
+  ASSERT_EQ(r.last_waypoint.size(), kGoal.size());
+  for (std::size_t j = 0; j < kGoal.size(); ++j) EXPECT_NEAR(r.last_waypoint[j], kGoal[j], 0.01) << "joint " << j;
+  EXPECT_LT(r.outcome->duration, 10.0);
+  EXPECT_EQ(r.contacts, "0");
+  std::cout << "zero-stamped: goal reached in " << r.outcome->duration << " s, " << r.trajectories << " trajectories\n";
 }
 
 TEST(TrajoptService, PersonOnTheGoalIsReportedAsWaitAndDelayNotContact) {

@@ -11,6 +11,8 @@
 //       publishes skeletons on the catalogue topic; after --publish-for
 //       seconds it stops publishing but stays alive (deadline tests).
 //       Modes: good, nan, backwards, wrong-size (malformed on purpose).
+//       --ros2-default-qos: the writer offers what a ROS 2 default publisher
+//       does (reliable, volatile, keep last 10, no deadline, infinite lease).
 #include <signal.h>
 
 #include <chrono>
@@ -156,8 +158,16 @@ msg::HumanSkeleton MakeSkeleton(int k) {
   return s;
 }
 
-int Stream(dds::Participant& p, double rate, double publish_for, double duration, const std::string& mode) {
+int Stream(dds::Participant& p, double rate, double publish_for, double duration, const std::string& mode,
+           bool ros2_default_qos) {
   auto topic = framework::topics::HumanSkeleton();
+  if (ros2_default_qos) {
+    topic.qos.writer_reliability = dds::QosProfile::Reliability::kReliable;
+    topic.qos.durability = dds::QosProfile::Durability::kVolatile;
+    topic.qos.depth = 10;
+    topic.qos.deadline = std::chrono::nanoseconds(0);
+    topic.qos.liveliness_lease = std::chrono::nanoseconds(0);
+  }
   dds::Writer<msg::HumanSkeleton> w(p, topic.name, topic.qos);
   w.WaitForReaders(1, 10s);
   std::cout << "publishing" << std::endl;
@@ -221,6 +231,8 @@ int main(int argc, char** argv) {
   stream->add_option("--publish-for", publish_for);
   stream->add_option("--duration", duration);
   stream->add_option("--mode", mode)->check(CLI::IsMember({"good", "nan", "backwards", "wrong-size"}));
+  bool ros2_default_qos = false;
+  stream->add_flag("--ros2-default-qos", ros2_default_qos);
   CLI11_PARSE(app, argc, argv);
   signal(SIGINT, [](int) { g_stop = 1; });
   signal(SIGTERM, [](int) { g_stop = 1; });
@@ -232,7 +244,7 @@ int main(int argc, char** argv) {
     auto p = dds::Participant::Create(o);
     if (*pub) return RoundtripPub(*p, seed, samples, timeout);
     if (*sub) return RoundtripSub(*p, seed, samples, timeout);
-    return Stream(*p, rate, publish_for, duration, mode);
+    return Stream(*p, rate, publish_for, duration, mode, ros2_default_qos);
   } catch (const std::exception& e) {
     std::cerr << "dds_probe: " << e.what() << "\n";
     return 2;

@@ -131,10 +131,25 @@ class FastWriter final : public BackendWriter {
   fdds::DataWriter* writer_;
 };
 
+// Liveliness of `r` as events (lost: a writer stopped asserting or left).
+void LivelinessEvents(fdds::DataReader* r, std::vector<ReaderEvent>* events) {
+  fdds::LivelinessChangedStatus s;
+  r->get_liveliness_changed_status(s);
+  if (s.not_alive_count_change > 0 || s.alive_count_change < 0) {
+    events->push_back({EventKind::kLivelinessLost, s.not_alive_count,
+                       std::max(s.not_alive_count_change, -s.alive_count_change), s.alive_count});
+  }
+  if (s.alive_count_change > 0) {
+    events->push_back({EventKind::kLivelinessRegained, s.alive_count, s.alive_count_change, s.alive_count});
+  }
+}
+
 class FastReader final : public BackendReader {
  public:
-  FastReader(FastParticipant* owner, fdds::Subscriber* sub, fdds::DataReader* r, const WriterNames& names)
-      : owner_(owner), subscriber_(sub), reader_(r), names_(names) {}
+  /// `watch`: the data-less reader that tracks liveliness for `r` (may be null).
+  FastReader(FastParticipant* owner, fdds::Subscriber* sub, fdds::DataReader* r, fdds::DataReader* watch,
+             const WriterNames& names)
+      : owner_(owner), subscriber_(sub), reader_(r), watch_(watch), names_(names) {}
   ~FastReader() override;
   bool Take(void* plain, SampleInfo* info) override {
     fdds::SampleInfo si;
@@ -171,18 +186,11 @@ class FastReader final : public BackendReader {
                            static_cast<int32_t>(s.total_count_change), 0});
       }
     }
-    if (changes.is_active(fdds::StatusMask::liveliness_changed())) {
-      fdds::LivelinessChangedStatus s;
-      reader_->get_liveliness_changed_status(s);
-      if (s.not_alive_count_change > 0 || s.alive_count_change < 0) {
-        events->push_back({EventKind::kLivelinessLost, s.not_alive_count,
-                           std::max(s.not_alive_count_change, -s.alive_count_change),
-                           s.alive_count});
-      }
-      if (s.alive_count_change > 0) {
-        events->push_back({EventKind::kLivelinessRegained, s.alive_count, s.alive_count_change,
-                           s.alive_count});
-      }
+    // With a watch reader, liveliness is its (the data reader requests an
+    // infinite lease and tracks none).
+    fdds::DataReader* live = watch_ ? watch_ : reader_;
+    if (live->get_status_changes().is_active(fdds::StatusMask::liveliness_changed())) {
+      LivelinessEvents(live, events);
     }
     if (changes.is_active(fdds::StatusMask::subscription_matched())) {
       fdds::SubscriptionMatchedStatus s;
@@ -214,6 +222,7 @@ class FastReader final : public BackendReader {
   FastParticipant* owner_;
   fdds::Subscriber* subscriber_;
   fdds::DataReader* reader_;
+  fdds::DataReader* watch_;
   const WriterNames& names_;
   std::unordered_map<uint64_t, std::string> cache_;
 };
@@ -364,18 +373,45 @@ class FastParticipant final : public BackendParticipant {
         eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
     fdds::DataReader* r = subscriber_->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
     if (!r) throw std::runtime_error("Fast DDS: cannot create a reader on " + topic);
-    auto reader = std::make_unique<FastReader>(this, subscriber_, r, listener_->names());
-    fdds::StatusCondition& cond = r->get_statuscondition();
+    fdds::DataReader* watch = q.watched_lease.count() > 0 ? CreateWatchReader(t, q.watched_lease) : nullptr;
+    if (q.watched_lease.count() > 0 && !watch) {
+      subscriber_->delete_datareader(r);
+      throw std::runtime_error("Fast DDS: cannot create the liveliness reader on " + topic);
+    }
+    auto reader = std::make_unique<FastReader>(this, subscriber_, r, watch, listener_->names());
     fdds::StatusMask mask = fdds::StatusMask::data_available();
     mask << fdds::StatusMask::requested_deadline_missed() << fdds::StatusMask::liveliness_changed()
          << fdds::StatusMask::subscription_matched() << fdds::StatusMask::requested_incompatible_qos();
+    Attach(r, mask, owner);
+    if (watch) Attach(watch, fdds::StatusMask::liveliness_changed(), owner);
+    return reader;
+  }
+
+  // A reader that takes no data and matches only writers offering `lease`
+  // or shorter (iplan's own): a Fast DDS 2.9 reader tracks liveliness only
+  // with a finite requested lease. Best effort, keep last 1, never taken:
+  // the samples it is sent overwrite each other in its history.
+  fdds::DataReader* CreateWatchReader(fdds::Topic* t, std::chrono::nanoseconds lease) {
+    fdds::DataReaderQos qos = subscriber_->get_default_datareader_qos();
+    qos.reliability().kind = fdds::BEST_EFFORT_RELIABILITY_QOS;
+    qos.durability().kind = fdds::VOLATILE_DURABILITY_QOS;
+    qos.history().kind = fdds::KEEP_LAST_HISTORY_QOS;
+    qos.history().depth = 1;
+    qos.liveliness().kind = fdds::AUTOMATIC_LIVELINESS_QOS;
+    qos.liveliness().lease_duration = ToDuration(lease);
+    qos.data_sharing().off();
+    qos.endpoint().history_memory_policy = eprosima::fastrtps::rtps::PREALLOCATED_WITH_REALLOC_MEMORY_MODE;
+    return subscriber_->create_datareader(t, qos, nullptr, fdds::StatusMask::none());
+  }
+
+  void Attach(fdds::DataReader* r, const fdds::StatusMask& mask, AnyReader* owner) {
+    fdds::StatusCondition& cond = r->get_statuscondition();
     cond.set_enabled_statuses(mask);
     {
       std::lock_guard<std::mutex> lock(mu_);
       owners_[r] = owner;
     }
     waitset_.attach_condition(cond);
-    return reader;
   }
 
   void DetachReader(fdds::DataReader* r) {
@@ -426,6 +462,10 @@ class FastParticipant final : public BackendParticipant {
 FastReader::~FastReader() {
   owner_->DetachReader(reader_);
   subscriber_->delete_datareader(reader_);
+  if (watch_) {
+    owner_->DetachReader(watch_);
+    subscriber_->delete_datareader(watch_);
+  }
 }
 
 }  // namespace

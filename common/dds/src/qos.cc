@@ -45,6 +45,15 @@ QosProfile QosProfile::Relaxed() {
   return q;
 }
 
+QosProfile QosProfile::AcceptingAnyWriter() const {
+  QosProfile q = *this;
+  q.deadline = std::chrono::nanoseconds(0);
+  q.watched_lease = liveliness_lease;
+  q.liveliness_lease = std::chrono::nanoseconds(0);
+  q.durability = Durability::kVolatile;
+  return q;
+}
+
 QosProfile QosProfile::RelaxedFor() const {
   QosProfile q = Relaxed();
   if (durability == Durability::kTransientLocal) {
@@ -59,6 +68,10 @@ std::string QosProfile::Validate() const {
   if (depth < 1) return "depth " + std::to_string(depth) + " must be >= 1";
   if (deadline.count() < 0) return "deadline must not be negative";
   if (liveliness_lease.count() < 0) return "liveliness lease must not be negative";
+  if (watched_lease.count() < 0) return "watched lease must not be negative";
+  if (watched_lease.count() > 0 && liveliness_lease.count() > 0) {
+    return "a watched lease is for readers that request an infinite lease";
+  }
   if (writer_reliability == Reliability::kBestEffort && reader_reliability == Reliability::kReliable) {
     return "a reliable reader never matches a best-effort writer";
   }

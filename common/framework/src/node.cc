@@ -82,6 +82,9 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
   for (const auto& [id, t] : timers_) {
     wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(t.next - now, std::chrono::nanoseconds(0)));
   }
+  if (const auto due = CheckDeadlines()) {
+    wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(*due - now, std::chrono::nanoseconds(0)));
+  }
   if (wait.count() > 0 || !subscriptions_.empty()) {
     participant_.Wait(std::max(wait, std::chrono::nanoseconds(1)), &ready_);
   }
@@ -91,6 +94,7 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
     HandleEvents(*it->second);
     it->second->Dispatch(*this);
   }
+  CheckDeadlines();
   RunTimers();
 }
 
@@ -101,38 +105,62 @@ void Node::SpinUntil(const std::function<bool()>& stop, const std::function<void
   }
 }
 
+std::optional<std::chrono::steady_clock::time_point> Node::CheckDeadlines() {
+  const auto now = std::chrono::steady_clock::now();
+  std::optional<std::chrono::steady_clock::time_point> next;
+  // By index: an event callback may subscribe to more topics.
+  for (std::size_t i = 0; i < subscriptions_.size(); ++i) {
+    SubscriptionBase& sub = *subscriptions_[i];
+    if (sub.deadline.count() <= 0 || !sub.last_sample) continue;
+    auto due = *sub.last_sample + sub.deadline * (sub.missed_periods + 1);
+    if (now >= due) {
+      // One event per period without a sample, as the DDS policy reports.
+      const int periods = static_cast<int>((now - *sub.last_sample) / sub.deadline);
+      const int change = std::max(1, periods - sub.missed_periods);
+      sub.missed_periods += change;
+      sub.deadline_misses_total += change;
+      HandleEvent(sub, dds::ReaderEvent{dds::EventKind::kDeadlineMissed, sub.deadline_misses_total, change, 0});
+      due = *sub.last_sample + sub.deadline * (sub.missed_periods + 1);
+    }
+    if (!next || due < *next) next = due;
+  }
+  return next;
+}
+
 void Node::HandleEvents(SubscriptionBase& sub) {
-  for (const dds::ReaderEvent& e : sub.reader->TakeEvents()) {
-    const std::string& topic = sub.reader->topic();
-    switch (e.kind) {
-      case dds::EventKind::kDeadlineMissed:
-        sub.stats.deadline_misses += static_cast<uint64_t>(e.count_change);
-        if (sub.stats.deadline_misses == static_cast<uint64_t>(e.count_change) || sub.stats.deadline_misses % 100 == 0) {
-          log_->warn("{}: deadline missed ({} so far)", topic, sub.stats.deadline_misses);
-        }
-        break;
-      case dds::EventKind::kLivelinessLost:
-        sub.stats.liveliness_lost += static_cast<uint64_t>(e.count_change);
-        sub.stats.alive_writers = e.current;
-        log_->warn("{}: a writer lost liveliness ({} alive)", topic, e.current);
-        break;
-      case dds::EventKind::kLivelinessRegained:
-        sub.stats.alive_writers = e.current;
-        log_->info("{}: writer alive ({} alive)", topic, e.current);
-        break;
-      case dds::EventKind::kIncompatibleQos:
-        sub.stats.incompatible_qos += static_cast<uint64_t>(e.count_change);
-        log_->error("{}: a writer offers incompatible QoS (policy id {})", topic, e.current);
-        break;
-      case dds::EventKind::kMatched:
-      case dds::EventKind::kUnmatched:
-        log_->debug("{}: {} ({} matched)", topic, dds::ToString(e.kind), e.current);
-        break;
-    }
-    if (on_event_) {
-      auto cb = on_event_;
-      RunGuarded(&sub, "event callback", [&] { cb(topic, e); });
-    }
+  for (const dds::ReaderEvent& e : sub.reader->TakeEvents()) HandleEvent(sub, e);
+}
+
+void Node::HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e) {
+  const std::string& topic = sub.reader->topic();
+  switch (e.kind) {
+    case dds::EventKind::kDeadlineMissed:
+      sub.stats.deadline_misses += static_cast<uint64_t>(e.count_change);
+      if (sub.stats.deadline_misses == static_cast<uint64_t>(e.count_change) || sub.stats.deadline_misses % 100 == 0) {
+        log_->warn("{}: deadline missed ({} so far)", topic, sub.stats.deadline_misses);
+      }
+      break;
+    case dds::EventKind::kLivelinessLost:
+      sub.stats.liveliness_lost += static_cast<uint64_t>(e.count_change);
+      sub.stats.alive_writers = e.current;
+      log_->warn("{}: a writer lost liveliness ({} alive)", topic, e.current);
+      break;
+    case dds::EventKind::kLivelinessRegained:
+      sub.stats.alive_writers = e.current;
+      log_->info("{}: writer alive ({} alive)", topic, e.current);
+      break;
+    case dds::EventKind::kIncompatibleQos:
+      sub.stats.incompatible_qos += static_cast<uint64_t>(e.count_change);
+      log_->error("{}: a writer offers incompatible QoS (policy id {})", topic, e.current);
+      break;
+    case dds::EventKind::kMatched:
+    case dds::EventKind::kUnmatched:
+      log_->debug("{}: {} ({} matched)", topic, dds::ToString(e.kind), e.current);
+      break;
+  }
+  if (on_event_) {
+    auto cb = on_event_;
+    RunGuarded(&sub, "event callback", [&] { cb(topic, e); });
   }
 }
 
@@ -189,9 +217,11 @@ bool Node::AcceptStamp(SubscriptionBase& sub, uint64_t writer, int64_t stamp_ns)
 }
 
 std::vector<std::string> Node::EntitledWriters(const std::string& topic, const std::vector<std::string>& catalogue) const {
-  // Configuration keys may use the wire name ("rt/iplan/...") or the ROS name ("/iplan/...").
-  const std::string ros = topic.rfind("rt/", 0) == 0 ? topic.substr(2) : topic;
-  for (const std::string& key : {topic, ros}) {
+  // Configuration keys may use the wire name ("rt/iplan/...") or the ROS name
+  // ("/iplan/..."), remapped or the catalogue's.
+  const auto ros = [](const std::string& t) { return t.rfind("rt/", 0) == 0 ? t.substr(2) : t; };
+  const std::string catalogue_name = topics::CatalogueName(topic);
+  for (const std::string& key : {topic, ros(topic), catalogue_name, ros(catalogue_name)}) {
     if (auto it = options_.entitled_writers.find(key); it != options_.entitled_writers.end()) return it->second;
   }
   return catalogue;

@@ -2,11 +2,13 @@
 #include <cstdlib>
 #include <fstream>
 #include <iostream>
+#include <map>
 
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
 #include "iplan/framework/service.h"
+#include "iplan/framework/topics.h"
 #include "realtime.h"
 #include "iplan/framework/systemd.h"
 
@@ -21,9 +23,40 @@ bool FileExists(const std::string& p) { return std::ifstream(p).good(); }
 
 // The service's file with the --set overrides applied, and the framework's
 // `node` section read from it. False (the problems printed) on a bad one.
+// The topic remappings: `node.remap` ({FROM: TO}), then the command line's
+// --remap FROM:=TO rules over it; applied to the catalogue. False (printed)
+// on a bad rule.
+bool ApplyRemappings(const std::string& name, ConfigSection& node_section, const std::vector<std::string>& rules) {
+  std::map<std::string, std::string> from_to;
+  ConfigSection remap = node_section.Section("remap");
+  for (const std::string& from : remap.Keys()) {
+    std::string to;
+    remap.Read(from, &to);
+    from_to[from] = to;
+  }
+  for (const std::string& rule : rules) {
+    std::string from, to, error;
+    if (!topics::ParseRemapRule(rule, &from, &to, &error)) {
+      std::cerr << "iplan-" << name << ": --remap: " << error << "\n";
+      return false;
+    }
+    from_to[from] = to;
+  }
+  // Config keys may be written without the leading slash; normalise.
+  std::map<std::string, std::string> normalised;
+  for (const auto& [from, to] : from_to) {
+    normalised[from.empty() || from[0] == '/' ? from : "/" + from] = to;
+  }
+  if (const std::string why = topics::SetRemappings(normalised); !why.empty()) {
+    std::cerr << "iplan-" << name << ": " << why << "\n";
+    return false;
+  }
+  return true;
+}
+
 bool LoadConfiguration(const std::string& name, const std::string& config_file,
-                       const std::vector<std::string>& overrides, std::unique_ptr<ConfigSection>* config,
-                       NodeOptions* nopts) {
+                       const std::vector<std::string>& overrides, const std::vector<std::string>& remaps,
+                       std::unique_ptr<ConfigSection>* config, NodeOptions* nopts) {
   try {
     *config = std::make_unique<ConfigSection>(
         config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
@@ -48,6 +81,7 @@ bool LoadConfiguration(const std::string& name, const std::string& config_file,
       entitled.Read(topic, &names);
       nopts->entitled_writers[topic] = names;
     }
+    if (!ApplyRemappings(name, node_section, remaps)) return false;
   } catch (const ConfigError& e) {
     std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
     return false;
@@ -115,6 +149,40 @@ bool RunActive(Service* service, Node* node) {
   return true;
 }
 
+// The service's command line.
+struct CommandLine {
+  std::string config_file;
+  std::string vendor_text;
+  int domain = -1;
+  std::string log_level = "info";
+  bool check_only = false;
+  std::vector<std::string> overrides;
+  std::vector<std::string> remaps;
+};
+
+void AddOptions(const ServiceInfo& info, CLI::App* app, CommandLine* cl) {
+  app->add_option("-c,--config", cl->config_file, "YAML configuration file")
+      ->capture_default_str();
+  app->add_option("--dds", cl->vendor_text,
+                  "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
+  app->add_option("--domain", cl->domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
+  app->add_option("--log-level", cl->log_level, "trace, debug, info, warn, error")
+      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
+      ->capture_default_str();
+  app->add_option("--set", cl->overrides,
+                  "override a setting of the configuration file: KEY=VALUE with a dotted key from the "
+                  "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable); "
+                  "a key may continue into a parameter file the configuration names, e.g. "
+                  "--set trajopt.planner.max_iterations=30 (docs/configuration.md)");
+  app->add_option("-r,--remap", cl->remaps,
+                  "rename a topic, ROS 2's FROM:=TO, e.g. --remap /iplan/robot/trajectory:=/arm_controller/"
+                  "joint_trajectory (repeatable; over node.remap of the configuration; docs/topics.md)");
+  app->add_flag("--check-config", cl->check_only,
+                "read the configuration and every parameter file it names as the service would (all "
+                "keys, types and ranges, Validate() included), print the problems and exit: 0 valid, "
+                "2 not");
+}
+
 }  // namespace
 
 std::string DefaultConfigFile(const std::string& service_name) {
@@ -142,44 +210,24 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
                "DDS on the chosen vendor and domain, publishes diagnostics on /diagnostics, "
                "and stops cleanly on SIGINT or SIGTERM. Exit codes: 0 stopped, 1 runtime "
                "error, 2 bad configuration."};
-  std::string config_file = DefaultConfigFile(info.name);
-  std::string vendor_text;
-  int domain = -1;
-  std::string log_level = "info";
-  bool check_only = false;
-  std::vector<std::string> overrides;
-  app.add_option("-c,--config", config_file, "YAML configuration file")
-      ->capture_default_str();
-  app.add_option("--dds", vendor_text,
-                 "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
-  app.add_option("--domain", domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
-  app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
-      ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
-      ->capture_default_str();
-  app.add_option("--set", overrides,
-                 "override a setting of the configuration file: KEY=VALUE with a dotted key from the "
-                 "file's top level and a YAML value, e.g. --set " + info.name + ".seed=3 (repeatable); "
-                 "a key may continue into a parameter file the configuration names, e.g. "
-                 "--set trajopt.planner.max_iterations=30 (docs/configuration.md)");
-  app.add_flag("--check-config", check_only,
-               "read the configuration and every parameter file it names as the service would (all "
-               "keys, types and ranges, Validate() included), print the problems and exit: 0 valid, "
-               "2 not");
+  CommandLine cl;
+  cl.config_file = DefaultConfigFile(info.name);
+  AddOptions(info, &app, &cl);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     const int rc = app.exit(e);
     return rc == 0 ? kExitOk : kExitConfigError;
   }
-  spdlog::set_level(spdlog::level::from_str(log_level));
+  spdlog::set_level(spdlog::level::from_str(cl.log_level));
   spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
 
   dds::ParticipantOptions popts;
-  if (!ParticipantOptionsFrom(info.name, vendor_text, domain, &popts)) return kExitConfigError;
+  if (!ParticipantOptionsFrom(info.name, cl.vendor_text, cl.domain, &popts)) return kExitConfigError;
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
-  if (!LoadConfiguration(info.name, config_file, overrides, &config, &nopts)) return kExitConfigError;
+  if (!LoadConfiguration(info.name, cl.config_file, cl.overrides, cl.remaps, &config, &nopts)) return kExitConfigError;
 
   std::signal(SIGINT, OnSignal);
   std::signal(SIGTERM, OnSignal);
@@ -195,12 +243,12 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     participant = dds::Participant::Create(popts);
     node = std::make_unique<Node>(info.name, *participant, nopts);
     service = make();
-    node->log().info("configuring from {} on {} domain {}", config_file.empty() ? "(defaults)" : config_file,
+    node->log().info("configuring from {} on {} domain {}", cl.config_file.empty() ? "(defaults)" : cl.config_file,
                      dds::ToString(popts.vendor), popts.domain_id);
     if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
     node->SetState("configured");
-    if (check_only) {
-      std::cout << config_file << ": configuration is valid\n";
+    if (cl.check_only) {
+      std::cout << cl.config_file << ": configuration is valid\n";
       return kExitOk;
     }
     if (!RunActive(service.get(), node.get())) return kExitRuntimeError;

@@ -176,6 +176,20 @@ std::optional<std::string> CheckSizes(const PointCloud2& m) {
   return std::nullopt;
 }
 
+std::optional<std::string> CheckSizes(const TFMessage& m) {
+  if (m.transforms.size() > Limits::kTransforms) return Over("transforms", m.transforms.size(), Limits::kTransforms);
+  for (std::size_t i = 0; i < m.transforms.size(); ++i) {
+    const auto field = [&](const char* f) { return "transforms[" + std::to_string(i) + "]." + f; };
+    if (auto e = CheckLength(m.transforms[i].header.frame_id, Limits::kName, [&] { return field("header.frame_id"); })) {
+      return e;
+    }
+    if (auto e = CheckLength(m.transforms[i].child_frame_id, Limits::kName, [&] { return field("child_frame_id"); })) {
+      return e;
+    }
+  }
+  return std::nullopt;
+}
+
 std::optional<std::string> CheckSizes(const ObstacleArray& m) {
   if (auto e = CheckSizes(m.header)) return e;
   if (m.obstacles.size() > Limits::kObstacles) return Over("obstacles", m.obstacles.size(), Limits::kObstacles);

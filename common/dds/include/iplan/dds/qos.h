@@ -27,6 +27,14 @@ struct QosProfile {
   /// AUTOMATIC liveliness lease; zero: infinite. A writer process that dies
   /// is reported as EventKind::kLivelinessLost within about one lease.
   std::chrono::nanoseconds liveliness_lease{0};
+  /// Reader only, with an infinite `liveliness_lease`: the reader still
+  /// reports liveliness lost/regained of the writers that offer this lease
+  /// or a shorter one (iplan's own), while it matches writers that offer
+  /// none (a ROS 2 default publisher). Zero: off. Cyclone tracks every
+  /// writer's own lease anyway; a Fast DDS 2.9 reader with an infinite lease
+  /// tracks none, so the Fast DDS backend adds a second, data-less reader
+  /// that requests this lease (docs/dds.md, "Readers that accept ROS 2").
+  std::chrono::nanoseconds watched_lease{0};
 
   /// Sensor streams (skeletons, predictions, joint states, risk): writers
   /// reliable, readers best-effort (so a reader also accepts a best-effort
@@ -45,6 +53,13 @@ struct QosProfile {
   /// The same profile with the reader's durability raised to transient-local
   /// when the writer's profile is latched (for tools echoing a latched topic).
   QosProfile RelaxedFor() const;
+  /// The reader side that matches every writer this profile's writers would,
+  /// and a ROS 2 default publisher too: the reader's reliability, no
+  /// deadline, infinite lease, volatile (a late joiner waits for the next
+  /// sample); liveliness of writers offering this profile's lease is still
+  /// reported (`watched_lease`). The caller watches the deadline itself
+  /// (framework::Node).
+  QosProfile AcceptingAnyWriter() const;
 
   /// Empty when the profile is consistent, else the reason.
   std::string Validate() const;

@@ -18,8 +18,21 @@
 //     samples the writer's clock is taken to have stepped back and the
 //     ordering restarts from the new stamp (logged).
 // A failing message is rejected, counted per topic, logged once (then every
-// 100th), and reported in diagnostics. A callback that throws is logged and
-// counted; it never takes the service down.
+// 100th), and reported in diagnostics.
+//
+// A callback that throws is logged and counted; it never takes the service
+// down.
+//
+// Readers accept what any writer offers, a ROS 2 default publisher included
+// (no DEADLINE, infinite LIVELINESS lease, volatile): a reader that requested
+// the topic's deadline or lease would not match such a writer at all. The
+// node watches the topic's deadline itself instead: after the first accepted
+// sample (one that passed the checks above, so a stranger or a broken writer
+// cannot keep the topic fresh), every deadline period without one is a
+// kDeadlineMissed event, as the DDS policy would report it. Liveliness of
+// writers that offer the topic's lease (iplan's) is still reported by the
+// reader (dds::QosProfile::watched_lease); a writer that offers none (ROS 2
+// default) is watched by the deadline only.
 //
 // Threading: all callbacks and timers run on the thread that calls
 // SpinOnce()/SpinUntil(); the core of a service therefore needs no locks.
@@ -164,6 +177,11 @@ class Node {
       int64_t last_ns = 0;
       int backwards = 0;  // consecutive backwards samples
     };
+    // The topic's deadline, watched here (see the file comment).
+    std::chrono::nanoseconds deadline{0};
+    std::optional<std::chrono::steady_clock::time_point> last_sample;  // any sample taken
+    int missed_periods = 0;  // since the last sample
+    int32_t deadline_misses_total = 0;
     std::map<uint64_t, WriterClock> clocks;  // per writer
     std::set<std::string> ignored_names;     // logged once each
   };
@@ -176,6 +194,11 @@ class Node {
   };
 
   void HandleEvents(SubscriptionBase& sub);
+  /// Counts, logs and passes on (on_event_) one event of `sub`: the reader's,
+  /// or a deadline miss the node found (CheckDeadlines).
+  void HandleEvent(SubscriptionBase& sub, const dds::ReaderEvent& e);
+  /// Emits the deadline misses due by now; returns the time of the next one.
+  std::optional<std::chrono::steady_clock::time_point> CheckDeadlines();
   void Reject(SubscriptionBase& sub, const std::string& why);
   /// True when the writer may write this topic (else counts and logs it).
   bool AcceptWriter(SubscriptionBase& sub, const dds::SampleInfo& info);
@@ -248,6 +271,8 @@ struct Node::Subscription : Node::SubscriptionBase {
         }
       }
       ++stats.received;
+      last_sample = std::chrono::steady_clock::now();
+      missed_periods = 0;
       node.RunGuarded(this, "callback", [&] { on_message(msg, info); });
     }
   }
@@ -261,7 +286,8 @@ void Node::Subscribe(const Topic<T>& topic, std::function<void(const T&, const d
   sub->options = options;
   sub->entitled = EntitledWriters(topic.name, topic.writers);
   sub->check_frame = topic.in_cell_frame;
-  sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos);
+  sub->deadline = topic.qos.deadline;
+  sub->reader = std::make_unique<dds::Reader<T>>(participant_, topic.name, topic.qos.AcceptingAnyWriter());
   by_reader_[sub->reader.get()] = sub.get();
   subscriptions_.push_back(std::move(sub));
 }

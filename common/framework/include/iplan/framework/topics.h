@@ -5,6 +5,7 @@
 #pragma once
 
 #include <chrono>
+#include <map>
 #include <string>
 #include <vector>
 
@@ -72,8 +73,28 @@ Topic<msg::SafetyPermit> SafetyPermit();
 /// Per-service diagnostics (ROS 2 /diagnostics).
 Topic<msg::DiagnosticArray> Diagnostics();
 
+/// Static transforms (ROS 2 /tf_static, transient local like tf2's static
+/// broadcaster): `world` -> the robot's base, from the robot simulator.
+Topic<msg::TFMessage> TfStatic();
+
 /// Every topic above, in that order.
 std::vector<TopicDescription> All();
+
+// Remapping, as ROS 2's `--remap FROM:=TO`: every function above returns the
+// remapped name once SetRemappings() has been called (RunService does, from
+// `--remap` and the `node.remap` configuration, before the service
+// configures). Names are ROS names ("/joint_states"; "joint_states" is read
+// as "/joint_states"); the wire name is "rt" + the ROS name.
+
+/// Parses "FROM:=TO" into ROS names. False with the reason in `error`.
+bool ParseRemapRule(const std::string& rule, std::string* from, std::string* to, std::string* error);
+/// Replaces the remappings (FROM -> TO, ROS names). Empty when accepted;
+/// else the reason, and nothing changes: a FROM that is not a catalogue
+/// topic, a TO that is not a valid ROS 2 topic name, or two topics on one name.
+std::string SetRemappings(const std::map<std::string, std::string>& from_to);
+/// The catalogue name (wire, "rt/...") a possibly remapped wire name came
+/// from; the name itself when it is not a remapped one.
+std::string CatalogueName(const std::string& dds_name);
 
 }  // namespace topics
 }  // namespace iplan::framework

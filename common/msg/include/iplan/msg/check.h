@@ -59,6 +59,9 @@ struct Limits {
   // DiagnosticArray.
   static constexpr std::size_t kDiagnosticStatuses = 64;   ///< status entries per array
   static constexpr std::size_t kDiagnosticValues = 256;    ///< values per status (a node sends ~5 per topic)
+
+  // TFMessage.
+  static constexpr std::size_t kTransforms = 256;  ///< transforms per message (a robot's tree has ~20)
 };
 
 /// True when the type has a std_msgs Header named `header`.
@@ -87,6 +90,7 @@ std::optional<std::string> CheckSizes(const PlanStatus& m);
 std::optional<std::string> CheckSizes(const CollisionRisk& m);
 std::optional<std::string> CheckSizes(const SafetyPermit& m);
 std::optional<std::string> CheckSizes(const DiagnosticArray& m);
+std::optional<std::string> CheckSizes(const TFMessage& m);
 template <class T>
 std::optional<std::string> CheckSizes(const T& m) {
   if constexpr (HasHeader<T>::value) {
