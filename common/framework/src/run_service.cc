@@ -6,6 +6,8 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "iplan/dds/security.h"
+#include "iplan/framework/enclaves.h"
 #include "iplan/framework/service.h"
 #include "realtime.h"
 #include "iplan/framework/systemd.h"
@@ -75,17 +77,21 @@ bool Configure(const std::string& name, ConfigSection* config, Service* service,
   return true;
 }
 
-// --dds and --domain, or their environment defaults. False (printed) on a bad one.
+// --dds, --domain and --security, or their environment defaults. False
+// (printed) on a bad one, including a missing or invalid enclave: a
+// restart cannot fix those (exit code 2).
 bool ParticipantOptionsFrom(const std::string& name, const std::string& vendor_text, int domain,
-                            dds::ParticipantOptions* popts) {
+                            const std::string& security_dir, dds::ParticipantOptions* popts) {
+  popts->name = EnclaveName(name);
   try {
     popts->vendor = vendor_text.empty() ? dds::DefaultVendor() : dds::ParseVendor(vendor_text);
     popts->domain_id = domain >= 0 ? domain : dds::DefaultDomain();
+    popts->security_dir = security_dir.empty() ? dds::DefaultSecurityDir() : security_dir;
+    if (!popts->security_dir.empty()) dds::LoadEnclave(popts->security_dir, popts->name);
   } catch (const std::exception& e) {
     std::cerr << "iplan-" << name << ": " << e.what() << "\n";
     return false;
   }
-  popts->name = "iplan-" + name;
   return true;
 }
 
@@ -145,6 +151,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   std::string config_file = DefaultConfigFile(info.name);
   std::string vendor_text;
   int domain = -1;
+  std::string security_dir;
   std::string log_level = "info";
   bool check_only = false;
   std::vector<std::string> overrides;
@@ -153,6 +160,10 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   app.add_option("--dds", vendor_text,
                  "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
   app.add_option("--domain", domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
+  app.add_option("--security", security_dir,
+                 "DDS Security keystore (`iplan security create-keystore`): the service authenticates as "
+                 "enclave iplan-" + info.name + ", encrypts and may use only its topics (default: "
+                 "$IPLAN_SECURITY, else no security)");
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -175,7 +186,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
 
   dds::ParticipantOptions popts;
-  if (!ParticipantOptionsFrom(info.name, vendor_text, domain, &popts)) return kExitConfigError;
+  if (!ParticipantOptionsFrom(info.name, vendor_text, domain, security_dir, &popts)) return kExitConfigError;
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
@@ -195,8 +206,9 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     participant = dds::Participant::Create(popts);
     node = std::make_unique<Node>(info.name, *participant, nopts);
     service = make();
-    node->log().info("configuring from {} on {} domain {}", config_file.empty() ? "(defaults)" : config_file,
-                     dds::ToString(popts.vendor), popts.domain_id);
+    node->log().info("configuring from {} on {} domain {}{}", config_file.empty() ? "(defaults)" : config_file,
+                     dds::ToString(popts.vendor), popts.domain_id,
+                     popts.security_dir.empty() ? "" : ", DDS Security enclave " + popts.name + " of " + popts.security_dir);
     if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
     node->SetState("configured");
     if (check_only) {
