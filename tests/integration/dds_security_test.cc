@@ -288,6 +288,13 @@ INSTANTIATE_TEST_SUITE_P(Vendors, SecuredCell,
                                            Variant{"fastdds", "fastdds", "fastdds"},
                                            Variant{"mixed", "fastdds", "cyclonedds"}),
                          [](const auto& info) { return info.param.name; });
+// Cyclone DDS services with Fast DDS clients: fails on Debian 12's builds
+// (Cyclone: "Begin handshake reply failed: Failed to convert octet sequence
+// to ASN1 integer"; the vendors encode the DH public key differently,
+// docs/dds.md). Disabled; run it with --gtest_also_run_disabled_tests.
+INSTANTIATE_TEST_SUITE_P(DISABLED_KnownFailure, SecuredCell,
+                         ::testing::Values(Variant{"mixed_cyclone_services", "cyclonedds", "fastdds"}),
+                         [](const auto& info) { return info.param.name; });
 
 }  // namespace
 }  // namespace iplan::testing
