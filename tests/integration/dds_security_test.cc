@@ -303,7 +303,7 @@ TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
   EXPECT_EQ(traj->Wait(30s), 0) << traj->Stderr();
   EXPECT_EQ(permit->Wait(30s), 0) << permit->Stderr();
   EXPECT_TRUE(obs.SpinUntil([&] {
-    return obs.Robot("received/" + traj_topic) >= 1 && obs.Robot("received/" + permit_topic) >= 20;
+    return obs.Robot("received/" + traj_topic) >= 1 && obs.Robot("received/" + permit_topic) >= 10;
   }, 10s)) << "trajectories " << obs.Robot("received/" + traj_topic) << ", permits "
            << obs.Robot("received/" + permit_topic);
   EXPECT_EQ(obs.Robot("ignored_writers"), 0);

@@ -3,6 +3,7 @@
 #include <sys/stat.h>
 #include <unistd.h>
 
+#include <cctype>
 #include <cerrno>
 #include <cstring>
 #include <ctime>
@@ -27,7 +28,7 @@ using internal::KeystorePaths;
 
 void MakeDir(const std::string& path, unsigned mode) {
   if (::mkdir(path.c_str(), static_cast<mode_t>(mode)) != 0) {
-    throw std::runtime_error("security: cannot create folder " + path + ": " + std::strerror(errno));
+    throw std::runtime_error("cannot create folder " + path + ": " + std::strerror(errno));
   }
   ::chmod(path.c_str(), static_cast<mode_t>(mode));  // exactly `mode`, whatever the umask
 }

@@ -2,6 +2,7 @@
 // properties that turn on each vendor's builtin security plugins.
 #include <sys/stat.h>
 
+#include <cstdio>
 #include <cstdlib>
 #include <filesystem>
 #include <stdexcept>
