@@ -123,11 +123,16 @@ class CellHarness {
   int domain() const { return domain_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
 
+  /// Runs `svc` on `vendor` instead of the cell's (from its next Start).
+  void SetVendor(const std::string& svc, dds::Vendor vendor) { vendors_[svc] = vendor; }
+
   /// Starts (or restarts) `svc` with the shipped configuration.
   void Start(const std::string& svc, const std::vector<std::string>& extra = {}) {
     const std::string exe = svc == "robot_sim" ? "robot-sim" : svc == "collision_risk" ? "collision-risk" : svc;
+    const auto v = vendors_.find(svc);
     std::vector<std::string> argv = {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml",
-                                     "--dds", dds::ToString(vendor_), "--domain", std::to_string(domain_)};
+                                     "--dds", dds::ToString(v == vendors_.end() ? vendor_ : v->second),
+                                     "--domain", std::to_string(domain_)};
     if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
     if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
     if (svc == "perception") {
@@ -231,6 +236,7 @@ class CellHarness {
   dds::Vendor vendor_;
   int domain_;
   std::string security_;  ///< DDS Security keystore, or ""
+  std::map<std::string, dds::Vendor> vendors_;  ///< services not on vendor_
   std::filesystem::path dir_;
   std::string config_dir_, model_;
   std::unique_ptr<TestNode> observer_;
