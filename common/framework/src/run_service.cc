@@ -95,6 +95,19 @@ bool ParticipantOptionsFrom(const std::string& name, const std::string& vendor_t
   return true;
 }
 
+void AddSecurityOption(CLI::App* app, const std::string& name, std::string* dir) {
+  app->add_option("--security", *dir,
+                  "DDS Security keystore (`iplan security create-keystore`): the service authenticates as "
+                  "enclave " + EnclaveName(name) + ", encrypts and may use only its topics (default: "
+                  "$IPLAN_SECURITY, else no security)");
+}
+
+void LogConfiguring(Node& node, const std::string& config_file, const dds::ParticipantOptions& popts) {
+  node.log().info("configuring from {} on {} domain {}{}", config_file.empty() ? "(defaults)" : config_file,
+                  dds::ToString(popts.vendor), popts.domain_id,
+                  popts.security_dir.empty() ? "" : ", DDS Security enclave " + popts.name + " of " + popts.security_dir);
+}
+
 // Activate, spin until SIGINT/SIGTERM, deactivate, clean up. False when
 // activation failed (cleaned up, logged).
 bool RunActive(Service* service, Node* node) {
@@ -160,10 +173,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   app.add_option("--dds", vendor_text,
                  "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
   app.add_option("--domain", domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
-  app.add_option("--security", security_dir,
-                 "DDS Security keystore (`iplan security create-keystore`): the service authenticates as "
-                 "enclave iplan-" + info.name + ", encrypts and may use only its topics (default: "
-                 "$IPLAN_SECURITY, else no security)");
+  AddSecurityOption(&app, info.name, &security_dir);
   app.add_option("--log-level", log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -206,9 +216,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     participant = dds::Participant::Create(popts);
     node = std::make_unique<Node>(info.name, *participant, nopts);
     service = make();
-    node->log().info("configuring from {} on {} domain {}{}", config_file.empty() ? "(defaults)" : config_file,
-                     dds::ToString(popts.vendor), popts.domain_id,
-                     popts.security_dir.empty() ? "" : ", DDS Security enclave " + popts.name + " of " + popts.security_dir);
+    LogConfiguring(*node, config_file, popts);
     if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
     node->SetState("configured");
     if (check_only) {
