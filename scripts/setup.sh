@@ -18,6 +18,9 @@ PACKAGES=(
   libpcl-dev
   # infrastructure
   libspdlog-dev libyaml-cpp-dev libcli11-dev nlohmann-json3-dev libsystemd-dev systemd
+  # DDS Security keystores (iplan security, common/dds/src/pki.cc; the openssl
+  # CLI to inspect them)
+  libssl-dev openssl
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
   # the planning benchmark's peer planner (benchmark only, no service links it)

@@ -49,8 +49,10 @@ class CellHarness {
     std::string writer;
   };
 
-  CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset)
-      : vendor_(vendor), domain_(UniqueDomain(domain_offset)) {
+  /// With a DDS Security keystore `security_dir` every service starts with
+  /// --security and the observer uses enclave iplan-observer.
+  CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset, const std::string& security_dir = "")
+      : vendor_(vendor), domain_(UniqueDomain(domain_offset)), security_(security_dir) {
     dir_ = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
@@ -66,7 +68,7 @@ class CellHarness {
       return;
     }
     model_ = out.substr(at + 12, out.find('\n', at) - at - 12);
-    observer_ = std::make_unique<TestNode>("observer", vendor, domain_);
+    observer_ = std::make_unique<TestNode>("observer", vendor, domain_, security_);
     framework::Node& node = *observer_->node;
     using SI = const dds::SampleInfo&;
     framework::SubscribeOptions any_order{false};
@@ -121,11 +123,17 @@ class CellHarness {
   int domain() const { return domain_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
 
+  /// Runs `svc` on `vendor` instead of the cell's (from its next Start).
+  void SetVendor(const std::string& svc, dds::Vendor vendor) { vendors_[svc] = vendor; }
+
   /// Starts (or restarts) `svc` with the shipped configuration.
   void Start(const std::string& svc, const std::vector<std::string>& extra = {}) {
     const std::string exe = svc == "robot_sim" ? "robot-sim" : svc == "collision_risk" ? "collision-risk" : svc;
+    const auto v = vendors_.find(svc);
     std::vector<std::string> argv = {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml",
-                                     "--dds", dds::ToString(vendor_), "--domain", std::to_string(domain_)};
+                                     "--dds", dds::ToString(v == vendors_.end() ? vendor_ : v->second),
+                                     "--domain", std::to_string(domain_)};
+    if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
     if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
     if (svc == "perception") {
       argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true"});
@@ -227,6 +235,8 @@ class CellHarness {
  private:
   dds::Vendor vendor_;
   int domain_;
+  std::string security_;  ///< DDS Security keystore, or ""
+  std::map<std::string, dds::Vendor> vendors_;  ///< services not on vendor_
   std::filesystem::path dir_;
   std::string config_dir_, model_;
   std::unique_ptr<TestNode> observer_;

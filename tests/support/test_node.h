@@ -12,11 +12,15 @@
 namespace iplan::testing {
 
 struct TestNode {
-  TestNode(const std::string& name, dds::Vendor vendor, int domain) {
+  /// With a DDS Security keystore `security_dir` the participant
+  /// authenticates as enclave `enclave` and takes its name.
+  TestNode(const std::string& name, dds::Vendor vendor, int domain, const std::string& security_dir = "",
+           const std::string& enclave = "iplan-observer") {
     dds::ParticipantOptions o;
     o.vendor = vendor;
     o.domain_id = domain;
-    o.name = name;
+    o.name = security_dir.empty() ? name : enclave;
+    o.security_dir = security_dir;
     participant = dds::Participant::Create(o);
     framework::NodeOptions no;
     no.diagnostics_period = 0;

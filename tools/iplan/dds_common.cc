@@ -1,11 +1,18 @@
 #include "dds_common.h"
 
+#include "iplan/dds/security.h"
+
 namespace iplan::cli {
 
 void AddDdsOptions(CLI::App* app, DdsOptions* o) {
   app->add_option("--dds", o->vendor, "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
   app->add_option("--domain", o->domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)")
       ->check(CLI::Range(0, 232));
+  app->add_option("--security", o->security,
+                  "DDS Security keystore (`iplan security create-keystore`); default: $IPLAN_SECURITY, else none");
+  app->add_option("--enclave", o->enclave,
+                  "with --security: the enclave to authenticate as (its permissions apply)")
+      ->capture_default_str();
 }
 
 std::unique_ptr<dds::Participant> MakeParticipant(const DdsOptions& o, const std::string& name, bool track) {
@@ -14,6 +21,11 @@ std::unique_ptr<dds::Participant> MakeParticipant(const DdsOptions& o, const std
   p.domain_id = o.domain >= 0 ? o.domain : dds::DefaultDomain();
   p.name = name;
   p.track_endpoints = track;
+  p.security_dir = o.security.empty() ? dds::DefaultSecurityDir() : o.security;
+  if (!p.security_dir.empty()) {
+    p.enclave = o.enclave;
+    p.name = o.enclave;
+  }
   return dds::Participant::Create(p);
 }
 

@@ -8,6 +8,7 @@
 #include <CLI/CLI.hpp>
 
 #include "iplan/dds/participant.h"
+#include "iplan/framework/enclaves.h"
 #include "iplan/framework/topics.h"
 
 namespace iplan::cli {
@@ -15,12 +16,16 @@ namespace iplan::cli {
 struct DdsOptions {
   std::string vendor;  ///< empty: $IPLAN_DDS or cyclonedds
   int domain = -1;     ///< negative: $IPLAN_DOMAIN or 0
+  std::string security;  ///< DDS Security keystore; empty: $IPLAN_SECURITY or none
+  std::string enclave = framework::kObserverEnclave;  ///< with a keystore: whose identity
 };
 
-/// Adds --dds and --domain to a subcommand.
+/// Adds --dds, --domain, --security and --enclave to a subcommand.
 void AddDdsOptions(CLI::App* app, DdsOptions* o);
 
 /// Creates the participant; throws std::runtime_error / invalid_argument.
+/// With a keystore the participant authenticates as `o.enclave` and takes
+/// its name (the name its writers announce), not `name`.
 std::unique_ptr<dds::Participant> MakeParticipant(const DdsOptions& o, const std::string& name,
                                                   bool track_endpoints = false);
 

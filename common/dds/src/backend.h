@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "iplan/dds/participant.h"
+#include "iplan/dds/security.h"
 
 namespace iplan::dds::internal {
 
@@ -42,11 +43,15 @@ class BackendParticipant {
   virtual std::vector<EndpointInfo> Endpoints() const = 0;
 };
 
-/// `config_file` may be empty (vendor default / environment).
+/// `config_file` may be empty (vendor default / environment);
+/// `security` the participant properties that enable DDS Security (empty:
+/// none; security.h).
 std::unique_ptr<BackendParticipant> CreateFastDdsParticipant(const ParticipantOptions& options,
-                                                             const std::string& config_file);
+                                                             const std::string& config_file,
+                                                             const Properties& security);
 std::unique_ptr<BackendParticipant> CreateCycloneParticipant(const ParticipantOptions& options,
-                                                             const std::string& config_file);
+                                                             const std::string& config_file,
+                                                             const Properties& security);
 
 int64_t NowNs();
 std::string HexGuid(const unsigned char* bytes, int n);

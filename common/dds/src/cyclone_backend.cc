@@ -199,7 +199,7 @@ class CycloneReader final : public BackendReader {
 
 class CycloneParticipant final : public BackendParticipant {
  public:
-  CycloneParticipant(const ParticipantOptions& options, const std::string& config_file)
+  CycloneParticipant(const ParticipantOptions& options, const std::string& config_file, const Properties& security)
       : user_data_(WriterUserData(options.name)) {
     if (!config_file.empty()) {
       const std::string uri = "file://" + config_file;
@@ -214,11 +214,13 @@ class CycloneParticipant final : public BackendParticipant {
     }
     dds_qos_t* pq = dds_create_qos();
     dds_qset_entity_name(pq, options.name.c_str());
+    for (const auto& [name, value] : security) dds_qset_prop(pq, name.c_str(), value.c_str());
     participant_ = dds_create_participant(static_cast<dds_domainid_t>(options.domain_id), pq, nullptr);
     dds_delete_qos(pq);
     if (participant_ < 0) {
-      throw std::runtime_error(Err("cannot create a participant on domain " +
-                                   std::to_string(options.domain_id), participant_));
+      throw std::runtime_error(Err("cannot create a participant on domain " + std::to_string(options.domain_id) +
+                                       (security.empty() ? "" : " with DDS Security (see the log above)"),
+                                   participant_));
     }
     waitset_ = dds_create_waitset(participant_);
     guard_ = dds_create_guardcondition(participant_);
@@ -327,8 +329,9 @@ class CycloneParticipant final : public BackendParticipant {
 }  // namespace
 
 std::unique_ptr<BackendParticipant> CreateCycloneParticipant(const ParticipantOptions& options,
-                                                             const std::string& config_file) {
-  return std::make_unique<CycloneParticipant>(options, config_file);
+                                                             const std::string& config_file,
+                                                             const Properties& security) {
+  return std::make_unique<CycloneParticipant>(options, config_file, security);
 }
 
 }  // namespace iplan::dds::internal

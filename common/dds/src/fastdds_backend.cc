@@ -280,30 +280,29 @@ class DiscoveryListener : public fdds::DomainParticipantListener {
 
 class FastParticipant final : public BackendParticipant {
  public:
-  FastParticipant(const ParticipantOptions& options, const std::string& config_file)
+  FastParticipant(const ParticipantOptions& options, const std::string& config_file, const Properties& security)
       : user_data_(WriterUserData(options.name)) {
     auto* factory = fdds::DomainParticipantFactory::get_instance();
     listener_ = std::make_unique<DiscoveryListener>(options.track_endpoints);
+    fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
+    std::string from = "";
     if (!config_file.empty()) {
       if (factory->load_XML_profiles_file(config_file) != RC::RETCODE_OK) {
         throw std::runtime_error("Fast DDS: cannot load XML profiles from " + config_file);
       }
-      participant_ = factory->create_participant_with_profile(
-          options.domain_id, kParticipantProfile, listener_.get(), fdds::StatusMask::none());
-      if (!participant_) {
-        throw std::runtime_error("Fast DDS: cannot create a participant from profile '" +
-                                 std::string(kParticipantProfile) + "' of " + config_file +
-                                 " on domain " + std::to_string(options.domain_id));
+      if (factory->get_participant_qos_from_profile(kParticipantProfile, qos) != RC::RETCODE_OK) {
+        throw std::runtime_error("Fast DDS: no participant profile '" + std::string(kParticipantProfile) + "' in " +
+                                 config_file);
       }
+      from = " (profile '" + std::string(kParticipantProfile) + "' of " + config_file + ")";
     } else {
-      fdds::DomainParticipantQos qos = factory->get_default_participant_qos();
       qos.name(options.name);
-      participant_ = factory->create_participant(options.domain_id, qos, listener_.get(),
-                                                 fdds::StatusMask::none());
-      if (!participant_) {
-        throw std::runtime_error("Fast DDS: cannot create a participant on domain " +
-                                 std::to_string(options.domain_id));
-      }
+    }
+    for (const auto& [name, value] : security) qos.properties().properties().emplace_back(name, value);
+    participant_ = factory->create_participant(options.domain_id, qos, listener_.get(), fdds::StatusMask::none());
+    if (!participant_) {
+      throw std::runtime_error("Fast DDS: cannot create a participant on domain " + std::to_string(options.domain_id) +
+                               from + (security.empty() ? "" : " with DDS Security (see the log above)"));
     }
     publisher_ = participant_->create_publisher(fdds::PUBLISHER_QOS_DEFAULT);
     subscriber_ = participant_->create_subscriber(fdds::SUBSCRIBER_QOS_DEFAULT);
@@ -471,8 +470,9 @@ FastReader::~FastReader() {
 }  // namespace
 
 std::unique_ptr<BackendParticipant> CreateFastDdsParticipant(const ParticipantOptions& options,
-                                                             const std::string& config_file) {
-  return std::make_unique<FastParticipant>(options, config_file);
+                                                             const std::string& config_file,
+                                                             const Properties& security) {
+  return std::make_unique<FastParticipant>(options, config_file, security);
 }
 
 }  // namespace iplan::dds::internal

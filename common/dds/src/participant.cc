@@ -134,9 +134,14 @@ std::unique_ptr<Participant> Participant::Create(const ParticipantOptions& optio
   std::unique_ptr<Participant> p(new Participant());
   p->options_ = options;
   p->config_used_ = ResolveConfig(options);
+  Properties security;
+  if (!options.security_dir.empty()) {
+    const EnclaveFiles files = LoadEnclave(options.security_dir, options.enclave.empty() ? options.name : options.enclave);
+    security = options.vendor == Vendor::kCyclone ? CycloneSecurityProperties(files) : FastDdsSecurityProperties(files);
+  }
   p->backend_ = options.vendor == Vendor::kCyclone
-                    ? internal::CreateCycloneParticipant(options, p->config_used_)
-                    : internal::CreateFastDdsParticipant(options, p->config_used_);
+                    ? internal::CreateCycloneParticipant(options, p->config_used_, security)
+                    : internal::CreateFastDdsParticipant(options, p->config_used_, security);
   return p;
 }
 

@@ -7,6 +7,8 @@
 #include <CLI/CLI.hpp>
 #include <spdlog/spdlog.h>
 
+#include "iplan/dds/security.h"
+#include "iplan/framework/enclaves.h"
 #include "iplan/framework/service.h"
 #include "iplan/framework/topics.h"
 #include "realtime.h"
@@ -109,18 +111,35 @@ bool Configure(const std::string& name, ConfigSection* config, Service* service,
   return true;
 }
 
-// --dds and --domain, or their environment defaults. False (printed) on a bad one.
+// --dds, --domain and --security, or their environment defaults. False
+// (printed) on a bad one, including a missing or invalid enclave: a
+// restart cannot fix those (exit code 2).
 bool ParticipantOptionsFrom(const std::string& name, const std::string& vendor_text, int domain,
-                            dds::ParticipantOptions* popts) {
+                            const std::string& security_dir, dds::ParticipantOptions* popts) {
+  popts->name = EnclaveName(name);
   try {
     popts->vendor = vendor_text.empty() ? dds::DefaultVendor() : dds::ParseVendor(vendor_text);
     popts->domain_id = domain >= 0 ? domain : dds::DefaultDomain();
+    popts->security_dir = security_dir.empty() ? dds::DefaultSecurityDir() : security_dir;
+    if (!popts->security_dir.empty()) dds::LoadEnclave(popts->security_dir, popts->name);
   } catch (const std::exception& e) {
     std::cerr << "iplan-" << name << ": " << e.what() << "\n";
     return false;
   }
-  popts->name = "iplan-" + name;
   return true;
+}
+
+void AddSecurityOption(CLI::App* app, const std::string& name, std::string* dir) {
+  app->add_option("--security", *dir,
+                  "DDS Security keystore (`iplan security create-keystore`): the service authenticates as "
+                  "enclave " + EnclaveName(name) + ", encrypts and may use only its topics (default: "
+                  "$IPLAN_SECURITY, else no security)");
+}
+
+void LogConfiguring(Node& node, const std::string& config_file, const dds::ParticipantOptions& popts) {
+  node.log().info("configuring from {} on {} domain {}{}", config_file.empty() ? "(defaults)" : config_file,
+                  dds::ToString(popts.vendor), popts.domain_id,
+                  popts.security_dir.empty() ? "" : ", DDS Security enclave " + popts.name + " of " + popts.security_dir);
 }
 
 // Activate, spin until SIGINT/SIGTERM, deactivate, clean up. False when
@@ -154,6 +173,7 @@ struct CommandLine {
   std::string config_file;
   std::string vendor_text;
   int domain = -1;
+  std::string security_dir;
   std::string log_level = "info";
   bool check_only = false;
   std::vector<std::string> overrides;
@@ -166,6 +186,7 @@ void AddOptions(const ServiceInfo& info, CLI::App* app, CommandLine* cl) {
   app->add_option("--dds", cl->vendor_text,
                   "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
   app->add_option("--domain", cl->domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
+  AddSecurityOption(app, info.name, &cl->security_dir);
   app->add_option("--log-level", cl->log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -223,7 +244,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   spdlog::set_pattern("[%H:%M:%S.%e] [%n] [%^%l%$] %v");
 
   dds::ParticipantOptions popts;
-  if (!ParticipantOptionsFrom(info.name, cl.vendor_text, cl.domain, &popts)) return kExitConfigError;
+  if (!ParticipantOptionsFrom(info.name, cl.vendor_text, cl.domain, cl.security_dir, &popts)) return kExitConfigError;
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
@@ -243,8 +264,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     participant = dds::Participant::Create(popts);
     node = std::make_unique<Node>(info.name, *participant, nopts);
     service = make();
-    node->log().info("configuring from {} on {} domain {}", cl.config_file.empty() ? "(defaults)" : cl.config_file,
-                     dds::ToString(popts.vendor), popts.domain_id);
+    LogConfiguring(*node, cl.config_file, popts);
     if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
     node->SetState("configured");
     if (cl.check_only) {

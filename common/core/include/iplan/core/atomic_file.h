@@ -10,8 +10,10 @@
 namespace iplan::core {
 
 /// Replaces `path` with `content` atomically (write temp, fsync, rename,
-/// fsync folder). Throws std::runtime_error with the path and errno text.
-void WriteFileAtomically(const std::string& path, const std::string& content);
+/// fsync folder). `mode` is the new file's permission bits (less the
+/// umask): 0600 for secrets. Throws std::runtime_error with the path and
+/// errno text.
+void WriteFileAtomically(const std::string& path, const std::string& content, unsigned mode = 0644);
 
 /// Removes the temporaries `path.tmp.<pid>` that WriteFileAtomically left
 /// behind when its process died between creating and renaming them (kill -9,

@@ -52,6 +52,11 @@ struct ParticipantOptions {
   std::string config_file;
   /// Keep track of every endpoint on the domain (for `iplan topic list`).
   bool track_endpoints = false;
+  /// DDS Security keystore folder (iplan/dds/security.h); empty: no
+  /// security. The participant authenticates as enclave `enclave` (empty:
+  /// `name`), and Create throws when that enclave is missing or invalid.
+  std::string security_dir;
+  std::string enclave;
   // `name` is also announced in every writer's USER_DATA (WriterUserData), so
   // readers can tell which participant wrote a sample (SampleInfo::writer_name).
 };
