@@ -60,6 +60,22 @@ void OnTrajectory(const JointTrajectory_& t) {
                    with_velocities);
 }
 
+// /tf_static as tf2's static listener: reliable, transient local, keep last 1.
+fdds::DataReader* MakeTfReader(fdds::DomainParticipant* dp, fdds::Subscriber* sub, const std::string& topic,
+                               const fdds::DataReaderQos& rq, const dyn::DynamicType_ptr& tf_type) {
+  auto* tf_support = new dyn::DynamicPubSubType(tf_type);
+  fdds::TypeSupport tf_ts(tf_support);
+  tf_ts->auto_fill_type_information(false);
+  tf_ts->auto_fill_type_object(false);
+  tf_ts.register_type(dp);
+  fdds::Topic* tf_topic = Check(dp->create_topic(Wire(topic), tf_ts.get_type_name(), fdds::TOPIC_QOS_DEFAULT),
+                                "topic");
+  fdds::DataReaderQos sq = rq;
+  sq.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
+  sq.history().depth = 1;
+  return Check(sub->create_datareader(tf_topic, sq), "reader");
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -91,19 +107,8 @@ int main(int argc, char** argv) {
     js_reader = Check(sub->create_datareader(t, rq), "reader");
   }
   const int states_wanted = js_reader ? 3 : 0;
-  // /tf_static as tf2's static listener: reliable, transient local, keep last 1.
   const dyn::DynamicType_ptr tf_type = TfMessageType();
-  auto* tf_support = new dyn::DynamicPubSubType(tf_type);
-  fdds::TypeSupport tf_ts(tf_support);
-  tf_ts->auto_fill_type_information(false);
-  tf_ts->auto_fill_type_object(false);
-  tf_ts.register_type(dp);
-  fdds::Topic* tf_topic = Check(dp->create_topic(Wire(o.tf_static_topic), tf_ts.get_type_name(),
-                                                 fdds::TOPIC_QOS_DEFAULT), "topic");
-  fdds::DataReaderQos sq = rq;
-  sq.durability().kind = fdds::TRANSIENT_LOCAL_DURABILITY_QOS;
-  sq.history().depth = 1;
-  fdds::DataReader* tf_reader = Check(sub->create_datareader(tf_topic, sq), "reader");
+  fdds::DataReader* tf_reader = MakeTfReader(dp, sub, o.tf_static_topic, rq, tf_type);
   dyn::DynamicData* tf_data = dyn::DynamicDataFactory::get_instance()->create_data(tf_type);
   int transforms = 0;
 
