@@ -88,7 +88,8 @@ class MultiHostCell {
         profile_("IPLAN_DDS_PROFILE", "network"),
         interface_("IPLAN_DDS_INTERFACE", "eth0"),
         ops_(lab_.Namespace("ops")),
-        cell_(tag, v.planning, 91) {
+        cell_(tag, v.planning, 91),
+        variant_(v) {
     for (const auto& svc : CellHarness::Services()) {
       const std::string host = HostOf(svc);
       cell_.Place(svc, lab_.On(host), host == "sensor" ? v.sensor : host == "robot" ? v.robot : v.planning);
@@ -96,12 +97,14 @@ class MultiHostCell {
   }
   NetLab& lab() { return lab_; }
   CellHarness& cell() { return cell_; }
+  const Variant& variant() const { return variant_; }
 
  private:
   NetLab lab_;
   ScopedEnv profile_, interface_;
   InNamespace ops_;
   CellHarness cell_;
+  Variant variant_;
 };
 
 // Distinct tasks that succeeded in outcomes[from...], and how many failed.
@@ -267,7 +270,16 @@ void UnderFault(MultiHostCell& mh, const std::string& what, const std::function<
         return cell.MaxSpeedSince(off) > 0.2 || Clock::now() - clean_since > 5s;
       },
       30s);
-  EXPECT_TRUE(recovered) << "still a network stop after " << what << " ended; " << Why(cell);
+  if (!recovered) {
+    // Whose side is stuck: a fresh reader on the planning host.
+    std::vector<std::string> hz = mh.lab().On("planning");
+    hz.insert(hz.end(), {BinPath("iplan"), "topic", "hz", "/iplan/human/prediction", "--duration", "3", "--dds",
+                         dds::ToString(mh.variant().planning), "--domain", std::to_string(cell.domain())});
+    std::string out;
+    NetLab::Run(hz, &out);
+    ADD_FAILURE() << "still a network stop after " << what << " ended; " << Why(cell)
+                  << "\na new reader of /iplan/human/prediction on the planning host:\n" << out;
+  }
   std::cout << what << " removed: after " << Seconds(Clock::now() - off) << " s "
             << (cell.MaxSpeedSince(off) > 0.2 ? "moving again" : "at rest, held by the cell: " + Why(cell)) << "\n";
 }

@@ -8,7 +8,6 @@
 #include <cerrno>
 #include <chrono>
 #include <cstring>
-#include <filesystem>
 #include <sstream>
 #include <stdexcept>
 
@@ -61,10 +60,14 @@ std::string NetLab::Unavailable() {
   const std::string probe = std::string(kPrefix) + std::to_string(getpid()) + "-probe";
   std::string out;
   if (Run({ip, "netns", "add", probe}, &out) != 0) return "`ip netns add` failed: " + out;
-  const int rc = Run({ip, "-n", probe, "link", "add", "probe0", "type", "veth", "peer", "name", "probe1"}, &out);
+  std::string why;
+  if (Run({ip, "-n", probe, "link", "add", "probe0", "type", "veth", "peer", "name", "probe1"}, &out) != 0) {
+    why = "cannot create a veth pair in a namespace: " + out;
+  } else if (Run({ip, "netns", "exec", probe, "/bin/true"}, &out) != 0) {
+    why = "`ip netns exec` fails here (it mounts /sys for the namespace): " + out;
+  }
   Run({ip, "netns", "del", probe});
-  if (rc != 0) return "cannot create a veth pair in a namespace: " + out;
-  return "";
+  return why;
 }
 
 void NetLab::RemoveStale() {
