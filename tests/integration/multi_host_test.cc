@@ -186,7 +186,7 @@ constexpr double kPermitValidity = 0.2;   // s, a permit's validity at the robot
 constexpr double kStoppingTime = 0.3;     // s, robot_sim.stopping_time
 constexpr double kJointDeadline = 0.1;    // s, /joint_states deadline at the supervisor
 constexpr double kSlack = 0.25;           // s, scheduling on a loaded 2-core machine, 20 ms joint-state period
-constexpr auto kCut = 4s;                 // longer than Cyclone's 3 s participant lease: rediscovery too
+constexpr auto kCut = 12s;  // well past Cyclone's 3 s participant lease: peers expire and are rediscovered
 
 // Cable out while the arm moves; returns the robot's rest latency, s.
 double CutTheRobotHost(MultiHostCell& mh, const Process& echo) {
@@ -233,7 +233,7 @@ bool NetworkStop(const std::string& reason) {
 // safely: no contact, no service lost; once the fault is gone, no stop is
 // the network's any more (the cell moves, or it holds for a reason of its
 // own, e.g. the person inside the protective separation).
-constexpr auto kFaultRun = 30s;
+constexpr auto kFaultRun = 20s;
 void UnderFault(MultiHostCell& mh, const std::string& what, const std::function<void(bool)>& fault) {
   CellHarness& cell = mh.cell();
   const std::size_t from = cell.outcomes().size();
