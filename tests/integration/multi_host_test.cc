@@ -126,9 +126,9 @@ std::string Why(CellHarness& cell) {
   return "supervisor: " + cell.LastReason("supervisor") + "; collision risk: " + cell.LastReason("collision_risk");
 }
 
-#define IPLAN_SKIP_WITHOUT_NAMESPACES()                                                      \
-  if (const std::string why = NetLab::Unavailable(); !why.empty()) {                         \
-    GTEST_SKIP() << "multi-host test skipped: " << why;                                      \
+#define IPLAN_SKIP_WITHOUT_NAMESPACES()                              \
+  if (const std::string why = NetLab::Unavailable(); !why.empty()) { \
+    GTEST_SKIP() << "multi-host test skipped: " << why;              \
   }
 
 class MultiHost : public ::testing::TestWithParam<Variant> {};
@@ -171,7 +171,8 @@ std::vector<RobotSample> RobotSamples(const Process& echo) {
     const auto j = nlohmann::json::parse(line, nullptr, false);
     if (j.is_discarded() || !j.contains("header")) continue;
     RobotSample s;
-    s.stamp_ns = j["header"]["stamp"]["sec"].get<int64_t>() * 1000000000 + j["header"]["stamp"]["nanosec"].get<int64_t>();
+    s.stamp_ns =
+        j["header"]["stamp"]["sec"].get<int64_t>() * 1000000000 + j["header"]["stamp"]["nanosec"].get<int64_t>();
     for (const auto& v : j["velocity"]) s.max_speed = std::max(s.max_speed, std::abs(v.get<double>()));
     out.push_back(s);
   }
@@ -182,11 +183,11 @@ int64_t WallNs() {
       .count();
 }
 
-constexpr double kPermitValidity = 0.2;   // s, a permit's validity at the robot (docs/safety.md)
-constexpr double kStoppingTime = 0.3;     // s, robot_sim.stopping_time
-constexpr double kJointDeadline = 0.1;    // s, /joint_states deadline at the supervisor
-constexpr double kSlack = 0.25;           // s, scheduling on a loaded 2-core machine, 20 ms joint-state period
-constexpr auto kCut = 12s;  // well past Cyclone's 3 s participant lease: peers expire and are rediscovered
+constexpr double kPermitValidity = 0.2;  // s, a permit's validity at the robot (docs/safety.md)
+constexpr double kStoppingTime = 0.3;    // s, robot_sim.stopping_time
+constexpr double kJointDeadline = 0.1;   // s, /joint_states deadline at the supervisor
+constexpr double kSlack = 0.25;          // s, scheduling on a loaded 2-core machine, 20 ms joint-state period
+constexpr auto kCut = 12s;               // well past Cyclone's 3 s participant lease: peers expire and are rediscovered
 
 // Cable out while the arm moves; returns the robot's rest latency, s.
 double CutTheRobotHost(MultiHostCell& mh, const Process& echo) {
@@ -212,8 +213,9 @@ double CutTheRobotHost(MultiHostCell& mh, const Process& echo) {
   EXPECT_GT(after_cut, 50) << "the robot host published too little while cut off";
   EXPECT_TRUE(rest.has_value()) << "the robot still moved when its cable was plugged back";
   const double rest_s = rest ? (*rest - cut_ns) * 1e-9 : 1e9;
-  std::cout << "robot host cut off: supervisor permit withdrawn after " << withdrawn << " s (" << cell.LastReason("supervisor")
-            << "); robot at rest " << rest_s << " s after the cut (its own /joint_states)\n";
+  std::cout << "robot host cut off: supervisor permit withdrawn after " << withdrawn << " s ("
+            << cell.LastReason("supervisor") << "); robot at rest " << rest_s
+            << " s after the cut (its own /joint_states)\n";
   EXPECT_LE(withdrawn, kJointDeadline + kSlack);
   EXPECT_LE(rest_s, kPermitValidity + kStoppingTime + kSlack);
   mh.lab().SetLink("robot", true);
@@ -278,10 +280,37 @@ void UnderFault(MultiHostCell& mh, const std::string& what, const std::function<
     std::string out;
     NetLab::Run(hz, &out);
     ADD_FAILURE() << "still a network stop after " << what << " ended; " << Why(cell)
-                  << "\na new reader of /iplan/human/prediction on the planning host:\n" << out;
+                  << "\na new reader of /iplan/human/prediction on the planning host:\n"
+                  << out;
   }
   std::cout << what << " removed: after " << Seconds(Clock::now() - off) << " s "
             << (cell.MaxSpeedSince(off) > 0.2 ? "moving again" : "at rest, held by the cell: " + Why(cell)) << "\n";
+}
+
+// Packet loss (nftables) at 5 % and 20 %, then added delay where the kernel
+// has netem; says which of them ran.
+void LossAndDelay(MultiHostCell& mh) {
+  std::string ran = "cable out";
+  if (const std::string why = mh.lab().LossUnavailable(); why.empty()) {
+    for (const int percent : {5, 20}) {
+      UnderFault(mh, std::to_string(percent) + " % packet loss on every host", [&](bool on) {
+        for (const char* h : {"sensor", "planning", "robot"}) mh.lab().SetLoss(h, on ? percent : 0);
+      });
+      ran += ", " + std::to_string(percent) + " % loss";
+    }
+  } else {
+    std::cout << "packet-loss fault NOT run: " << why << "\n";
+  }
+  if (const std::string why = mh.lab().DelayUnavailable(); why.empty()) {
+    UnderFault(mh, "20 ms added delay on every host", [&](bool on) {
+      for (const char* h : {"sensor", "planning", "robot"}) mh.lab().SetDelay(h, on ? 20 : 0);
+    });
+    ran += ", 20 ms delay";
+  } else {
+    std::cout << "delay fault NOT run: this kernel has no netem (tc: " << why << ")\n";
+  }
+  std::cout << "network faults run: " << ran << "\n";
+  ::testing::Test::RecordProperty("faults_run", ran);
 }
 
 struct FaultVariant {
@@ -298,8 +327,8 @@ TEST_P(MultiHostFaults, CableOutLossAndDelay) {
   ASSERT_TRUE(cell.ready());
   const std::uint64_t model_hash = core::Fnv1a64(core::ReadFile(cell.model()), core::kIplanFnvSeed);
   std::vector<std::string> echo_argv = mh.lab().On("robot");
-  echo_argv.insert(echo_argv.end(), {BinPath("iplan"), "topic", "echo", "/joint_states", "--dds", dds::ToString(v.robot),
-                                     "--domain", std::to_string(cell.domain())});
+  echo_argv.insert(echo_argv.end(), {BinPath("iplan"), "topic", "echo", "/joint_states", "--dds",
+                                     dds::ToString(v.robot), "--domain", std::to_string(cell.domain())});
   Process echo(echo_argv);
   cell.StartAll();
   // A learned table to keep: some task has ended.
@@ -307,47 +336,21 @@ TEST_P(MultiHostFaults, CableOutLossAndDelay) {
   // Moving with both permits: whatever stops the arm now is the fault.
   ASSERT_TRUE(cell.SpinUntil(
       [&] { return cell.Moving() && cell.Permits("supervisor") && cell.Permits("collision_risk"); }, 120s))
-      << Why(cell) << "\n" << cell.Logs("robot_sim");
+      << Why(cell) << "\n"
+      << cell.Logs("robot_sim");
   CutTheRobotHost(mh, echo);
   const auto replugged = Clock::now();
   ASSERT_TRUE(cell.SpinUntil([&] { return cell.MaxSpeedSince(replugged) > 0.2; }, 60s))
       << "no motion after the cable is back; " << Why(cell);
   std::cout << "robot host back: moving again " << Seconds(Clock::now() - replugged) << " s after the replug\n";
 
-  std::string ran = "cable out";
-  if (!GetParam().loss_and_delay) {
-    cell.ExpectNoContactAndCleanShutdown();
-    return;
-  }
-  std::string nft_out;
-  const int nft = NetLab::Run([&] { auto a = mh.lab().On("robot"); a.insert(a.end(), {"nft", "list", "tables"}); return a; }(), &nft_out);
-  if (nft == 0) {
-    for (const int percent : {5, 20}) {
-      UnderFault(mh, std::to_string(percent) + " % packet loss on every host", [&](bool on) {
-        for (const char* h : {"sensor", "planning", "robot"}) mh.lab().SetLoss(h, on ? percent : 0);
-      });
-      ran += ", " + std::to_string(percent) + " % loss";
-    }
-  } else {
-    std::cout << "packet-loss fault NOT run: nft unavailable (" << nft_out << "); install Debian's nftables\n";
-  }
-  if (const std::string why = mh.lab().DelayUnavailable(); why.empty()) {
-    UnderFault(mh, "20 ms added delay on every host", [&](bool on) {
-      for (const char* h : {"sensor", "planning", "robot"}) mh.lab().SetDelay(h, on ? 20 : 0);
-    });
-    ran += ", 20 ms delay";
-  } else {
-    std::cout << "delay fault NOT run: this kernel has no netem (tc: " << why << ")\n";
-  }
-  std::cout << "network faults run: " << ran << "\n";
-  RecordProperty("faults_run", ran);
-
+  if (GetParam().loss_and_delay) LossAndDelay(mh);
   cell.ExpectNoContactAndCleanShutdown();
   // Nothing lost: the model unchanged, the Q-table loads with what it learned.
   EXPECT_EQ(core::Fnv1a64(core::ReadFile(cell.model()), core::kIplanFnvSeed), model_hash) << cell.model();
   cell.Start("supervisor");
-  EXPECT_TRUE(cell.SpinUntil([&] { return cell["supervisor"].Stderr().find("loaded " + cell.q_table()) != std::string::npos; },
-                             10s))
+  EXPECT_TRUE(cell.SpinUntil(
+      [&] { return cell["supervisor"].Stderr().find("loaded " + cell.q_table()) != std::string::npos; }, 10s))
       << cell["supervisor"].Stderr();
   cell["supervisor"].Signal(SIGTERM);
   EXPECT_EQ(cell["supervisor"].Wait(10s), 0);

@@ -135,9 +135,7 @@ std::string NetLab::Namespace(const std::string& host) const {
   return prefix_ + host;
 }
 
-std::string NetLab::Address(const std::string& host) const {
-  return "10.201.0." + std::to_string(index_.at(host));
-}
+std::string NetLab::Address(const std::string& host) const { return "10.201.0." + std::to_string(index_.at(host)); }
 
 std::vector<std::string> NetLab::On(const std::string& host) const {
   return {IpTool(), "netns", "exec", Namespace(host)};
@@ -164,6 +162,15 @@ void NetLab::SetLoss(const std::string& host, int percent) {
   // over its loopback, which no cable fault touches.
   Must(with("add rule " + table + " input iifname \"eth0\" numgen random mod 100 < " + std::to_string(percent) +
             " drop"));
+}
+
+std::string NetLab::LossUnavailable() {
+  if (hosts_.empty()) return "no hosts";
+  std::vector<std::string> nft = On(hosts_.front());
+  nft.insert(nft.end(), {"nft", "list", "tables"});
+  std::string out;
+  if (Run(nft, &out) != 0) return "nft fails in a host (Debian package nftables): " + out.substr(0, out.find('\n'));
+  return "";
 }
 
 std::string NetLab::DelayUnavailable() {

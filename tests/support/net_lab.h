@@ -48,6 +48,8 @@ class NetLab {
   /// Drops `percent` (0-100) of the packets `host` receives; 0 removes the
   /// rule.
   void SetLoss(const std::string& host, int percent);
+  /// Empty when nftables works in the hosts, else why not.
+  std::string LossUnavailable();
   /// Empty when `tc qdisc ... netem` works here, else the kernel's answer.
   std::string DelayUnavailable();
   /// Adds a fixed one-way delay (ms) on the host's eth0; 0 removes it.
