@@ -23,6 +23,9 @@ PACKAGES=(
   libssl-dev openssl
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev
+  # the multi-host test: network namespaces, veth pairs, a bridge (iproute2)
+  # and packet loss inside a namespace (nftables)
+  iproute2 nftables
   # the planning benchmark's peer planner (benchmark only, no service links it)
   libompl-dev
   # viewer (iplan view / record / report): HTTP + WebSocket server, Node.js for

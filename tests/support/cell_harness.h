@@ -122,6 +122,15 @@ class CellHarness {
   framework::Node& node() { return *observer_->node; }
   int domain() const { return domain_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
+  /// The intent model the cell's intent service loads.
+  const std::string& model() const { return model_; }
+
+  /// Where `svc` runs from its next start: `launcher` goes before its
+  /// command line (e.g. `ip netns exec <host>`), on `vendor`.
+  void Place(const std::string& svc, std::vector<std::string> launcher, dds::Vendor vendor) {
+    launchers_[svc] = std::move(launcher);
+    vendors_[svc] = vendor;
+  }
 
   /// Runs `svc` on `vendor` instead of the cell's (from its next Start).
   void SetVendor(const std::string& svc, dds::Vendor vendor) { vendors_[svc] = vendor; }
@@ -129,10 +138,10 @@ class CellHarness {
   /// Starts (or restarts) `svc` with the shipped configuration.
   void Start(const std::string& svc, const std::vector<std::string>& extra = {}) {
     const std::string exe = svc == "robot_sim" ? "robot-sim" : svc == "collision_risk" ? "collision-risk" : svc;
-    const auto v = vendors_.find(svc);
-    std::vector<std::string> argv = {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml",
-                                     "--dds", dds::ToString(v == vendors_.end() ? vendor_ : v->second),
-                                     "--domain", std::to_string(domain_)};
+    const dds::Vendor vendor = vendors_.count(svc) ? vendors_.at(svc) : vendor_;
+    std::vector<std::string> argv = launchers_[svc];
+    argv.insert(argv.end(), {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml", "--dds",
+                             dds::ToString(vendor), "--domain", std::to_string(domain_)});
     if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
     if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
     if (svc == "perception") {
@@ -241,6 +250,8 @@ class CellHarness {
   std::string config_dir_, model_;
   std::unique_ptr<TestNode> observer_;
   std::map<std::string, std::unique_ptr<Process>> procs_;
+  std::map<std::string, std::vector<std::string>> launchers_;
+  std::map<std::string, dds::Vendor> vendors_;
   int starts_ = 0;
   std::vector<JointSample> joints_;
   std::vector<double> positions_;
