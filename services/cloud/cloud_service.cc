@@ -6,6 +6,8 @@
 // /joint_states and the robot's collision spheres, table plane,
 // segmentation, tracking over frames.
 #include <chrono>
+#include <cstdlib>
+#include <deque>
 #include <optional>
 
 #include "common/cloud_adapters.h"
@@ -86,19 +88,30 @@ class CloudService : public framework::Service {
     }
     Eigen::VectorXd q(static_cast<Eigen::Index>(index.size()));
     for (std::size_t k = 0; k < index.size(); ++k) q[static_cast<Eigen::Index>(k)] = m.position[static_cast<std::size_t>(index[k])];
-    q_ = q;
-    q_ns_ = msg::ToNanoseconds(m.header.stamp);
+    // A second of history, so that a cloud processed late still finds the
+    // robot's pose of its own time.
+    history_.push_back({msg::ToNanoseconds(m.header.stamp), q});
+    while (history_.size() > 1 && history_.back().first - history_.front().first > 1'000'000'000) history_.pop_front();
+  }
+
+  // The joint state nearest the cloud's stamp, if within joint_state_timeout.
+  std::optional<Eigen::VectorXd> PoseAt(int64_t stamp) const {
+    const std::pair<int64_t, Eigen::VectorXd>* best = nullptr;
+    for (const auto& h : history_) {
+      if (!best || std::llabs(h.first - stamp) < std::llabs(best->first - stamp)) best = &h;
+    }
+    if (!best || static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) return std::nullopt;
+    return best->second;
   }
 
   void OnCloud(Node& node, const msg::PointCloud2& m) {
     const auto t0 = std::chrono::steady_clock::now();
     if (node.CountRejection("depth_points", services::FromPointCloud2(m, &cloud_))) return;
     const int64_t stamp = msg::ToNanoseconds(m.header.stamp);
-    // The robot's pose when the cloud was taken: the latest joint state, if
-    // recent enough; otherwise no self-filter (the robot's own points then
+    // The robot's pose when the cloud was taken: the nearest joint state, if
+    // near enough; otherwise no self-filter (the robot's own points then
     // count as a person: cautious, and reported).
-    std::optional<Eigen::VectorXd> q;
-    if (q_ && std::abs(static_cast<double>(stamp - q_ns_)) * 1e-9 <= joint_state_timeout_) q = q_;
+    const std::optional<Eigen::VectorXd> q = PoseAt(stamp);
     if (!joint_names_.empty() && !q) ++unfiltered_;
     const StageOutput out = stage_->Process(&cloud_, q, stamp);
     Publish(node, m.header.stamp, out);
@@ -149,8 +162,7 @@ class CloudService : public framework::Service {
 
   std::unique_ptr<CloudStage> stage_;
   std::vector<std::string> joint_names_;
-  std::optional<Eigen::VectorXd> q_;
-  int64_t q_ns_ = 0;
+  std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
   double joint_state_timeout_ = 0.2;
   double human_voxel_ = 0.03;
   std::string frame_id_ = "world";
