@@ -63,6 +63,60 @@ std::unique_ptr<Process> Start(const std::string& exe, const std::string& cfg, i
   return std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, log);
 }
 
+const msg::Obstacle* Find(const msg::ObstacleArray& a, const Eigen::Vector3d& c, double tol) {
+  for (const auto& o : a.obstacles)
+    if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - c).norm() < tol) return &o;
+  return nullptr;
+}
+
+// The box and the parts bin are static obstacles with stable ids; nothing flat (table).
+void CheckObstacles(const std::vector<msg::ObstacleArray>& arrays, const Eigen::Vector3d& box_centre,
+                    const Eigen::Vector3d& box_size) {
+  const msg::ObstacleArray& last = arrays.back();
+  EXPECT_EQ(last.header.frame_id, "world");
+  const msg::Obstacle* box = Find(last, box_centre, 0.03);
+  ASSERT_NE(box, nullptr) << "no obstacle within 3 cm of the box; " << last.obstacles.size() << " obstacles";
+  std::cout << "box centre error " << (Eigen::Vector3d(box->centre.x, box->centre.y, box->centre.z) - box_centre).norm()
+            << " m\n";
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(2 * box->half_extents[static_cast<std::size_t>(k)], box_size[k], 0.03) << k;
+  EXPECT_NE(Find(last, Eigen::Vector3d(0.55, 0.45, 0.1), 0.05), nullptr) << "parts bin not reported";
+  int same_id = 0;
+  for (std::size_t i = arrays.size() - 30; i < arrays.size(); ++i) {
+    const msg::Obstacle* b = Find(arrays[i], box_centre, 0.03);
+    same_id += b && b->id == box->id && b->first_seen.sec == box->first_seen.sec && b->first_seen.nanosec == box->first_seen.nanosec;
+  }
+  EXPECT_EQ(same_id, 30);
+  for (const auto& o : last.obstacles) EXPECT_GT(o.half_extents[2], 0.02) << "a flat obstacle: table left over?";
+}
+
+// The person's points of the last 40 sets lie on the true body; none is the table.
+void CheckHumanPoints(const std::vector<msg::HumanPoints>& points, const std::vector<std::vector<Eigen::Vector3d>>& centres_at,
+                      const collision::HumanBodyModel& body) {
+  std::vector<double> dist;
+  int on_table = 0;
+  const std::vector<double> radii = body.Radii();
+  for (std::size_t i = points.size() - 40; i < points.size(); ++i) {
+    EXPECT_EQ(points[i].header.frame_id, "world");
+    EXPECT_DOUBLE_EQ(points[i].voxel_size, 0.03);
+    for (const auto& p : points[i].points) {
+      const Eigen::Vector3d m(p.mean.x, p.mean.y, p.mean.z);
+      double d = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < body.num_spheres(); ++k)
+        d = std::min(d, (m - centres_at[i][static_cast<std::size_t>(k)]).norm() - radii[static_cast<std::size_t>(k)]);
+      dist.push_back(std::abs(d));
+      on_table += std::abs(m.z()) < 0.01;
+      EXPECT_GT(p.covariance[8], 0);
+    }
+  }
+  ASSERT_GT(dist.size(), 40u * 100);
+  std::sort(dist.begin(), dist.end());
+  std::cout << "human points " << dist.size() << " in 40 sets, distance to the true body median " << dist[dist.size() / 2]
+            << " m, p90 " << dist[dist.size() * 9 / 10] << " m; near the table top " << on_table << "\n";
+  EXPECT_LT(dist[dist.size() / 2], 0.03) << "median distance to the true body";
+  EXPECT_LT(dist[dist.size() * 9 / 10], 0.08) << "90th percentile";
+  EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
+}
+
 TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
   const int domain = UniqueDomain(41);
   const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-test-" + std::to_string(getpid()));
@@ -108,51 +162,8 @@ TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
       << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cloud->Stderr()
       << perception->Stderr();
 
-  // The box and the parts bin are static obstacles with stable ids.
-  auto find = [](const msg::ObstacleArray& a, const Eigen::Vector3d& c, double tol) -> const msg::Obstacle* {
-    for (const auto& o : a.obstacles)
-      if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - c).norm() < tol) return &o;
-    return nullptr;
-  };
-  const msg::ObstacleArray& last = arrays.back();
-  EXPECT_EQ(last.header.frame_id, "world");
-  const msg::Obstacle* box = find(last, box_centre, 0.03);
-  ASSERT_NE(box, nullptr) << "no obstacle within 3 cm of the box; " << last.obstacles.size() << " obstacles";
-  for (int k = 0; k < 3; ++k) EXPECT_NEAR(2 * box->half_extents[static_cast<std::size_t>(k)], box_size[k], 0.03) << k;
-  EXPECT_NE(find(last, Eigen::Vector3d(0.55, 0.45, 0.1), 0.05), nullptr) << "parts bin not reported";
-  int same_id = 0;
-  for (std::size_t i = arrays.size() - 30; i < arrays.size(); ++i) {
-    const msg::Obstacle* b = find(arrays[i], box_centre, 0.03);
-    same_id += b && b->id == box->id && b->first_seen.sec == box->first_seen.sec && b->first_seen.nanosec == box->first_seen.nanosec;
-  }
-  EXPECT_EQ(same_id, 30);
-  for (const auto& o : last.obstacles) EXPECT_GT(o.half_extents[2], 0.02) << "a flat obstacle: table left over?";
-
-  // The person's points lie on the true body; none is the table.
-  std::vector<double> dist;
-  int on_table = 0;
-  for (std::size_t i = points.size() - 40; i < points.size(); ++i) {
-    EXPECT_EQ(points[i].header.frame_id, "world");
-    EXPECT_DOUBLE_EQ(points[i].voxel_size, 0.03);
-    for (const auto& p : points[i].points) {
-      const Eigen::Vector3d m(p.mean.x, p.mean.y, p.mean.z);
-      double d = std::numeric_limits<double>::infinity();
-      for (int k = 0; k < body.num_spheres(); ++k)
-        d = std::min(d, (m - centres_at[i][static_cast<std::size_t>(k)]).norm() - body.Radii()[static_cast<std::size_t>(k)]);
-      dist.push_back(std::abs(d));
-      on_table += std::abs(m.z()) < 0.01;
-      EXPECT_GT(p.covariance[8], 0);
-    }
-  }
-  ASSERT_GT(dist.size(), 40u * 100);
-  std::sort(dist.begin(), dist.end());
-  std::cout << "box centre error " << (Eigen::Vector3d(box->centre.x, box->centre.y, box->centre.z) - box_centre).norm()
-            << " m; human points " << dist.size() << " in 40 sets, distance to the true body median " << dist[dist.size() / 2]
-            << " m, p90 " << dist[dist.size() * 9 / 10] << " m; near the table top " << on_table << "\n";
-  EXPECT_LT(dist[dist.size() / 2], 0.03) << "median distance to the true body";
-  EXPECT_LT(dist[dist.size() * 9 / 10], 0.08) << "90th percentile";
-  EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
-
+  CheckObstacles(arrays, box_centre, box_size);
+  CheckHumanPoints(points, centres_at, body);
   obs.SpinUntil([&] { return obs.Diag("cloud", "clouds") > 50; }, std::chrono::seconds(3));
   EXPECT_GT(obs.Diag("cloud", "clouds"), 50);
   EXPECT_EQ(obs.Diag("cloud", "clouds_without_self_filter"), 0);

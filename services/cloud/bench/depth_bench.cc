@@ -130,8 +130,20 @@ void BM_CloudStage(benchmark::State& state) {
   state.counters["human_points"] = static_cast<double>(human) / static_cast<double>(std::max<std::size_t>(1, n));
 }
 
+// The obstacle pipeline alone on the same frames (no crop, self-filter,
+// tracking or human points): what the rest of the stage adds.
+void BM_PipelineOnly(benchmark::State& state) {
+  const Cell& cell = TheCell();
+  perception::SimulatedDepthCamera cam(cell.camera);
+  std::vector<cloud::Cloud> frames(kFrames);
+  for (int f = 0; f < kFrames; ++f) cam.Render(cell.scenes[static_cast<std::size_t>(f)], &frames[static_cast<std::size_t>(f)]);
+  cloud::ObstaclePipeline pipeline(cell.stage.pipeline);
+  Run(state, [&](int f) { benchmark::DoNotOptimize(pipeline.Process(frames[static_cast<std::size_t>(f)])); });
+}
+
 BENCHMARK(BM_SimulatedCamera)->Arg(1)->Arg(0)->Iterations(kFrames)->UseManualTime()->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_CloudStage)->Iterations(kFrames)->UseManualTime()->Unit(benchmark::kMillisecond);
+BENCHMARK(BM_PipelineOnly)->Iterations(kFrames)->UseManualTime()->Unit(benchmark::kMillisecond);
 
 }  // namespace
 
