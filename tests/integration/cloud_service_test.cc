@@ -19,6 +19,8 @@
 #include <map>
 #include <thread>
 
+#include "common/cloud_adapters.h"
+#include "iplan/cloud/cloud.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/framework/node.h"
 #include "test_node.h"
@@ -171,6 +173,55 @@ TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
   EXPECT_EQ(cloud->Wait(std::chrono::seconds(10)), 0) << cloud->Stderr();
   EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
   EXPECT_EQ(robot->Wait(std::chrono::seconds(10)), 0);
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+// perception's PCD replay publishes the files of a folder in name order, each
+// cloud point for point the file's (x, y, z, NaN where the file has NaN).
+TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
+  const int domain = UniqueDomain(45);
+  const std::string folder = std::string(IPLAN_SHARED_DIR) + "/data/pointclouds/mosd_learn";
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(folder))
+    if (e.path().extension() == ".pcd") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 4u);
+  std::vector<cloud::Cloud> truth;
+  for (std::size_t i = 0; i < 4; ++i) truth.push_back(cloud::LoadPcd(files[i]));
+  Observer obs(domain);
+  std::vector<int> which;  // index of the file each received cloud equals, -1 none
+  obs.t.node->Subscribe(framework::topics::DepthPoints(),
+                        std::function<void(const msg::PointCloud2&, SI)>([&](const msg::PointCloud2& m, SI) {
+                          cloud::Cloud c;
+                          if (services::FromPointCloud2(m, &c)) return;
+                          int match = -1;
+                          for (std::size_t k = 0; k < truth.size() && match < 0; ++k) {
+                            if (c.width != truth[k].width || c.height != truth[k].height) continue;
+                            bool same = true;
+                            for (std::size_t i = 0; i < c.size() && same; ++i) {
+                              const auto& a = c.points[i];
+                              const auto& b = truth[k].points[i];
+                              same = a.allFinite() ? a == b : !b.allFinite();
+                            }
+                            if (same) match = static_cast<int>(k);
+                          }
+                          which.push_back(match);
+                        }),
+                        framework::SubscribeOptions{false});
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-pcd-test-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
+                          {"--set", "perception.depth.provider=pcd", "--set", "perception.depth.pcd.path=" + folder, "--set",
+                           "perception.depth.rate_hz=4", "--set", "perception.depth.pcd.loop=false"});
+  ASSERT_TRUE(obs.SpinUntil([&] { return which.size() >= 3 && which.back() == 3; }, std::chrono::seconds(30)))
+      << which.size() << " clouds\n" << perception->Stderr();
+  // Every received cloud is one of the files, in order (best effort: one may be lost).
+  for (std::size_t i = 0; i < which.size(); ++i) {
+    EXPECT_GE(which[i], 0) << i;
+    if (i > 0) EXPECT_GT(which[i], which[i - 1]) << i;
+  }
+  perception->Signal(SIGTERM);
+  EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }
 
