@@ -34,7 +34,7 @@ using SI = const dds::SampleInfo&;
 const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 
 struct Observer {
-  explicit Observer(int domain) : t("observer", dds::Vendor::kCyclone, domain) {
+  explicit Observer(int domain, dds::Vendor vendor = dds::Vendor::kCyclone) : t("observer", vendor, domain) {
     framework::Node& n = *t.node;
     framework::SubscribeOptions any{false};
     n.Subscribe(framework::topics::Diagnostics(),
@@ -58,8 +58,8 @@ struct Observer {
 };
 
 std::unique_ptr<Process> Start(const std::string& exe, const std::string& cfg, int domain, const std::string& log,
-                               std::vector<std::string> extra = {}) {
-  std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", "cyclonedds", "--domain",
+                               std::vector<std::string> extra = {}, dds::Vendor vendor = dds::Vendor::kCyclone) {
+  std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", dds::ToString(vendor), "--domain",
                                    std::to_string(domain)};
   argv.insert(argv.end(), extra.begin(), extra.end());
   return std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, log);
@@ -119,15 +119,18 @@ void CheckHumanPoints(const std::vector<msg::HumanPoints>& points, const std::ve
   EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
 }
 
-TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
-  const int domain = UniqueDomain(41);
+class CloudPathTest : public ::testing::TestWithParam<dds::Vendor> {};
+
+TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
+  const dds::Vendor vendor = GetParam();
+  const int domain = UniqueDomain(vendor == dds::Vendor::kCyclone ? 41 : 42);
   const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-test-" + std::to_string(getpid()));
   std::filesystem::create_directories(dir);
   // A box left on the table, besides the cell's parts bin.
   const Eigen::Vector3d box_centre(0.75, -0.2, 0.075), box_size(0.15, 0.15, 0.15);
   const std::string box_file = (dir / "box.yaml").string();
   std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: [0.75, -0.2, 0.075], size: [0.15, 0.15, 0.15]}\n";
-  Observer obs(domain);
+  Observer obs(domain, vendor);
   std::vector<msg::ObstacleArray> arrays;
   const collision::HumanBodyModel body(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml"));
   Eigen::Matrix3Xd truth(3, body.num_joints());
@@ -153,13 +156,14 @@ TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
                 centres_at.push_back(c);
                 points.push_back(m);
               }), any);
-  auto robot = Start("iplan-robot-sim", "robot_sim.yaml", domain, (dir / "robot_sim").string());
+  auto robot = Start("iplan-robot-sim", "robot_sim.yaml", domain, (dir / "robot_sim").string(), {}, vendor);
   auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
                           {"--set", "perception.provider=synthetic", "--set", "perception.synthetic.start=loop", "--set",
                            "perception.publish_truth=true", "--set", "perception.depth.provider=simulated", "--set",
                            "perception.depth.rate_hz=10", "--set",
-                           "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"});
-  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string());
+                           "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"},
+                          vendor);
+  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string(), {}, vendor);
   ASSERT_TRUE(obs.SpinUntil([&] { return arrays.size() >= 60 && points.size() >= 60; }, std::chrono::seconds(90)))
       << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cloud->Stderr()
       << perception->Stderr();
@@ -175,6 +179,9 @@ TEST(CloudServiceTest, SimulatedCameraToObstaclesAndHumanPoints) {
   EXPECT_EQ(robot->Wait(std::chrono::seconds(10)), 0);
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }
+
+INSTANTIATE_TEST_SUITE_P(BothVendors, CloudPathTest, ::testing::Values(dds::Vendor::kCyclone, dds::Vendor::kFastDds),
+                         [](const ::testing::TestParamInfo<dds::Vendor>& i) { return dds::ToString(i.param); });
 
 // perception's PCD replay publishes the files of a folder in name order, each
 // cloud point for point the file's (x, y, z, NaN where the file has NaN).
