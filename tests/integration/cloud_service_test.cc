@@ -78,8 +78,8 @@ void CheckObstacles(const std::vector<msg::ObstacleArray>& arrays, const Eigen::
   EXPECT_EQ(last.header.frame_id, "world");
   const msg::Obstacle* box = Find(last, box_centre, 0.03);
   ASSERT_NE(box, nullptr) << "no obstacle within 3 cm of the box; " << last.obstacles.size() << " obstacles";
-  std::cout << "box centre error " << (Eigen::Vector3d(box->centre.x, box->centre.y, box->centre.z) - box_centre).norm()
-            << " m\n";
+  const Eigen::Vector3d error = Eigen::Vector3d(box->centre.x, box->centre.y, box->centre.z) - box_centre;
+  std::cout << "box centre error " << error.norm() << " m (x, y, z: " << error.transpose() << ")\n";
   for (int k = 0; k < 3; ++k) EXPECT_NEAR(2 * box->half_extents[static_cast<std::size_t>(k)], box_size[k], 0.03) << k;
   EXPECT_NE(Find(last, Eigen::Vector3d(0.55, 0.45, 0.1), 0.05), nullptr) << "parts bin not reported";
   int same_id = 0;
