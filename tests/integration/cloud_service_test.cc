@@ -232,6 +232,23 @@ TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
   if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
 }
 
+// Bad configurations are refused with exit code 2 and the key named.
+TEST(CloudServiceTest, BadConfigurationIsRefused) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"cloud.tracking.static_frames=0", "static_frames must be >= 1"},
+      {"cloud.tracking.bogus=1", "unknown key 'cloud.tracking.bogus'"},
+      {"cloud.camera.look_at=[0.45, 1.3, 1.1]", "key 'cloud.camera.look_at'"},
+      {"cloud.workspace_min=[0, 0]", "key 'cloud.workspace_min'"},
+      {"cloud.pipeline.stride=3", "is not supported; edit the file"},
+      {"cloud.robot=missing.yaml", "missing.yaml"},
+  };
+  for (const auto& [set, why] : cases) {
+    Process p({BinPath("iplan-cloud"), "--config", kConfig + "/cloud.yaml", "--check-config", "--set", set});
+    EXPECT_EQ(p.Wait(std::chrono::seconds(20)), 2) << set;
+    EXPECT_NE(p.Stderr().find(why), std::string::npos) << set << ":\n" << p.Stderr();
+  }
+}
+
 msg::PointCloud2 GoodCloud() {
   msg::PointCloud2 m;
   m.header.stamp = msg::Now();
