@@ -96,10 +96,6 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
   out->is_dense = dense;
 }
 
-}  // namespace iplan::services
-
-namespace iplan::services {
-
 Eigen::Isometry3d ReadCameraPose(core::ConfigSection camera) {
   auto three = core::Check<std::vector<double>>(
       [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; });

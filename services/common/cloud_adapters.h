@@ -1,4 +1,5 @@
-// sensor_msgs/PointCloud2 <-> iplan::cloud::Cloud. The framework's Check has
+// sensor_msgs/PointCloud2 <-> iplan::cloud::Cloud, and the camera settings
+// the depth providers and the cloud service read alike. The framework's Check has
 // already refused size mismatches (data vs row_step * height, point_step *
 // width vs row_step); here the field layout and the coordinates are checked,
 // so that a cloud the core reads is well-formed.
@@ -10,7 +11,12 @@
 #include <optional>
 #include <string>
 
+#include <Eigen/Geometry>
+
+#include "iplan/cloud/camera.h"
 #include "iplan/cloud/cloud.h"
+#include "iplan/cloud/noise.h"
+#include "iplan/core/config.h"
 #include "iplan/msg/types.h"
 
 namespace iplan::services {
@@ -29,16 +35,6 @@ std::optional<std::string> FromPointCloud2(const msg::PointCloud2& m, cloud::Clo
 /// point_step 12, little-endian, is_dense when every point is finite.
 void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id,
                    msg::PointCloud2* out);
-
-}  // namespace iplan::services
-
-#include <Eigen/Geometry>
-
-#include "iplan/cloud/camera.h"
-#include "iplan/cloud/noise.h"
-#include "iplan/core/config.h"
-
-namespace iplan::services {
 
 /// Reads a camera's pose from a `camera` section (`position`: [x, y, z] m in
 /// world, `look_at`: [x, y, z] m in world; see cloud::CameraPoseLookAt) and
