@@ -111,10 +111,15 @@ StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::
     c.centroid /= std::max(1, c.points);
     obs.push_back(c);
   }
-  const std::vector<int> track_of = tracker_.Update(obs, stamp_ns);
+  // Without the robot's pose the robot's own points are among the clusters
+  // and would merge with, and move, the tracks of real objects: such a
+  // frame does not update the tracker, and all its clusters count as human
+  // (cautious); the static obstacles already known stay published.
+  const bool track = !robot_ || out.self_filtered;
+  const std::vector<int> track_of = track ? tracker_.Update(obs, stamp_ns) : std::vector<int>(obs.size(), -1);
   std::vector<int> human;
   for (std::size_t c = 0; c < obs.size(); ++c) {
-    if (tracker_.IsHuman(tracker_.tracks()[static_cast<std::size_t>(track_of[c])])) {
+    if (!track || tracker_.IsHuman(tracker_.tracks()[static_cast<std::size_t>(track_of[c])])) {
       human.insert(human.end(), r.obstacles[c].indices.begin(), r.obstacles[c].indices.end());
     }
   }

@@ -76,7 +76,9 @@ class CloudStage {
 
   /// Processes one cloud (S frame; points outside the workspace are set to
   /// NaN in place). `q` (model order, rad / m) places the robot's spheres;
-  /// nullopt: no self-filter this frame. Never throws on cloud content.
+  /// nullopt: no self-filter this frame, and then (with a robot) the frame
+  /// does not update the tracking: every cluster is human, the known static
+  /// obstacles are output unchanged. Never throws on cloud content.
   StageOutput Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns);
 
  private:

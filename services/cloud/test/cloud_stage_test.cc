@@ -132,7 +132,44 @@ TEST(CloudStageTest, RobotSpheresAreFilteredGivenTheJointState) {
   const StageOutput without_q = unfiltered.Process(&copy, std::nullopt, 0);
   EXPECT_FALSE(without_q.self_filtered);
   EXPECT_EQ(without_q.clusters, 1);
-  EXPECT_FALSE(without_q.human.empty());  // pending counts as human: cautious
+  EXPECT_FALSE(without_q.human.empty());  // the robot counts as human: cautious
+}
+
+TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
+  // The robot's sphere beside a box on the table: 12 frames without the
+  // joint state, then with it. The box must settle as a static obstacle
+  // as if the unfiltered frames had not been (no merged track, no move).
+  collision::RobotModel robot;
+  robot.name = "ball";
+  robot.link_names = {"base"};
+  robot.link_parent_joint = {-1};
+  collision::CollisionSphere s;
+  s.link = 0;
+  s.p_LS = Eigen::Vector3d(0.6, 0.1, 0.25);  // on top of the box
+  s.radius = 0.06;
+  robot.spheres.push_back(s);
+  SimulatedDepthCamera cam = Camera();
+  DepthScene scene = Table();
+  const Eigen::Vector3d centre(0.6, 0.1, 0.1);
+  scene.boxes.push_back(Box(centre, {0.2, 0.3, 0.2}));
+  scene.spheres.push_back({s.p_LS, s.radius});
+  CloudStage stage(Params(), &robot);
+  cloud::Cloud c;
+  for (int f = 0; f < 12; ++f) {
+    cam.Render(scene, &c);
+    const StageOutput out = stage.Process(&c, std::nullopt, f * kFrameNs);
+    EXPECT_TRUE(out.obstacles.empty());
+    EXPECT_FALSE(out.human.empty());
+  }
+  StageOutput out;
+  for (int f = 12; f < 22; ++f) {
+    cam.Render(scene, &c);
+    out = stage.Process(&c, Eigen::VectorXd(0), f * kFrameNs);
+  }
+  ASSERT_EQ(out.obstacles.size(), 1u);
+  EXPECT_EQ(out.obstacles[0].first_seen_ns, 12 * kFrameNs);
+  EXPECT_LT((out.obstacles[0].centre - centre).norm(), 0.02);
+  EXPECT_TRUE(out.human.empty());
 }
 
 TEST(CloudStageTest, WorkspaceCropRemovesWhatIsOutside) {
