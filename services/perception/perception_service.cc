@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "core/skeleton_replay.h"
+#include "depth_source.h"
 #include "iplan/framework/service.h"
 #include "synthetic_config.h"
 
@@ -54,11 +55,12 @@ class PerceptionService : public framework::Service {
     skeleton_writer_ = &node.Advertise(framework::topics::HumanSkeleton());
     if (publish_truth_) truth_writer_ = &node.Advertise(framework::topics::HumanTruth());
     node.SetDiagnosticValue("provider", provider_);
-    return Result::Ok();
+    return depth_.Configure(config.Section("depth"), node);  // the depth camera, if any
   }
 
   Result OnActivate(Node& node) override {
     start_ = std::chrono::system_clock::now();
+    depth_.Activate(node, [this] { return person_ ? person_->TruePose(Seconds()) : std::vector<JointSample>{}; });
     if (replay_) {
       start_ns_ = msg::ToNanoseconds(msg::Now());
       timer_ = node.AddTimer(kReplayPoll, [this, &node] { ReplayTick(node); });
@@ -70,6 +72,7 @@ class PerceptionService : public framework::Service {
 
   Result OnDeactivate(Node& node) override {
     node.CancelTimer(timer_);
+    depth_.Deactivate(node);
     return Result::Ok();
   }
 
@@ -213,6 +216,7 @@ class PerceptionService : public framework::Service {
   int64_t start_ns_ = 0;
   std::string sequence_;
   bool announced_end_ = false;
+  DepthSource depth_;
 };
 
 }  // namespace

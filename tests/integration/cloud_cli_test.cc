@@ -92,7 +92,7 @@ TEST_F(CloudCli, JsonLineAndLabelsAgree) {
 
 TEST_F(CloudCli, TextOutputAndConfigFileOfTheRepository) {
   std::string out, err;
-  ASSERT_EQ(Run({"obstacles", "--pcd", kScan, "--config", std::string(IPLAN_SOURCE_DIR) + "/config/cloud.yaml"},
+  ASSERT_EQ(Run({"obstacles", "--pcd", kScan, "--config", std::string(IPLAN_SOURCE_DIR) + "/config/cloud_pipeline.yaml"},
                 &out, &err),
             0)
       << err;

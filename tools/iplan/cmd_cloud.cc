@@ -153,7 +153,7 @@ const bool kRegistered = iplan::cli::RegisterCommand("cloud", [](CLI::App& app) 
   obs->add_option("--labels-out", o->labels_out,
                   "write one label per input point, file order, one per line: 0 removed or invalid, "
                   "1 table, k >= 2 obstacle k-1");
-  obs->add_option("--config", o->config, "pipeline parameters YAML (config/cloud.yaml; default: built-in)");
+  obs->add_option("--config", o->config, "pipeline parameters YAML (config/cloud_pipeline.yaml; default: built-in)");
   obs->callback([o] { iplan::cli::SetExitCode(RunObstacles(*o)); });
 
   auto e = std::make_shared<EvalOptions>();

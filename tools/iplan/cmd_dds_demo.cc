@@ -55,12 +55,17 @@ struct DemoOptions {
   /// planner ignores the person, trajopt.use_prediction false; collision
   /// risk still gets the model's prediction).
   std::string predictor = "model";
+  /// "skeleton": the skeleton stream only; "depth": also the simulated depth
+  /// camera (perception) and the cloud service.
+  std::string sensor = "skeleton";
 };
 
 // The services in start order (executable suffix, config name).
 const std::vector<std::pair<std::string, std::string>> kServices = {
     {"robot-sim", "robot_sim"},           {"perception", "perception"}, {"intent", "intent"},
     {"collision-risk", "collision_risk"}, {"trajopt", "trajopt"},       {"supervisor", "supervisor"}};
+// --sensor depth adds the cloud service (after perception, its source).
+const std::pair<std::string, std::string> kCloudService = {"cloud", "cloud"};
 
 struct Episode {
   int number = 0;
@@ -337,6 +342,9 @@ class DemoRun {
     if (name == "trajopt" && o_.predictor == "none") argv.insert(argv.end(), {"--set", "trajopt.use_prediction=false"});
     if (name == "perception") argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set",
                                                        "perception.publish_truth=true"});
+    if (name == "perception" && o_.sensor == "depth") {
+      argv.insert(argv.end(), {"--set", "perception.depth.provider=simulated"});
+    }
     if (name == "supervisor") {
       argv.insert(argv.end(), {"--set", "supervisor.max_episodes=" + std::to_string(o_.episodes)});
       if (!o_.keep_learning) argv.insert(argv.end(), {"--set", "supervisor.q_table=" + state_dir_ + "/q_table.bin"});
@@ -358,7 +366,9 @@ class DemoRun {
     }
     t0_ = Clock::now();
     std::cout << "  services:";
-    for (const auto& [exe, name] : kServices) {
+    services_ = kServices;
+    if (o_.sensor == "depth") services_.insert(services_.begin() + 2, kCloudService);
+    for (const auto& [exe, name] : services_) {
       try {
         procs_.push_back(std::make_unique<core::Process>(ServiceArguments(exe, name), std::map<std::string, std::string>{},
                                                          false, state_dir_ + "/" + name));
@@ -387,7 +397,7 @@ class DemoRun {
       for (const auto& e : mon.TakeEvents()) std::cout << "  [" << std::setw(4) << Fixed(mon.Now(), 0) << " s] " << e << std::endl;
       if (mon.completed_episodes() >= o_.episodes) break;
       for (size_t i = 0; i < procs_.size() && failure_.empty(); ++i) {
-        if (!procs_[i]->Running()) failure_ = "iplan-" + kServices[i].first + " exited unexpectedly:\n" + Tail(procs_[i]->Stderr(), 15);
+        if (!procs_[i]->Running()) failure_ = "iplan-" + services_[i].first + " exited unexpectedly:\n" + Tail(procs_[i]->Stderr(), 15);
       }
       if (!failure_.empty()) break;
       if (mon.Now() > o_.timeout) {
@@ -410,7 +420,7 @@ class DemoRun {
     for (size_t i = 0; i < procs_.size(); ++i) {
       const auto rc = procs_[i]->Wait(10s);
       exit_codes_.push_back(rc ? *rc : -1);
-      if (rc && *rc != 0 && failure_.empty()) failure_ = "iplan-" + kServices[i].first + " exited with " + std::to_string(*rc);
+      if (rc && *rc != 0 && failure_.empty()) failure_ = "iplan-" + services_[i].first + " exited with " + std::to_string(*rc);
     }
     if (recorder_) {
       if (auto err = StopRecorder(*recorder_); err && failure_.empty()) failure_ = *err;
@@ -453,6 +463,14 @@ class DemoRun {
     std::cout << "    stages p50/p99: intent " << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
               << " ms, prediction to planning " << Fixed(queue_lat.p50, 1) << "/" << Fixed(queue_lat.p99, 1)
               << " ms, planning " << Fixed(planning_lat.p50, 1) << "/" << Fixed(planning_lat.p99, 1) << " ms\n";
+    if (o_.sensor == "depth") {
+      std::cout << "  depth path                    " << Fixed(mon.DiagNumber("cloud", "clouds", 0), 0)
+                << " clouds processed (p50 " << Fixed(1e3 * mon.DiagNumber("cloud", "cycle_time_p50_s", 0), 1) << " ms, p99 "
+                << Fixed(1e3 * mon.DiagNumber("cloud", "cycle_time_p99_s", 0), 1) << " ms per cloud), last: "
+                << Fixed(mon.DiagNumber("cloud", "obstacles", 0), 0) << " static obstacles, "
+                << Fixed(mon.DiagNumber("cloud", "human_points", 0), 0) << " human points; "
+                << Fixed(mon.DiagNumber("cloud", "clouds_without_self_filter", 0), 0) << " clouds without self-filter\n";
+    }
     for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
     std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
     for (const auto& [n, e] : mon.episodes()) {
@@ -525,6 +543,7 @@ class DemoRun {
   std::unique_ptr<core::Process> recorder_;
   Clock::time_point t0_;
   std::vector<std::unique_ptr<core::Process>> procs_;
+  std::vector<std::pair<std::string, std::string>> services_;  // (executable suffix, config name), in start order
   std::vector<std::string> names_;
   std::vector<int> exit_codes_;
   std::string failure_;
@@ -553,6 +572,11 @@ void Register(CLI::App& app) {
   d->add_flag("--keep-learning", o.keep_learning,
               "use the Q-table of supervisor.yaml (learning carries over between runs) instead of a fresh one");
   d->add_flag("--retrain", o.retrain, "train the intent model again even if a cached one fits");
+  d->add_option("--sensor", o.sensor,
+                 "skeleton: the skeleton stream; depth: also the simulated depth camera and the cloud service "
+                 "(obstacles and human points, docs/perception-clouds.md)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"skeleton", "depth"}));
   d->add_option("--predictor", o.predictor,
                  "prediction the cell plans with: model (the trained intent model), constant-velocity or "
                  "constant-position (kinematic baselines from the intent service), none (the planner ignores "

@@ -365,8 +365,8 @@ TEST(LoadCloudParams, StrictKeysTypesAndValues) {
 
 TEST(CloudParams, DefaultsAreValidAndConfigFileWritesThemOut) {
   EXPECT_EQ(CloudParams{}.Validate(), "");
-  // config/cloud.yaml documents the defaults: every key, every value.
-  const CloudParams file = LoadCloudParams(std::string(IPLAN_SOURCE_DIR) + "/config/cloud.yaml");
+  // config/cloud_pipeline.yaml documents the defaults: every key, every value.
+  const CloudParams file = LoadCloudParams(std::string(IPLAN_SOURCE_DIR) + "/config/cloud_pipeline.yaml");
   const CloudParams d;
   EXPECT_EQ(file.crop_min, d.crop_min);
   EXPECT_EQ(file.crop_max, d.crop_max);

@@ -13,7 +13,10 @@ std::vector<dds::EnclaveGrant> CellEnclaves() {
   // publishes its diagnostics.
   const std::string diag = Diagnostics().name;
   std::vector<dds::EnclaveGrant> g = {
-      {EnclaveName("perception"), {HumanSkeleton().name, HumanTruth().name, diag}, {TaskCommand().name}},
+      {EnclaveName("perception"),
+       {HumanSkeleton().name, HumanTruth().name, DepthPoints().name, diag},
+       {TaskCommand().name, JointStates().name}},
+      {EnclaveName("cloud"), {Obstacles().name, HumanPoints().name, diag}, {DepthPoints().name, JointStates().name}},
       {EnclaveName("intent"), {ActionBelief().name, HumanPrediction().name, diag}, {HumanSkeleton().name}},
       {EnclaveName("collision_risk"),
        {CollisionRisk().name, SafetyPermit().name, diag},

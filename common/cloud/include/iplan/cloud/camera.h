@@ -1,0 +1,41 @@
+// A pinhole depth camera's geometry: intrinsics and its pose in the cell,
+// shared by the simulated camera (perception) and the cloud stage, so both
+// name the same optical frame the same way.
+//
+// Frames: W the cell frame (`world`, z up), S the camera's optical frame
+// (x right, y down, z along the view). Metres, pixels where named.
+#pragma once
+
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+#include <Eigen/Geometry>
+
+namespace iplan::cloud {
+
+/// Pinhole intrinsics of a depth image (no distortion).
+struct CameraIntrinsics {
+  int width = 640;    ///< pixels
+  int height = 480;   ///< pixels
+  double fx = 525.0;  ///< focal length, pixels (Kinect v1 at 640x480)
+  double fy = 525.0;  ///< pixels
+  double cx = 319.5;  ///< principal point, pixels
+  double cy = 239.5;  ///< pixels
+
+  /// Empty when valid, else the first problem ("fx must be > 0, got 0").
+  std::string Validate() const;
+};
+
+/// X_WS of a camera at p_WC looking at p_WT, with the image's "up" as close
+/// to +z of W as the view allows (x_S = z_S x z_W normalised, y_S = z_S x
+/// x_S). Throws
+/// std::invalid_argument when the points coincide or the view is vertical.
+Eigen::Isometry3d CameraPoseLookAt(const Eigen::Vector3d& p_WC, const Eigen::Vector3d& p_WT);
+
+/// Voxel-grid reduction (PCL VoxelGrid): the centroid of the points in each
+/// occupied cube of edge `leaf` (m, > 0) of a grid aligned with the points'
+/// frame; points must be finite. Order: PCL's (by voxel index). Allocates.
+std::vector<Eigen::Vector3f> VoxelCentroids(const std::vector<Eigen::Vector3f>& points, float leaf);
+
+}  // namespace iplan::cloud

@@ -1,0 +1,186 @@
+// iplan-cloud: the depth camera's clouds (/iplan/depth/points, sensor frame)
+// into typed outputs in the cell frame: static unknown obstacles as boxes
+// (/iplan/obstacles, stable ids) and the points of moving objects, people,
+// with the sensor's noise covariance (/iplan/human/points). The stage
+// (core/cloud_stage.h): workspace crop, robot self-filter from
+// /joint_states and the robot's collision spheres, table plane,
+// segmentation, tracking over frames.
+#include <chrono>
+#include <cstdlib>
+#include <deque>
+#include <optional>
+
+#include "common/cloud_adapters.h"
+#include "core/cloud_stage.h"
+#include "iplan/cell/joint_trajectory.h"
+#include "iplan/core/params.h"
+#include "iplan/framework/service.h"
+#include "iplan/msg/check.h"
+
+namespace iplan::cloud_service {
+namespace {
+
+using framework::ConfigSection;
+using framework::Node;
+using framework::Result;
+using SI = const dds::SampleInfo&;
+
+class CloudService : public framework::Service {
+ public:
+  Result OnConfigure(ConfigSection& config, Node& node) override {
+    CloudStageParams p;
+    std::string pipeline_file, robot_file = "robots/panda.yaml";
+    const core::Overrides overrides = config.ReadParamsFile("pipeline", "cloud_pipeline.yaml", &pipeline_file);
+    config.Read("robot", &robot_file);
+    p.X_WS = services::ReadCameraPose(config.Section("camera"));
+    p.noise = services::ReadDepthNoise(config.Section("noise"));
+    ReadBox(config, &p);
+    config.Read("human_voxel", &p.human_voxel, framework::NonNegative<double>());
+    config.Read("joint_state_timeout", &joint_state_timeout_, framework::Positive<double>());
+    config.Read("frame_id", &frame_id_);
+    core::ReadParams(config.Section("tracking"), &p.tracking);
+    human_voxel_ = p.human_voxel;
+    if (!config.Problems().empty()) return Result::Ok();  // reported by the configuration check
+    try {
+      if (!overrides.empty()) throw std::runtime_error("--set into " + pipeline_file + " is not supported; edit the file");
+      p.pipeline = cloud::LoadCloudParams(pipeline_file);
+      std::optional<collision::RobotModel> robot;
+      if (!robot_file.empty()) robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));
+      stage_ = std::make_unique<CloudStage>(p, robot ? &*robot : nullptr);
+    } catch (const std::exception& e) {
+      return Result::Fail(config.file() + ": key 'cloud': " + e.what());
+    }
+    joint_names_ = stage_->JointNames();
+    obstacles_writer_ = &node.Advertise(framework::topics::Obstacles());
+    human_writer_ = &node.Advertise(framework::topics::HumanPoints());
+    node.Subscribe(framework::topics::JointStates(),
+                   std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {
+                     OnJointState(node, m);
+                   }));
+    node.Subscribe(framework::topics::DepthPoints(),
+                   std::function<void(const msg::PointCloud2&, SI)>([this, &node](const msg::PointCloud2& m, SI) {
+                     OnCloud(node, m);
+                   }));
+    node.SetDiagnosticValue("self_filter", joint_names_.empty() ? "off (no robot)" : "waiting for joint states");
+    return Result::Ok();
+  }
+
+  Result OnActivate(Node&) override { return Result::Ok(); }
+  Result OnDeactivate(Node&) override { return Result::Ok(); }
+
+ private:
+  static void ReadBox(ConfigSection& config, CloudStageParams* p) {
+    auto three = framework::Check<std::vector<double>>(
+        [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; });
+    std::vector<double> lo(p->workspace_min.data(), p->workspace_min.data() + 3);
+    std::vector<double> hi(p->workspace_max.data(), p->workspace_max.data() + 3);
+    if (config.Read("workspace_min", &lo, three)) p->workspace_min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
+    if (config.Read("workspace_max", &hi, three)) p->workspace_max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
+  }
+
+  void OnJointState(Node& node, const msg::JointState& m) {
+    if (joint_names_.empty()) return;
+    std::vector<int> index;
+    if (node.CountRejection("joint_states", cell::MapJointNames(m.name, joint_names_, &index))) return;
+    if (m.position.size() != m.name.size()) {
+      node.CountRejection("joint_states", std::string("position and name sizes differ"));
+      return;
+    }
+    Eigen::VectorXd q(static_cast<Eigen::Index>(index.size()));
+    for (std::size_t k = 0; k < index.size(); ++k) q[static_cast<Eigen::Index>(k)] = m.position[static_cast<std::size_t>(index[k])];
+    // A second of history, so that a cloud processed late still finds the
+    // robot's pose of its own time.
+    history_.push_back({msg::ToNanoseconds(m.header.stamp), q});
+    while (history_.size() > 1 && history_.back().first - history_.front().first > 1'000'000'000) history_.pop_front();
+  }
+
+  // The joint state nearest the cloud's stamp, if within joint_state_timeout.
+  std::optional<Eigen::VectorXd> PoseAt(int64_t stamp) const {
+    const std::pair<int64_t, Eigen::VectorXd>* best = nullptr;
+    for (const auto& h : history_) {
+      if (!best || std::llabs(h.first - stamp) < std::llabs(best->first - stamp)) best = &h;
+    }
+    if (!best || static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) return std::nullopt;
+    return best->second;
+  }
+
+  void OnCloud(Node& node, const msg::PointCloud2& m) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (node.CountRejection("depth_points", services::FromPointCloud2(m, &cloud_))) return;
+    const int64_t stamp = msg::ToNanoseconds(m.header.stamp);
+    // The robot's pose when the cloud was taken: the nearest joint state, if
+    // near enough; otherwise no self-filter (the robot's own points then
+    // count as a person: cautious, and reported).
+    const std::optional<Eigen::VectorXd> q = PoseAt(stamp);
+    if (!joint_names_.empty() && !q) ++unfiltered_;
+    const StageOutput out = stage_->Process(&cloud_, q, stamp);
+    Publish(node, m.header.stamp, out);
+    ++processed_;
+    node.SetDiagnosticValue("clouds", std::to_string(processed_));
+    node.SetDiagnosticValue("obstacles", std::to_string(out.obstacles.size()));
+    node.SetDiagnosticValue("human_points", std::to_string(out.human.size()));
+    node.SetDiagnosticValue("clusters", std::to_string(out.clusters));
+    node.SetDiagnosticValue("table", out.table_found ? std::to_string(out.table_points) + " points" : "not found");
+    node.SetDiagnosticValue("clouds_without_self_filter", std::to_string(unfiltered_));
+    if (!joint_names_.empty()) node.SetDiagnosticValue("self_filter", out.self_filtered ? "on" : "off (no recent joint state)");
+    node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+
+  void Publish(Node& node, const msg::Time& stamp, const StageOutput& out) {
+    obstacles_.header.stamp = stamp;
+    obstacles_.header.frame_id = frame_id_;
+    obstacles_.obstacles.clear();
+    for (const StaticObstacle& s : out.obstacles) {
+      if (obstacles_.obstacles.size() >= msg::Limits::kObstacles) break;
+      msg::Obstacle o;
+      o.id = s.id;
+      o.centre.x = s.centre.x();
+      o.centre.y = s.centre.y();
+      o.centre.z = s.centre.z();
+      o.half_extents = {s.half_extents.x(), s.half_extents.y(), s.half_extents.z()};
+      o.points = static_cast<uint32_t>(s.points);
+      o.first_seen = msg::TimeFromNanoseconds(s.first_seen_ns);
+      obstacles_.obstacles.push_back(o);
+    }
+    human_.header = obstacles_.header;
+    human_.voxel_size = human_voxel_;
+    human_.points.clear();
+    for (const HumanPoint& h : out.human) {
+      if (human_.points.size() >= msg::Limits::kHumanPoints) break;
+      msg::PointGaussian g;
+      g.mean.x = h.mean.x();
+      g.mean.y = h.mean.y();
+      g.mean.z = h.mean.z();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) g.covariance[static_cast<std::size_t>(3 * r + c)] = h.covariance(r, c);
+      human_.points.push_back(g);
+    }
+    std::string err;
+    if (!obstacles_writer_->Write(obstacles_, &err)) node.log().warn("obstacles not published: {}", err);
+    if (!human_writer_->Write(human_, &err)) node.log().warn("human points not published: {}", err);
+  }
+
+  std::unique_ptr<CloudStage> stage_;
+  std::vector<std::string> joint_names_;
+  std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
+  double joint_state_timeout_ = 0.2;
+  double human_voxel_ = 0.03;
+  std::string frame_id_ = "world";
+  cloud::Cloud cloud_;
+  msg::ObstacleArray obstacles_;
+  msg::HumanPoints human_;
+  dds::Writer<msg::ObstacleArray>* obstacles_writer_ = nullptr;
+  dds::Writer<msg::HumanPoints>* human_writer_ = nullptr;
+  uint64_t processed_ = 0, unfiltered_ = 0;
+};
+
+}  // namespace
+}  // namespace iplan::cloud_service
+
+int main(int argc, char** argv) {
+  return iplan::framework::RunService(
+      argc, argv,
+      {"cloud", "depth-camera clouds into static obstacles and the person's points (crop, self-filter, table, "
+                "segmentation, tracking)"},
+      [] { return std::make_unique<iplan::cloud_service::CloudService>(); });
+}

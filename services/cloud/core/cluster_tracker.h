@@ -1,0 +1,88 @@
+// Tracking the depth camera's clusters over frames, to tell static unknown
+// objects (a box left on the table) from moving ones (a person): a cluster
+// whose centroid stays within `static_motion` of where it settled for
+// `static_frames` frames is static; one that moves, or one as large as a
+// person, is human. Pure algorithm, no DDS types.
+//
+// Frame: the cell frame W (`world`), metres; stamps in ns (wall clock).
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include <Eigen/Core>
+
+#include "iplan/core/name_value.h"
+
+namespace iplan::cloud_service {
+
+struct TrackerParams {
+  int static_frames = 10;        ///< frames a cluster must stay put to become a static obstacle
+  double static_motion = 0.03;   ///< m the centroid may wander from where it settled and still be "put"
+  double match_distance = 0.15;  ///< m, farthest centroid-to-centroid match between frames
+  int lost_frames = 15;          ///< frames a track outlives its last sighting
+  double person_extent = 0.5;    ///< m; a cluster with an edge this long is a person at once
+  bool pending_as_human = true;  ///< clusters not yet classified count as human (the cautious choice)
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(static_frames, "frames a cluster must stay put to become a static obstacle"));
+    a->Visit(IPLAN_NVP(static_motion, "m the centroid may wander and still be put"));
+    a->Visit(IPLAN_NVP(match_distance, "m, farthest centroid match between frames"));
+    a->Visit(IPLAN_NVP(lost_frames, "frames a track outlives its last sighting"));
+    a->Visit(IPLAN_NVP(person_extent, "m; a cluster with an edge this long is a person at once"));
+    a->Visit(IPLAN_NVP(pending_as_human, "clusters not yet classified count as human"));
+  }
+  /// Empty when valid, else the first problem.
+  std::string Validate() const;
+};
+
+/// One cluster of one frame, axis-aligned in W.
+struct ClusterObservation {
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< m, mean of the points
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   ///< m
+  Eigen::Vector3d box_max = Eigen::Vector3d::Zero();   ///< m
+  int points = 0;
+};
+
+enum class TrackClass { kPending, kStatic, kHuman };
+
+struct Track {
+  uint32_t id = 0;  ///< >= 1, never reused
+  TrackClass cls = TrackClass::kPending;
+  ClusterObservation last;             ///< the latest sighting
+  Eigen::Vector3d anchor = Eigen::Vector3d::Zero();  ///< m, where the centroid settled
+  Eigen::Vector3d mean_min = Eigen::Vector3d::Zero();  ///< m, box averaged since it settled
+  Eigen::Vector3d mean_max = Eigen::Vector3d::Zero();
+  int still = 0;             ///< frames since it settled at `anchor`
+  int unseen = 0;            ///< frames since the last sighting
+  int64_t first_seen_ns = 0;
+};
+
+class ClusterTracker {
+ public:
+  /// Throws std::invalid_argument when params.Validate() fails.
+  explicit ClusterTracker(const TrackerParams& params);
+
+  /// One frame: matches the observations to the tracks (nearest centroids
+  /// first, within match_distance), starts tracks for the rest, ages and
+  /// drops unseen ones. Returns, per observation, the index into tracks()
+  /// of its track (valid until the next Update).
+  std::vector<int> Update(const std::vector<ClusterObservation>& clusters, int64_t stamp_ns);
+
+  const std::vector<Track>& tracks() const { return tracks_; }
+  /// True when the observation's track counts as human this frame.
+  bool IsHuman(const Track& t) const {
+    return t.cls == TrackClass::kHuman || (t.cls == TrackClass::kPending && params_.pending_as_human);
+  }
+
+ private:
+  void Observe(Track* t, const ClusterObservation& o) const;
+
+  TrackerParams params_;
+  std::vector<Track> tracks_;
+  uint32_t next_id_ = 1;
+};
+
+}  // namespace iplan::cloud_service

@@ -1,0 +1,228 @@
+// The cloud service's stage on frames of the simulated depth camera: a box
+// on the table becomes one static obstacle (stable id, centre and size
+// right), a moving person-sized body becomes human points near its truth,
+// the robot's own spheres are filtered from the joint state, the table is
+// removed. And the tracker on its own: settle, move, lose.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include <Eigen/Eigenvalues>
+
+#include "core/cloud_stage.h"
+#include "core/depth_camera.h"
+#include "iplan/cloud/camera.h"
+
+namespace iplan::cloud_service {
+namespace {
+
+using perception::DepthScene;
+using perception::SimulatedDepthCamera;
+
+constexpr int64_t kFrameNs = 33'333'333;
+
+const Eigen::Isometry3d kCamera = cloud::CameraPoseLookAt({0.45, 1.3, 1.1}, {0.6, 0.0, 0.1});
+
+CloudStageParams Params() {
+  CloudStageParams p;
+  p.X_WS = kCamera;
+  p.workspace_min = Eigen::Vector3d(-0.3, -0.6, -0.1);
+  p.workspace_max = Eigen::Vector3d(1.8, 0.8, 1.4);
+  return p;
+}
+
+DepthScene::Box Box(const Eigen::Vector3d& centre, const Eigen::Vector3d& size, double yaw = 0) {
+  DepthScene::Box b;
+  b.X_WO = Eigen::Translation3d(centre) * Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ());
+  b.size = size;
+  return b;
+}
+
+DepthScene Table() {
+  DepthScene s;
+  s.boxes.push_back(Box({0.45, 0.0, -0.025}, {1.2, 0.9, 0.05}));
+  return s;
+}
+
+SimulatedDepthCamera Camera() {
+  perception::DepthCameraParams p;
+  p.X_WS = kCamera;
+  p.seed = 3;
+  return SimulatedDepthCamera(p);
+}
+
+TEST(CloudStageTest, BoxOnTheTableIsOneStaticObstacleWithStableId) {
+  SimulatedDepthCamera cam = Camera();
+  DepthScene scene = Table();
+  const Eigen::Vector3d centre(0.6, 0.1, 0.1), size(0.2, 0.3, 0.2);
+  scene.boxes.push_back(Box(centre, size));
+  CloudStage stage(Params(), nullptr);
+  cloud::Cloud c;
+  uint32_t id = 0;
+  for (int f = 0; f < 15; ++f) {
+    cam.Render(scene, &c);
+    const StageOutput out = stage.Process(&c, std::nullopt, 1000 + f * kFrameNs);
+    EXPECT_TRUE(out.table_found);
+    EXPECT_GT(out.table_points, 50000);
+    if (f < 9) {  // static_frames = 10: pending, counted as human points meanwhile
+      EXPECT_TRUE(out.obstacles.empty()) << "frame " << f;
+      EXPECT_FALSE(out.human.empty());
+      continue;
+    }
+    ASSERT_EQ(out.obstacles.size(), 1u) << "frame " << f;
+    EXPECT_TRUE(out.human.empty()) << "frame " << f;
+    const StaticObstacle& o = out.obstacles[0];
+    if (id == 0) id = o.id;
+    EXPECT_EQ(o.id, id);
+    EXPECT_EQ(o.first_seen_ns, 1000);
+    // Centre within 2 cm, edges within 3 cm (the bottom 7 mm are table band).
+    EXPECT_LT((o.centre - centre).norm(), 0.02) << o.centre.transpose();
+    EXPECT_LT(((2 * o.half_extents) - size).cwiseAbs().maxCoeff(), 0.03) << o.half_extents.transpose();
+  }
+}
+
+TEST(CloudStageTest, MovingPersonIsHumanPointsNearTheTruth) {
+  SimulatedDepthCamera cam = Camera();
+  CloudStage stage(Params(), nullptr);
+  cloud::Cloud c;
+  for (int f = 0; f < 20; ++f) {
+    DepthScene scene = Table();
+    // A torso-and-head column of spheres (0.6 m tall) drifting along y at 0.3 m/s.
+    const double y = -0.2 + 0.01 * f;
+    for (int k = 0; k < 4; ++k) scene.spheres.push_back({Eigen::Vector3d(1.1, y, 0.15 + 0.15 * k), 0.12});
+    cam.Render(scene, &c);
+    const StageOutput out = stage.Process(&c, std::nullopt, f * kFrameNs);
+    EXPECT_TRUE(out.obstacles.empty()) << "frame " << f;
+    ASSERT_GT(out.human.size(), 50u) << "frame " << f;
+    for (const HumanPoint& h : out.human) {
+      double surface = 1e9;
+      for (const auto& s : scene.spheres) surface = std::min(surface, (h.mean - s.centre).norm() - s.radius);
+      EXPECT_LT(std::abs(surface), 0.03);  // a 3 cm voxel's centroid near the surface
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h.covariance);
+      EXPECT_GT(eig.eigenvalues().minCoeff(), 0);
+      EXPECT_LT(std::sqrt(eig.eigenvalues().maxCoeff()), 0.01);  // a few mm at 1.5 m
+    }
+  }
+}
+
+TEST(CloudStageTest, RobotSpheresAreFilteredGivenTheJointState) {
+  // A one-link "robot": a sphere on a fixed base, from a minimal model.
+  collision::RobotModel robot;
+  robot.name = "ball";
+  robot.link_names = {"base"};
+  robot.link_parent_joint = {-1};
+  robot.nq = 0;
+  collision::CollisionSphere s;
+  s.link = 0;
+  s.p_LS = Eigen::Vector3d(0.4, -0.2, 0.3);
+  s.radius = 0.12;
+  robot.spheres.push_back(s);
+  SimulatedDepthCamera cam = Camera();
+  DepthScene scene = Table();
+  scene.spheres.push_back({s.p_LS, s.radius});
+  cloud::Cloud c;
+  CloudStage filtered(Params(), &robot), unfiltered(Params(), &robot);
+  cam.Render(scene, &c);
+  cloud::Cloud copy = c;
+  const StageOutput with_q = filtered.Process(&c, Eigen::VectorXd(0), 0);
+  EXPECT_TRUE(with_q.self_filtered);
+  EXPECT_EQ(with_q.clusters, 0);
+  EXPECT_TRUE(with_q.human.empty());
+  const StageOutput without_q = unfiltered.Process(&copy, std::nullopt, 0);
+  EXPECT_FALSE(without_q.self_filtered);
+  EXPECT_EQ(without_q.clusters, 1);
+  EXPECT_FALSE(without_q.human.empty());  // the robot counts as human: cautious
+}
+
+TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
+  // The robot's sphere beside a box on the table: 12 frames without the
+  // joint state, then with it. The box must settle as a static obstacle
+  // as if the unfiltered frames had not been (no merged track, no move).
+  collision::RobotModel robot;
+  robot.name = "ball";
+  robot.link_names = {"base"};
+  robot.link_parent_joint = {-1};
+  collision::CollisionSphere s;
+  s.link = 0;
+  s.p_LS = Eigen::Vector3d(0.6, 0.1, 0.25);  // on top of the box
+  s.radius = 0.06;
+  robot.spheres.push_back(s);
+  SimulatedDepthCamera cam = Camera();
+  DepthScene scene = Table();
+  const Eigen::Vector3d centre(0.6, 0.1, 0.1);
+  scene.boxes.push_back(Box(centre, {0.2, 0.3, 0.2}));
+  scene.spheres.push_back({s.p_LS, s.radius});
+  CloudStage stage(Params(), &robot);
+  cloud::Cloud c;
+  for (int f = 0; f < 12; ++f) {
+    cam.Render(scene, &c);
+    const StageOutput out = stage.Process(&c, std::nullopt, f * kFrameNs);
+    EXPECT_TRUE(out.obstacles.empty());
+    EXPECT_FALSE(out.human.empty());
+  }
+  StageOutput out;
+  for (int f = 12; f < 22; ++f) {
+    cam.Render(scene, &c);
+    out = stage.Process(&c, Eigen::VectorXd(0), f * kFrameNs);
+  }
+  ASSERT_EQ(out.obstacles.size(), 1u);
+  EXPECT_EQ(out.obstacles[0].first_seen_ns, 12 * kFrameNs);
+  EXPECT_LT((out.obstacles[0].centre - centre).norm(), 0.02);
+  EXPECT_TRUE(out.human.empty());
+}
+
+TEST(CloudStageTest, WorkspaceCropRemovesWhatIsOutside) {
+  SimulatedDepthCamera cam = Camera();
+  DepthScene scene = Table();
+  scene.boxes.push_back(Box({0.6, 0.1, 0.1}, {0.2, 0.2, 0.2}));
+  CloudStageParams p = Params();
+  p.workspace_max.x() = 0.4;  // the box is beyond
+  CloudStage stage(p, nullptr);
+  cloud::Cloud c;
+  cam.Render(scene, &c);
+  const StageOutput out = stage.Process(&c, std::nullopt, 0);
+  EXPECT_GT(out.cropped_points, 10000);
+  EXPECT_EQ(out.clusters, 0);
+}
+
+ClusterObservation Obs(const Eigen::Vector3d& c, double half = 0.05) {
+  ClusterObservation o;
+  o.centroid = c;
+  o.box_min = c.array() - half;
+  o.box_max = c.array() + half;
+  o.points = 1000;
+  return o;
+}
+
+TEST(ClusterTrackerTest, SettlesMovesAndIsLost) {
+  TrackerParams p;
+  p.static_frames = 3;
+  p.lost_frames = 2;
+  ClusterTracker t(p);
+  // Frames 1-2 pending, frame 3 static.
+  for (int f = 0; f < 3; ++f) {
+    const auto idx = t.Update({Obs({0.5, 0, 0.1})}, f);
+    ASSERT_EQ(t.tracks().size(), 1u);
+    EXPECT_EQ(t.tracks()[0].cls, f < 2 ? TrackClass::kPending : TrackClass::kStatic) << f;
+    EXPECT_EQ(idx[0], 0);
+  }
+  EXPECT_EQ(t.tracks()[0].id, 1u);
+  EXPECT_EQ(t.tracks()[0].first_seen_ns, 0);
+  // It moves 5 cm: a person (carried), same id.
+  t.Update({Obs({0.55, 0, 0.1})}, 3);
+  EXPECT_EQ(t.tracks()[0].cls, TrackClass::kHuman);
+  EXPECT_EQ(t.tracks()[0].id, 1u);
+  // A second cluster far away is a new track; a person-sized one is human at once.
+  t.Update({Obs({0.55, 0, 0.1}), Obs({1.5, 0, 0.3}, 0.3)}, 4);
+  ASSERT_EQ(t.tracks().size(), 2u);
+  EXPECT_EQ(t.tracks()[1].id, 2u);
+  EXPECT_EQ(t.tracks()[1].cls, TrackClass::kHuman);
+  // Unseen for lost_frames + 1 frames: gone.
+  for (int f = 5; f < 8; ++f) t.Update({}, f);
+  EXPECT_TRUE(t.tracks().empty());
+  EXPECT_THROW(ClusterTracker(TrackerParams{0}), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace iplan::cloud_service

@@ -1,0 +1,46 @@
+// sensor_msgs/PointCloud2 <-> iplan::cloud::Cloud, and the camera settings
+// the depth providers and the cloud service read alike. The framework's Check has
+// already refused size mismatches (data vs row_step * height, point_step *
+// width vs row_step); here the field layout and the coordinates are checked,
+// so that a cloud the core reads is well-formed.
+//
+// Frame: the cloud's own (header.frame_id, the sensor's optical frame S),
+// metres.
+#pragma once
+
+#include <optional>
+#include <string>
+
+#include <Eigen/Geometry>
+
+#include "iplan/cloud/camera.h"
+#include "iplan/cloud/cloud.h"
+#include "iplan/cloud/noise.h"
+#include "iplan/core/config.h"
+#include "iplan/msg/types.h"
+
+namespace iplan::services {
+
+/// Decodes x, y, z (FLOAT32, count 1, little-endian, inside point_step) of
+/// every point into *out (organised when height > 1). Returns why the cloud
+/// is malformed, nullopt when it was decoded: big-endian data, missing or
+/// duplicated x/y/z, a coordinate field not FLOAT32 or with count != 1, a
+/// field reaching past point_step, point_step under 12 bytes, an infinite
+/// coordinate, a point with some but not all coordinates NaN, NaN in a cloud
+/// that says is_dense. NaN x, y, z is "no return" (kept, as depth cameras
+/// send it). Reuses out's buffers.
+std::optional<std::string> FromPointCloud2(const msg::PointCloud2& m, cloud::Cloud* out);
+
+/// The cloud as PointCloud2: fields x, y, z FLOAT32 at offsets 0, 4, 8,
+/// point_step 12, little-endian, is_dense when every point is finite.
+void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id,
+                   msg::PointCloud2* out);
+
+/// Reads a camera's pose from a `camera` section (`position`: [x, y, z] m in
+/// world, `look_at`: [x, y, z] m in world; see cloud::CameraPoseLookAt) and
+/// its noise model (`noise`: axial_constant m, axial_quadratic 1/m, axial_z0
+/// m, lateral_px, focal_px). Problems are recorded in the sections.
+Eigen::Isometry3d ReadCameraPose(core::ConfigSection camera);
+cloud::DepthNoiseParams ReadDepthNoise(core::ConfigSection noise);
+
+}  // namespace iplan::services

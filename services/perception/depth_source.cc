@@ -1,0 +1,229 @@
+#include "depth_source.h"
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <optional>
+
+#include "common/cloud_adapters.h"
+#include "core/depth_camera.h"
+#include "iplan/cell/joint_trajectory.h"
+#include "iplan/collision/human_model.h"
+#include "iplan/collision/robot_model.h"
+#include "iplan/collision/scene.h"
+
+namespace iplan::perception {
+namespace fs = std::filesystem;
+
+struct DepthSource::Impl {
+  std::string provider = "none";
+  double rate_hz = 30;
+  std::string frame_id = "depth_camera";
+  // simulated
+  std::unique_ptr<SimulatedDepthCamera> camera;
+  DepthScene fixed;  // the scene files' objects
+  std::unique_ptr<collision::HumanBodyModel> body;
+  std::unique_ptr<collision::RobotModel> robot;
+  std::unique_ptr<collision::RobotData> robot_data;
+  std::vector<std::string> robot_joints;
+  std::optional<Eigen::VectorXd> q;
+  // pcd
+  std::vector<std::string> files;
+  bool loop = true;
+  std::size_t next_file = 0;
+
+  TruthFn truth;
+  dds::Writer<msg::PointCloud2>* writer = nullptr;
+  int timer = 0;
+  uint64_t published = 0;
+  cloud::Cloud cloud;
+  msg::PointCloud2 message;
+  double render_ms_sum = 0;
+
+  framework::Result ConfigureSimulated(framework::ConfigSection& depth);
+  framework::Result ConfigurePcd(framework::ConfigSection& depth);
+  void OnJointState(framework::Node& node, const msg::JointState& m);
+  bool Produce(framework::Node& node);
+  void Tick(framework::Node& node);
+};
+
+DepthSource::DepthSource() : impl_(std::make_unique<Impl>()) {}
+DepthSource::~DepthSource() = default;
+
+framework::Result DepthSource::Configure(framework::ConfigSection depth, framework::Node& node) {
+  Impl& s = *impl_;
+  depth.Read("provider", &s.provider, framework::OneOf({"none", "simulated", "pcd"}));
+  depth.Read("rate_hz", &s.rate_hz, framework::InRange(0.1, 120.0));
+  depth.Read("frame_id", &s.frame_id);
+  // Both providers' keys are read always, so that switching keeps the file valid.
+  if (framework::Result r = s.ConfigureSimulated(depth); !r.ok) return r;
+  if (framework::Result r = s.ConfigurePcd(depth); !r.ok) return r;
+  if (s.provider == "none") return framework::Result::Ok();
+  s.writer = &node.Advertise(framework::topics::DepthPoints());
+  if (s.provider == "simulated" && s.robot) {
+    using SI = const dds::SampleInfo&;
+    node.Subscribe(framework::topics::JointStates(),
+                   std::function<void(const msg::JointState&, SI)>(
+                       [this, &node](const msg::JointState& m, SI) { impl_->OnJointState(node, m); }),
+                   framework::SubscribeOptions{false});
+  }
+  node.SetDiagnosticValue("depth_provider", s.provider);
+  return framework::Result::Ok();
+}
+
+framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection& depth) {
+  framework::ConfigSection sim = depth.Section("simulated");
+  DepthCameraParams p;
+  p.X_WS = services::ReadCameraPose(sim.Section("camera"));
+  p.noise = services::ReadDepthNoise(sim.Section("noise"));
+  framework::ConfigSection in = sim.Section("intrinsics");
+  in.Read("width", &p.intrinsics.width);
+  in.Read("height", &p.intrinsics.height);
+  in.Read("fx", &p.intrinsics.fx);
+  in.Read("fy", &p.intrinsics.fy);
+  in.Read("cx", &p.intrinsics.cx);
+  in.Read("cy", &p.intrinsics.cy);
+  if (const std::string why = p.intrinsics.Validate(); !why.empty()) in.AddProblem(why);
+  sim.Read("add_noise", &p.add_noise);
+  sim.Read("min_range", &p.min_range, framework::NonNegative<double>());
+  sim.Read("max_range", &p.max_range, framework::Positive<double>());
+  int seed = 1;
+  sim.Read("seed", &seed);
+  p.seed = static_cast<uint64_t>(seed);
+  std::vector<std::string> scenes = {"scenes/cell.yaml"};
+  std::string body_file = "humans/upper_body.yaml", robot_file = "robots/panda.yaml";
+  sim.Read("scenes", &scenes);
+  sim.Read("human_body", &body_file);
+  sim.Read("robot", &robot_file);
+  if (provider != "simulated" || !depth.Problems().empty()) return framework::Result::Ok();
+  try {
+    camera = std::make_unique<SimulatedDepthCamera>(p);
+    for (const std::string& f : scenes) {
+      for (const collision::SceneObject& o : collision::LoadSceneParams(sim.ResolvePath(f)).objects) {
+        if (o.shape == collision::SceneObject::Shape::kBox) {
+          fixed.boxes.push_back({o.X_WO, o.size});
+        } else {
+          fixed.cylinders.push_back({o.X_WO, o.radius, o.length});
+        }
+      }
+    }
+    if (!body_file.empty()) {
+      body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(sim.ResolvePath(body_file)));
+    }
+    if (!robot_file.empty()) {
+      robot = std::make_unique<collision::RobotModel>(collision::LoadRobotModelFromYaml(sim.ResolvePath(robot_file)));
+      robot_data = std::make_unique<collision::RobotData>(*robot);
+      robot_joints = robot->JointNames();
+    }
+  } catch (const std::exception& e) {
+    return framework::Result::Fail(sim.file() + ": key 'perception.depth.simulated': " + e.what());
+  }
+  return framework::Result::Ok();
+}
+
+framework::Result DepthSource::Impl::ConfigurePcd(framework::ConfigSection& depth) {
+  framework::ConfigSection pcd = depth.Section("pcd");
+  std::string path;
+  pcd.Read("path", &path);
+  pcd.Read("loop", &loop);
+  if (provider != "pcd") return framework::Result::Ok();
+  if (path.empty()) {
+    pcd.AddError("path", "required with provider pcd (a .pcd file or a folder of them)");
+    return framework::Result::Ok();
+  }
+  path = pcd.ResolvePath(path);
+  std::error_code ec;
+  if (fs::is_directory(path, ec)) {
+    for (const auto& e : fs::directory_iterator(path, ec)) {
+      if (e.path().extension() == ".pcd") files.push_back(e.path().string());
+    }
+    std::sort(files.begin(), files.end());
+  } else if (fs::is_regular_file(path, ec)) {
+    files.push_back(path);
+  }
+  if (files.empty()) {
+    return framework::Result::Fail(pcd.file() + ": key 'perception.depth.pcd.path': no .pcd file at " + path);
+  }
+  try {
+    cloud::LoadPcd(files.front());  // a broken first file is a configuration problem, found now
+  } catch (const std::exception& e) {
+    return framework::Result::Fail(pcd.file() + ": key 'perception.depth.pcd.path': " + e.what());
+  }
+  return framework::Result::Ok();
+}
+
+void DepthSource::Impl::OnJointState(framework::Node& node, const msg::JointState& m) {
+  std::vector<int> index;
+  if (node.CountRejection("joint_states", cell::MapJointNames(m.name, robot_joints, &index))) return;
+  if (m.position.size() != m.name.size()) return;
+  Eigen::VectorXd v(static_cast<Eigen::Index>(index.size()));
+  for (std::size_t k = 0; k < index.size(); ++k) v[static_cast<Eigen::Index>(k)] = m.position[static_cast<std::size_t>(index[k])];
+  q = v;
+}
+
+// One frame into `cloud`; false when there is nothing (more) to publish.
+bool DepthSource::Impl::Produce(framework::Node& node) {
+  if (provider == "pcd") {
+    if (next_file >= files.size()) {
+      if (!loop) return false;
+      next_file = 0;
+    }
+    const std::string& f = files[next_file++];
+    try {
+      cloud = cloud::LoadPcd(f);
+    } catch (const std::exception& e) {
+      node.CountRejection("pcd_file", std::string(e.what()));
+      return false;
+    }
+    return true;
+  }
+  DepthScene scene = fixed;
+  if (body && truth) {
+    const std::vector<JointSample> joints = truth();
+    Eigen::Matrix3Xd J(3, body->num_joints());
+    bool complete = !joints.empty();
+    for (int j = 0; j < body->num_joints() && complete; ++j) {
+      const std::string& name = body->params().joints[static_cast<std::size_t>(j)];
+      auto it = std::find_if(joints.begin(), joints.end(), [&](const JointSample& s) { return s.name == name; });
+      if (it == joints.end()) complete = false; else J.col(j) = it->position_W;
+    }
+    const std::vector<double> radii = body->Radii();
+    for (int k = 0; complete && k < body->num_spheres(); ++k) {
+      scene.spheres.push_back({body->SphereCentre(k, J), radii[static_cast<std::size_t>(k)]});
+    }
+  }
+  if (robot && q && q->size() == robot->nq) {
+    collision::CalcForwardKinematics(*robot, *q, robot_data.get());
+    for (std::size_t k = 0; k < robot->spheres.size(); ++k) {
+      scene.spheres.push_back({robot_data->p_WS.col(static_cast<Eigen::Index>(k)), robot->spheres[k].radius});
+    }
+  }
+  camera->Render(scene, &cloud);
+  return true;
+}
+
+void DepthSource::Impl::Tick(framework::Node& node) {
+  const auto t0 = std::chrono::steady_clock::now();
+  if (!Produce(node)) return;
+  const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  services::ToPointCloud2(cloud, msg::Now(), frame_id, &message);
+  std::string err;
+  if (!writer->Write(message, &err)) node.log().warn("cloud not published: {}", err);
+  ++published;
+  render_ms_sum += ms;
+  node.SetDiagnosticValue("clouds_published", std::to_string(published));
+  node.SetDiagnosticValue("depth_frame_ms_mean", std::to_string(render_ms_sum / static_cast<double>(published)));
+}
+
+void DepthSource::Activate(framework::Node& node, TruthFn truth) {
+  Impl& s = *impl_;
+  if (s.provider == "none") return;
+  s.truth = std::move(truth);
+  s.timer = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(1e9 / s.rate_hz)), [this, &node] { impl_->Tick(node); });
+}
+
+void DepthSource::Deactivate(framework::Node& node) {
+  if (impl_->provider != "none") node.CancelTimer(impl_->timer);
+}
+
+}  // namespace iplan::perception

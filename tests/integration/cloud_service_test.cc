@@ -1,0 +1,319 @@
+// The depth-camera path as real processes over loopback DDS:
+//   iplan-perception (simulated camera, synthetic person) -> iplan-cloud ->
+//   /iplan/obstacles and /iplan/human/points, checked against the scene and
+//   the person's true pose (/iplan/sim/human_truth); iplan-robot-sim gives
+//   the joint states for the self-filter (it holds still: no permits).
+// And malformed clouds sent to iplan-cloud are rejected and counted, the
+// service keeps running and processes the next good cloud.
+#include <gtest/gtest.h>
+
+#include <signal.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+#include <thread>
+
+#include "common/cloud_adapters.h"
+#include "iplan/cloud/cloud.h"
+#include "iplan/collision/human_model.h"
+#include "iplan/framework/node.h"
+#include "test_node.h"
+#include "test_paths.h"
+
+namespace iplan::testing {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+using SI = const dds::SampleInfo&;
+const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
+
+struct Observer {
+  explicit Observer(int domain, dds::Vendor vendor = dds::Vendor::kCyclone) : t("observer", vendor, domain) {
+    framework::Node& n = *t.node;
+    framework::SubscribeOptions any{false};
+    n.Subscribe(framework::topics::Diagnostics(),
+                std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
+                  for (const auto& st : a.status)
+                    for (const auto& kv : st.values) diag[st.name][kv.key] = kv.value;
+                }),
+                any);
+  }
+  double Diag(const std::string& svc, const std::string& key) {
+    auto it = diag[svc].find(key);
+    return it == diag[svc].end() ? -1 : std::atof(it->second.c_str());
+  }
+  bool SpinUntil(const std::function<bool()>& done, std::chrono::seconds timeout) {
+    const auto end = Clock::now() + timeout;
+    while (!done() && Clock::now() < end) t.node->SpinOnce(std::chrono::milliseconds(5));
+    return done();
+  }
+  TestNode t;
+  std::map<std::string, std::map<std::string, std::string>> diag;
+};
+
+std::unique_ptr<Process> Start(const std::string& exe, const std::string& cfg, int domain, const std::string& log,
+                               std::vector<std::string> extra = {}, dds::Vendor vendor = dds::Vendor::kCyclone) {
+  std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", dds::ToString(vendor), "--domain",
+                                   std::to_string(domain)};
+  argv.insert(argv.end(), extra.begin(), extra.end());
+  return std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, log);
+}
+
+const msg::Obstacle* Find(const msg::ObstacleArray& a, const Eigen::Vector3d& c, double tol) {
+  for (const auto& o : a.obstacles)
+    if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - c).norm() < tol) return &o;
+  return nullptr;
+}
+
+// The box and the parts bin are static obstacles with stable ids; nothing flat (table).
+void CheckObstacles(const std::vector<msg::ObstacleArray>& arrays, const Eigen::Vector3d& box_centre,
+                    const Eigen::Vector3d& box_size) {
+  const msg::ObstacleArray& last = arrays.back();
+  EXPECT_EQ(last.header.frame_id, "world");
+  const msg::Obstacle* box = Find(last, box_centre, 0.03);
+  ASSERT_NE(box, nullptr) << "no obstacle within 3 cm of the box; " << last.obstacles.size() << " obstacles";
+  const Eigen::Vector3d error = Eigen::Vector3d(box->centre.x, box->centre.y, box->centre.z) - box_centre;
+  std::cout << "box centre error " << error.norm() << " m (x, y, z: " << error.transpose() << ")\n";
+  for (int k = 0; k < 3; ++k) EXPECT_NEAR(2 * box->half_extents[static_cast<std::size_t>(k)], box_size[k], 0.03) << k;
+  EXPECT_NE(Find(last, Eigen::Vector3d(0.55, 0.45, 0.1), 0.05), nullptr) << "parts bin not reported";
+  int same_id = 0;
+  for (std::size_t i = arrays.size() - 30; i < arrays.size(); ++i) {
+    const msg::Obstacle* b = Find(arrays[i], box_centre, 0.03);
+    same_id += b && b->id == box->id && b->first_seen.sec == box->first_seen.sec && b->first_seen.nanosec == box->first_seen.nanosec;
+  }
+  EXPECT_EQ(same_id, 30);
+  for (const auto& o : last.obstacles) EXPECT_GT(o.half_extents[2], 0.02) << "a flat obstacle: table left over?";
+}
+
+// The person's points of the last 40 sets lie on the true body; none is the table.
+void CheckHumanPoints(const std::vector<msg::HumanPoints>& points, const std::vector<std::vector<Eigen::Vector3d>>& centres_at,
+                      const collision::HumanBodyModel& body) {
+  std::vector<double> dist;
+  int on_table = 0;
+  const std::vector<double> radii = body.Radii();
+  for (std::size_t i = points.size() - 40; i < points.size(); ++i) {
+    EXPECT_EQ(points[i].header.frame_id, "world");
+    EXPECT_DOUBLE_EQ(points[i].voxel_size, 0.03);
+    for (const auto& p : points[i].points) {
+      const Eigen::Vector3d m(p.mean.x, p.mean.y, p.mean.z);
+      double d = std::numeric_limits<double>::infinity();
+      for (int k = 0; k < body.num_spheres(); ++k)
+        d = std::min(d, (m - centres_at[i][static_cast<std::size_t>(k)]).norm() - radii[static_cast<std::size_t>(k)]);
+      dist.push_back(std::abs(d));
+      on_table += std::abs(m.z()) < 0.01;
+      EXPECT_GT(p.covariance[8], 0);
+    }
+  }
+  ASSERT_GT(dist.size(), 40u * 100);
+  std::sort(dist.begin(), dist.end());
+  std::cout << "human points " << dist.size() << " in 40 sets, distance to the true body median " << dist[dist.size() / 2]
+            << " m, p90 " << dist[dist.size() * 9 / 10] << " m; near the table top " << on_table << "\n";
+  EXPECT_LT(dist[dist.size() / 2], 0.03) << "median distance to the true body";
+  EXPECT_LT(dist[dist.size() * 9 / 10], 0.08) << "90th percentile";
+  EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
+}
+
+class CloudPathTest : public ::testing::TestWithParam<dds::Vendor> {};
+
+TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
+  const dds::Vendor vendor = GetParam();
+  const int domain = UniqueDomain(vendor == dds::Vendor::kCyclone ? 41 : 42);
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-test-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  // A box left on the table, besides the cell's parts bin.
+  const Eigen::Vector3d box_centre(0.75, -0.2, 0.075), box_size(0.15, 0.15, 0.15);
+  const std::string box_file = (dir / "box.yaml").string();
+  std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: [0.75, -0.2, 0.075], size: [0.15, 0.15, 0.15]}\n";
+  Observer obs(domain, vendor);
+  std::vector<msg::ObstacleArray> arrays;
+  const collision::HumanBodyModel body(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml"));
+  Eigen::Matrix3Xd truth(3, body.num_joints());
+  bool have_truth = false;
+  framework::Node& n = *obs.t.node;
+  framework::SubscribeOptions any{false};
+  n.Subscribe(framework::topics::Obstacles(),
+              std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& m, SI) { arrays.push_back(m); }), any);
+  n.Subscribe(framework::topics::HumanTruth(),
+              std::function<void(const msg::HumanSkeleton&, SI)>([&](const msg::HumanSkeleton& m, SI) {
+                for (int j = 0; j < body.num_joints(); ++j)
+                  for (const auto& h : m.joints)
+                    if (h.name == body.params().joints[static_cast<std::size_t>(j)]) truth.col(j) << h.position.x, h.position.y, h.position.z;
+                have_truth = true;
+              }), any);
+  std::vector<std::vector<Eigen::Vector3d>> centres_at;  // true sphere centres when each human message came
+  std::vector<msg::HumanPoints> points;
+  n.Subscribe(framework::topics::HumanPoints(),
+              std::function<void(const msg::HumanPoints&, SI)>([&](const msg::HumanPoints& m, SI) {
+                if (!have_truth) return;
+                std::vector<Eigen::Vector3d> c;
+                for (int k = 0; k < body.num_spheres(); ++k) c.push_back(body.SphereCentre(k, truth));
+                centres_at.push_back(c);
+                points.push_back(m);
+              }), any);
+  auto robot = Start("iplan-robot-sim", "robot_sim.yaml", domain, (dir / "robot_sim").string(), {}, vendor);
+  auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
+                          {"--set", "perception.provider=synthetic", "--set", "perception.synthetic.start=loop", "--set",
+                           "perception.publish_truth=true", "--set", "perception.depth.provider=simulated", "--set",
+                           "perception.depth.rate_hz=10", "--set",
+                           "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"},
+                          vendor);
+  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string(), {}, vendor);
+  ASSERT_TRUE(obs.SpinUntil([&] { return arrays.size() >= 60 && points.size() >= 60; }, std::chrono::seconds(90)))
+      << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cloud->Stderr()
+      << perception->Stderr();
+
+  CheckObstacles(arrays, box_centre, box_size);
+  CheckHumanPoints(points, centres_at, body);
+  obs.SpinUntil([&] { return obs.Diag("cloud", "clouds") > 50; }, std::chrono::seconds(3));
+  EXPECT_GT(obs.Diag("cloud", "clouds"), 50);
+  EXPECT_EQ(obs.Diag("cloud", "clouds_without_self_filter"), 0);
+  for (auto* p : {cloud.get(), perception.get(), robot.get()}) p->Signal(SIGTERM);
+  EXPECT_EQ(cloud->Wait(std::chrono::seconds(10)), 0) << cloud->Stderr();
+  EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
+  EXPECT_EQ(robot->Wait(std::chrono::seconds(10)), 0);
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(BothVendors, CloudPathTest, ::testing::Values(dds::Vendor::kCyclone, dds::Vendor::kFastDds),
+                         [](const ::testing::TestParamInfo<dds::Vendor>& i) { return dds::ToString(i.param); });
+
+// perception's PCD replay publishes the files of a folder in name order, each
+// cloud point for point the file's (x, y, z, NaN where the file has NaN).
+TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
+  const int domain = UniqueDomain(45);
+  const std::string folder = std::string(IPLAN_SHARED_DIR) + "/data/pointclouds/mosd_learn";
+  std::vector<std::string> files;
+  for (const auto& e : std::filesystem::directory_iterator(folder))
+    if (e.path().extension() == ".pcd") files.push_back(e.path().string());
+  std::sort(files.begin(), files.end());
+  ASSERT_GE(files.size(), 4u);
+  std::vector<cloud::Cloud> truth;
+  for (std::size_t i = 0; i < 4; ++i) truth.push_back(cloud::LoadPcd(files[i]));
+  Observer obs(domain);
+  std::vector<int> which;  // index of the file each received cloud equals, -1 none
+  obs.t.node->Subscribe(framework::topics::DepthPoints(),
+                        std::function<void(const msg::PointCloud2&, SI)>([&](const msg::PointCloud2& m, SI) {
+                          cloud::Cloud c;
+                          if (services::FromPointCloud2(m, &c)) return;
+                          int match = -1;
+                          for (std::size_t k = 0; k < truth.size() && match < 0; ++k) {
+                            if (c.width != truth[k].width || c.height != truth[k].height) continue;
+                            bool same = true;
+                            for (std::size_t i = 0; i < c.size() && same; ++i) {
+                              const auto& a = c.points[i];
+                              const auto& b = truth[k].points[i];
+                              same = a.allFinite() ? a == b : !b.allFinite();
+                            }
+                            if (same) match = static_cast<int>(k);
+                          }
+                          which.push_back(match);
+                        }),
+                        framework::SubscribeOptions{false});
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-pcd-test-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
+                          {"--set", "perception.depth.provider=pcd", "--set", "perception.depth.pcd.path=" + folder, "--set",
+                           "perception.depth.rate_hz=4", "--set", "perception.depth.pcd.loop=false"});
+  ASSERT_TRUE(obs.SpinUntil([&] { return which.size() >= 3 && which.back() == 3; }, std::chrono::seconds(30)))
+      << which.size() << " clouds\n" << perception->Stderr();
+  // Every received cloud is one of the files, in order (best effort: one may be lost).
+  for (std::size_t i = 0; i < which.size(); ++i) {
+    EXPECT_GE(which[i], 0) << i;
+    if (i > 0) EXPECT_GT(which[i], which[i - 1]) << i;
+  }
+  perception->Signal(SIGTERM);
+  EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+// Bad configurations are refused with exit code 2 and the key named.
+TEST(CloudServiceTest, BadConfigurationIsRefused) {
+  const std::vector<std::pair<std::string, std::string>> cases = {
+      {"cloud.tracking.static_frames=0", "static_frames must be >= 1"},
+      {"cloud.tracking.bogus=1", "unknown key 'cloud.tracking.bogus'"},
+      {"cloud.camera.look_at=[0.45, 1.3, 1.1]", "key 'cloud.camera.look_at'"},
+      {"cloud.workspace_min=[0, 0]", "key 'cloud.workspace_min'"},
+      {"cloud.pipeline.stride=3", "is not supported; edit the file"},
+      {"cloud.robot=missing.yaml", "missing.yaml"},
+  };
+  for (const auto& [set, why] : cases) {
+    Process p({BinPath("iplan-cloud"), "--config", kConfig + "/cloud.yaml", "--check-config", "--set", set});
+    EXPECT_EQ(p.Wait(std::chrono::seconds(20)), 2) << set;
+    EXPECT_NE(p.Stderr().find(why), std::string::npos) << set << ":\n" << p.Stderr();
+  }
+}
+
+msg::PointCloud2 GoodCloud() {
+  msg::PointCloud2 m;
+  m.header.stamp = msg::Now();
+  m.header.frame_id = "depth_camera";
+  m.height = 1;
+  m.width = 100;
+  static const char* const names[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) m.fields.push_back({names[k], static_cast<uint32_t>(4 * k), msg::PointField::FLOAT32, 1});
+  m.point_step = 12;
+  m.row_step = 1200;
+  m.data.resize(1200);
+  for (int i = 0; i < 100; ++i) {
+    const float p[3] = {0.01f * i, 0.0f, 1.5f};
+    std::memcpy(m.data.data() + 12 * i, p, 12);
+  }
+  m.is_dense = true;
+  return m;
+}
+
+TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
+  const int domain = UniqueDomain(43);
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-bad-" + std::to_string(getpid()));
+  std::filesystem::create_directories(dir);
+  Observer obs(domain);
+  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string(), {"--set", "cloud.robot=\"\""});
+  auto& writer = obs.t.node->Advertise(framework::topics::DepthPoints());
+  ASSERT_TRUE(obs.SpinUntil([&] { return writer.MatchedReaders() > 0 && obs.Diag("cloud", "state") != -1; }, std::chrono::seconds(20)))
+      << cloud->Stderr();
+  std::vector<msg::PointCloud2> framework_bad, layout_bad;
+  { auto m = GoodCloud(); m.data.resize(1100); framework_bad.push_back(m); }           // data vs row_step * height
+  { auto m = GoodCloud(); m.width = 200; framework_bad.push_back(m); }                 // point_step * width > row_step
+  { auto m = GoodCloud(); m.point_step = 100000; framework_bad.push_back(m); }          // absurd point step
+  { auto m = GoodCloud(); m.point_step = 8; m.row_step = 800; m.data.resize(800); layout_bad.push_back(m); }  // under 12 bytes
+  { auto m = GoodCloud(); m.fields[0].datatype = msg::PointField::FLOAT64; layout_bad.push_back(m); }
+  { auto m = GoodCloud(); m.fields.pop_back(); layout_bad.push_back(m); }               // no z
+  { auto m = GoodCloud(); m.fields[1].name = "x"; layout_bad.push_back(m); }            // x twice
+  { auto m = GoodCloud(); m.fields[2].offset = 10; layout_bad.push_back(m); }           // z past point_step
+  { auto m = GoodCloud(); m.is_bigendian = true; layout_bad.push_back(m); }
+  { auto m = GoodCloud(); const float nan = std::nanf(""); std::memcpy(m.data.data() + 12 * 5, &nan, 4); m.is_dense = false; layout_bad.push_back(m); }  // x NaN only
+  { auto m = GoodCloud(); const float inf = std::numeric_limits<float>::infinity(); std::memcpy(m.data.data() + 8, &inf, 4); layout_bad.push_back(m); }
+  { auto m = GoodCloud(); const float nan[3] = {std::nanf(""), std::nanf(""), std::nanf("")}; std::memcpy(m.data.data(), nan, 12); layout_bad.push_back(m); }  // NaN in a dense cloud
+  for (auto* set : {&framework_bad, &layout_bad}) {
+    for (auto& m : *set) {
+      m.header.stamp = msg::Now();
+      writer.Write(m);
+      obs.SpinUntil([] { return false; }, std::chrono::seconds(0));
+      std::this_thread::sleep_for(std::chrono::milliseconds(60));  // best-effort reader: one at a time
+    }
+  }
+  auto good = GoodCloud();
+  good.header.stamp = msg::Now();
+  writer.Write(good);
+  const double nf = static_cast<double>(framework_bad.size()), nl = static_cast<double>(layout_bad.size());
+  EXPECT_TRUE(obs.SpinUntil([&] {
+    return obs.Diag("cloud", "rejected/rt/iplan/depth/points") == nf && obs.Diag("cloud", "rejected_inputs/depth_points") == nl &&
+           obs.Diag("cloud", "clouds") == 1;
+  }, std::chrono::seconds(15)))
+      << "framework rejections " << obs.Diag("cloud", "rejected/rt/iplan/depth/points") << " of " << nf
+      << ", layout rejections " << obs.Diag("cloud", "rejected_inputs/depth_points") << " of " << nl << ", processed "
+      << obs.Diag("cloud", "clouds") << "\n" << cloud->Stderr();
+  EXPECT_TRUE(cloud->Running());
+  cloud->Signal(SIGTERM);
+  EXPECT_EQ(cloud->Wait(std::chrono::seconds(10)), 0) << cloud->Stderr();
+  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+}
+
+}  // namespace
+}  // namespace iplan::testing
