@@ -179,17 +179,18 @@ bool DepthSource::Impl::Produce(framework::Node& node) {
   }
   DepthScene scene = fixed;
   if (body && truth) {
-    const std::vector<JointSample> joints = truth();
-    Eigen::Matrix3Xd J(3, body->num_joints());
-    bool complete = !joints.empty();
-    for (int j = 0; j < body->num_joints() && complete; ++j) {
-      const std::string& name = body->params().joints[static_cast<std::size_t>(j)];
-      auto it = std::find_if(joints.begin(), joints.end(), [&](const JointSample& s) { return s.name == name; });
-      if (it == joints.end()) complete = false; else J.col(j) = it->position_W;
-    }
     const std::vector<double> radii = body->Radii();
-    for (int k = 0; complete && k < body->num_spheres(); ++k) {
-      scene.spheres.push_back({body->SphereCentre(k, J), radii[static_cast<std::size_t>(k)]});
+    Eigen::Matrix3Xd J(3, body->num_joints());
+    for (const std::vector<JointSample>& joints : truth()) {
+      bool complete = !joints.empty();
+      for (int j = 0; j < body->num_joints() && complete; ++j) {
+        const std::string& name = body->params().joints[static_cast<std::size_t>(j)];
+        auto it = std::find_if(joints.begin(), joints.end(), [&](const JointSample& s) { return s.name == name; });
+        if (it == joints.end()) complete = false; else J.col(j) = it->position_W;
+      }
+      for (int k = 0; complete && k < body->num_spheres(); ++k) {
+        scene.spheres.push_back({body->SphereCentre(k, J), radii[static_cast<std::size_t>(k)]});
+      }
     }
   }
   if (robot && q && q->size() == robot->nq) {

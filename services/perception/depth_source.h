@@ -23,8 +23,9 @@ namespace iplan::perception {
 
 class DepthSource {
  public:
-  /// The true pose of the simulated person now (empty: no person).
-  using TruthFn = std::function<std::vector<JointSample>()>;
+  /// The true pose of every simulated person now, one joint list per
+  /// person (empty: nobody).
+  using TruthFn = std::function<std::vector<std::vector<JointSample>>()>;
 
   DepthSource();
   ~DepthSource();

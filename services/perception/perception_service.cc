@@ -60,7 +60,11 @@ class PerceptionService : public framework::Service {
 
   Result OnActivate(Node& node) override {
     start_ = std::chrono::system_clock::now();
-    depth_.Activate(node, [this] { return person_ ? person_->TruePose(Seconds()) : std::vector<JointSample>{}; });
+    depth_.Activate(node, [this] {
+      std::vector<std::vector<JointSample>> poses;
+      for (const auto& person : people_) poses.push_back(person->TruePose(Seconds()));
+      return poses;
+    });
     if (replay_) {
       start_ns_ = msg::ToNanoseconds(msg::Now());
       timer_ = node.AddTimer(kReplayPoll, [this, &node] { ReplayTick(node); });

@@ -250,8 +250,7 @@ class CellHarness {
   std::string config_dir_, model_;
   std::unique_ptr<TestNode> observer_;
   std::map<std::string, std::unique_ptr<Process>> procs_;
-  std::map<std::string, std::vector<std::string>> launchers_;
-  std::map<std::string, dds::Vendor> vendors_;
+  std::map<std::string, std::vector<std::string>> launchers_;  ///< what runs each service (Place), or none
   int starts_ = 0;
   std::vector<JointSample> joints_;
   std::vector<double> positions_;
