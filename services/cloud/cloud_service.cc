@@ -91,7 +91,7 @@ class CloudService : public framework::Service {
     // A second of history, so that a cloud processed late still finds the
     // robot's pose of its own time.
     history_.push_back({msg::ToNanoseconds(m.header.stamp), q});
-    while (history_.size() > 1 && history_.back().first - history_.front().first > 1'000'000'000) history_.pop_front();
+    while (history_.size() > 1 && history_.back().first - history_.front().first > kHistoryNs) history_.pop_front();
   }
 
   // The joint state nearest the cloud's stamp, if within joint_state_timeout.
@@ -162,6 +162,7 @@ class CloudService : public framework::Service {
 
   std::unique_ptr<CloudStage> stage_;
   std::vector<std::string> joint_names_;
+  static constexpr int64_t kHistoryNs = 1000000000;           // 1 s of joint states
   std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
   double joint_state_timeout_ = 0.2;
   double human_voxel_ = 0.03;

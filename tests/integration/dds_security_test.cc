@@ -78,7 +78,7 @@ TEST(SecurityKeystore, KeysAreTheOwnersAloneAndAKeystoreIsNeverOverwritten) {
       EXPECT_TRUE(fs::is_regular_file(e.path() / f)) << e.path() / f;
     }
   }
-  EXPECT_EQ(enclaves, 7);  // six services and the observer
+  EXPECT_EQ(enclaves, 8);  // seven services (cloud included) and the observer
   // No temporaries left beside it.
   for (const auto& e : fs::directory_iterator(Keystores::Dir())) {
     EXPECT_EQ(e.path().filename().string().find(".tmp."), std::string::npos) << e.path();
