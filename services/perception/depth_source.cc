@@ -24,6 +24,7 @@ struct DepthSource::Impl {
   DepthScene fixed;  // the scene files' objects
   DepthScene added;  // the added_scenes files' objects, rendered from added_after s after activation on
   double added_after = 0;  // s
+  double human_after = 0;  // s after activation before the person is rendered (they walk into view then)
   std::chrono::steady_clock::time_point activated;
   std::unique_ptr<collision::HumanBodyModel> body;
   std::unique_ptr<collision::RobotModel> robot;
@@ -98,6 +99,7 @@ framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection
   sim.Read("scenes", &scenes);
   sim.Read("added_scenes", &added_scenes);
   sim.Read("added_after", &added_after, framework::NonNegative<double>());
+  sim.Read("human_after", &human_after, framework::NonNegative<double>());
   sim.Read("human_body", &body_file);
   sim.Read("robot", &robot_file);
   if (provider != "simulated" || !depth.Problems().empty()) return framework::Result::Ok();
@@ -187,11 +189,12 @@ bool DepthSource::Impl::Produce(framework::Node& node) {
     return true;
   }
   DepthScene scene = fixed;
-  if (std::chrono::duration<double>(std::chrono::steady_clock::now() - activated).count() >= added_after) {
+  const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - activated).count();
+  if (since >= added_after) {
     scene.boxes.insert(scene.boxes.end(), added.boxes.begin(), added.boxes.end());
     scene.cylinders.insert(scene.cylinders.end(), added.cylinders.begin(), added.cylinders.end());
   }
-  if (body && truth) {
+  if (body && truth && since >= human_after) {
     const std::vector<double> radii = body->Radii();
     Eigen::Matrix3Xd J(3, body->num_joints());
     for (const std::vector<JointSample>& joints : truth()) {

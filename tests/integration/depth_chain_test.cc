@@ -18,7 +18,10 @@
 #include <signal.h>
 
 #include <cmath>
+#include <filesystem>
 #include <fstream>
+#include <map>
+#include <optional>
 
 #include <Eigen/Core>
 #include <gtest/gtest.h>
@@ -90,9 +93,12 @@ const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "
                                                "panda_joint5", "panda_joint6", "panda_joint7"};
 const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
 const std::vector<double> kReach = {0, 0.3, 0, -1.5, 0, 1.9, 0.785};
-constexpr double kRobotDelay = 0.5, kRobotMove = 2.5;  // s: the arm waits, then reaches out (the person's hand gets there at 3 s)
+// The person walks into the camera's view kPersonAfter s after perception's activation; the arm starts its one
+// reach (kReady to kReach in kRobotMove s, then holding) kRobotLead s before that, so it is moving when the person
+// comes. The person's right hand reaches (3 s out, 3 s back) to 5 cm beyond the arm's hand at kReach.
+constexpr double kPersonAfter = 10.0, kRobotLead = 0.7, kRobotMove = 3.0, kRunFor = 9.0;  // s
 std::vector<double> PlannedAt(double t) {
-  const double s = std::clamp((t - kRobotDelay) / kRobotMove, 0.0, 1.0), u = 0.5 - 0.5 * std::cos(M_PI * s);
+  const double s = std::clamp(t / kRobotMove, 0.0, 1.0), u = 0.5 - 0.5 * std::cos(M_PI * s);
   std::vector<double> q(7);
   for (std::size_t j = 0; j < 7; ++j) q[j] = (1 - u) * kReady[j] + u * kReach[j];
   return q;
@@ -101,7 +107,7 @@ msg::JointTrajectory Reaching(const msg::Time& start) {
   msg::JointTrajectory t;
   t.header.stamp = start;
   t.joint_names = kRobotJoints;
-  for (int i = 0; i <= 100; ++i) {
+  for (int i = 0; i <= 10 * static_cast<int>(kRunFor); ++i) {
     msg::JointTrajectoryPoint pt;
     pt.positions = PlannedAt(0.1 * i);
     pt.time_from_start = msg::DurationFromSeconds(0.1 * i);
@@ -122,116 +128,278 @@ double Distance(const collision::RobotModel& robot, const std::vector<double>& q
   return best;
 }
 
-TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
-  const collision::RobotModel robot = Panda();
-  const collision::HumanBodyModel body(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml"));
-  const std::vector<double> radii = body.Radii();
-  // The person's right hand reaches 8 cm beyond the arm's hand at kReach (away from the base), so the arm going on
-  // would run into it.
-  collision::RobotData d(robot);
-  collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(kReach.data(), 7), &d);
-  Eigen::Vector3d hand = d.X_WL[static_cast<std::size_t>(robot.FindLink("panda_hand"))].translation();
-  const Eigen::Vector3d target = hand + 0.08 * Eigen::Vector3d(hand.x(), hand.y(), 0).normalized();
-
-  Cell cell("depth-person", UniqueDomain(97));
-  TestNode sc("scripted_cell", dds::Vendor::kCyclone, cell.domain);
-  framework::Node& node = *sc.node;
-  auto& traj = node.Advertise(framework::topics::RobotTrajectory());
-  auto& cmd = node.Advertise(framework::topics::TaskCommand());
-  Clock::time_point t0{};
-  auto since = [&] { return std::chrono::duration<double>(Clock::now() - t0).count(); };
-  struct State { double t; std::vector<double> q, qd; std::vector<Eigen::Vector3d> body; };
+struct PersonRun {
+  struct State { double t; std::vector<double> q, qd; std::vector<Eigen::Vector3d> body; };  // t: s since the reach
   struct Truth { double t; std::vector<Eigen::Vector3d> centres; };
   struct Risk { double t; msg::CollisionRisk r; };
   std::vector<State> states;
   std::vector<Truth> truths;
   std::vector<Risk> risks;
-  int point_sets = 0, skeletons = 0;
+  int point_sets = 0, empty_sets = 0, skeletons = 0;
+  double first_points_t = -1;  // s since the reach: first non-empty human point set
+};
+
+void ObservePerson(framework::Node& node, const collision::HumanBodyModel& body, const Clock::time_point* t0, PersonRun* run) {
+  auto since = [t0] { return std::chrono::duration<double>(Clock::now() - *t0).count(); };
+  auto started = [t0] { return *t0 != Clock::time_point{}; };
   framework::SubscribeOptions any{false};
-  node.Subscribe(framework::topics::HumanTruth(), std::function<void(const msg::HumanSkeleton&, SI)>([&](const msg::HumanSkeleton& m, SI) {
+  node.Subscribe(framework::topics::HumanTruth(), std::function<void(const msg::HumanSkeleton&, SI)>([=, &body](const msg::HumanSkeleton& m, SI) {
                    Eigen::Matrix3Xd J(3, body.num_joints());
                    for (int j = 0; j < body.num_joints(); ++j)
                      for (const auto& h : m.joints)
                        if (h.name == body.params().joints[static_cast<std::size_t>(j)]) J.col(j) << h.position.x, h.position.y, h.position.z;
                    std::vector<Eigen::Vector3d> c;
                    for (int k = 0; k < body.num_spheres(); ++k) c.push_back(body.SphereCentre(k, J));
-                   truths.push_back({since(), c});
+                   if (started()) run->truths.push_back({since(), c});
+                   else run->truths = {{0, c}};
                  }), any);
-  node.Subscribe(framework::topics::JointStates(), std::function<void(const msg::JointState&, SI)>([&](const msg::JointState& m, SI) {
-                   if (t0 != Clock::time_point{} && !truths.empty()) states.push_back({since(), m.position, m.velocity, truths.back().centres});
+  node.Subscribe(framework::topics::JointStates(), std::function<void(const msg::JointState&, SI)>([=](const msg::JointState& m, SI) {
+                   if (started() && !run->truths.empty()) run->states.push_back({since(), m.position, m.velocity, run->truths.back().centres});
                  }), any);
-  node.Subscribe(framework::topics::CollisionRisk(), std::function<void(const msg::CollisionRisk& r, SI)>([&](const msg::CollisionRisk& r, SI) {
-                   risks.push_back({since(), r});
+  node.Subscribe(framework::topics::CollisionRisk(), std::function<void(const msg::CollisionRisk&, SI)>([=](const msg::CollisionRisk& r, SI) {
+                   run->risks.push_back({started() ? since() : -1, r});
                  }), any);
-  node.Subscribe(framework::topics::HumanPoints(), std::function<void(const msg::HumanPoints&, SI)>([&](const msg::HumanPoints&, SI) {
-                   ++point_sets;
+  node.Subscribe(framework::topics::HumanPoints(), std::function<void(const msg::HumanPoints&, SI)>([=](const msg::HumanPoints& m, SI) {
+                   ++run->point_sets;
+                   run->empty_sets += m.points.empty();
+                   if (started() && !m.points.empty() && run->first_points_t < 0) run->first_points_t = since();
                  }), any);
-  node.Subscribe(framework::topics::HumanSkeleton(), std::function<void(const msg::HumanSkeleton&, SI)>([&](const msg::HumanSkeleton&, SI) {
-                   ++skeletons;
+  node.Subscribe(framework::topics::HumanSkeleton(), std::function<void(const msg::HumanSkeleton&, SI)>([=](const msg::HumanSkeleton&, SI) {
+                   ++run->skeletons;
                  }), any);
+}
 
+// perception (no skeleton; the person walks into the camera's view at kPersonAfter), cloud, collision risk and the
+// robot; this process plays trajopt: one reach of the arm, kRobotLead s before the person comes.
+PersonRun RunPerson(const collision::HumanBodyModel& body, const Eigen::Vector3d& target) {
+  Cell cell("depth-person", UniqueDomain(97));
+  TestNode sc("scripted_cell", dds::Vendor::kCyclone, cell.domain);
+  framework::Node& node = *sc.node;
+  auto& traj = node.Advertise(framework::topics::RobotTrajectory());
+  Clock::time_point t0{};
+  PersonRun run;
+  ObservePerson(node, body, &t0, &run);
   const std::string entitled = "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]";
   cell.Start("iplan-robot-sim", "robot_sim.yaml", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]", "--set", entitled});
   cell.Start("iplan-collision-risk", "collision_risk.yaml", {"--set", entitled});
-  cell.Start("iplan-perception", "perception.yaml",
-             DepthPerception({"--set", "perception.publish_skeleton=false", "--set", "node.entitled_writers./iplan/task/command=[scripted_cell]",
-                              "--set", "perception.synthetic.start=episodes", "--set", "perception.synthetic.variation=0", "--set",
-                              "perception.synthetic.actions.reach_parts.target=" + List(target), "--set",
-                              "perception.synthetic.actions.reach_parts.period=6.0", "--set", "perception.synthetic.script=[reach_parts]",
-                              "--set", "perception.synthetic.durations=[6.0]"}));
   cell.Start("iplan-cloud", "cloud.yaml", {});
-  // Up: the person's points reach collision risk, which lets the arm at rest go (OK).
-  const auto up = Clock::now() + 40s;
-  auto ok_now = [&] { return !risks.empty() && risks.back().r.verdict == msg::CollisionRisk::OK && point_sets >= 10; };
-  while (Clock::now() < up && (!ok_now() || traj.MatchedReaders() < 2 || cmd.MatchedReaders() == 0)) node.SpinOnce(10ms);
-  ASSERT_TRUE(ok_now()) << point_sets << " human point sets; last verdict "
-                        << (risks.empty() ? std::string("none") : risks.back().r.reason) << "\n"
-                        << cell.procs["iplan-cloud"]->Stderr() << cell.procs["iplan-collision-risk"]->Stderr();
-  // The episode starts: the person reaches (3 s out, 3 s back), the arm reaches out from 0.5 s to 3 s.
-  msg::TaskCommand c;
-  c.header.stamp = msg::Now();
-  c.command = msg::TaskCommand::START;
-  c.episode = 1;
-  c.task_id = 1;
-  c.task_name = "reach";
+  const auto launched = Clock::now();
+  cell.Start("iplan-perception", "perception.yaml",
+             DepthPerception({"--set", "perception.publish_skeleton=false", "--set", "perception.synthetic.start=loop", "--set",
+                              "perception.synthetic.variation=0", "--set", "perception.synthetic.actions.reach_parts.target=" + List(target),
+                              "--set", "perception.synthetic.actions.reach_parts.period=6.0", "--set",
+                              "perception.synthetic.script=[reach_parts]", "--set", "perception.synthetic.durations=[6.0]", "--set",
+                              "perception.depth.simulated.human_after=" + std::to_string(kPersonAfter)}));
+  // Nobody in view yet: empty point sets, and collision risk lets the arm go (OK).
+  const auto go = launched + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kPersonAfter - kRobotLead));
+  while (Clock::now() < go) node.SpinOnce(5ms);
+  const bool ok = !run.risks.empty() && run.risks.back().r.verdict == msg::CollisionRisk::OK && traj.MatchedReaders() >= 2;
+  EXPECT_TRUE(ok) << run.point_sets << " human point sets (" << run.empty_sets << " empty); last verdict "
+                  << (run.risks.empty() ? std::string("none") : run.risks.back().r.reason);
   t0 = Clock::now();
-  states.clear();
-  risks.clear();
-  truths.erase(truths.begin(), truths.end() - 1);
-  truths.back().t = 0;
-  cmd.Write(c);
+  run.states.clear();
+  run.risks.clear();
   traj.Write(Reaching(msg::Now()));
-  while (since() < 7.0) node.SpinOnce(5ms);
+  while (std::chrono::duration<double>(Clock::now() - t0).count() < kRunFor) node.SpinOnce(5ms);
   cell.Stop();
+  return run;
+}
 
-  EXPECT_EQ(skeletons, 0) << "perception published skeletons";
-  ASSERT_GT(states.size(), 100u);
-  ASSERT_GT(truths.size(), 100u);
+TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
+  const collision::RobotModel robot = Panda();
+  const collision::HumanBodyModel body(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml"));
+  const std::vector<double> radii = body.Radii();
+  collision::RobotData d(robot);
+  collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(kReach.data(), 7), &d);
+  const Eigen::Vector3d hand = d.X_WL[static_cast<std::size_t>(robot.FindLink("panda_hand"))].translation();
+  const Eigen::Vector3d target = hand + 0.05 * Eigen::Vector3d(hand.x(), hand.y(), 0).normalized();
+  const PersonRun run = RunPerson(body, target);
+
+  EXPECT_EQ(run.skeletons, 0) << "perception published skeletons";
+  ASSERT_GT(run.states.size(), 100u);
+  ASSERT_GT(run.truths.size(), 100u);
   // Without a stop the arm would run into the reaching hand: the planned arm against the true body at the same time.
   double unstopped = std::numeric_limits<double>::infinity();
-  for (const Truth& tr : truths) unstopped = std::min(unstopped, Distance(robot, PlannedAt(tr.t), tr.centres, radii));
-  EXPECT_LT(unstopped, -0.02);
-  const Risk* stop = nullptr;
-  for (const Risk& r : risks)
+  for (const auto& tr : run.truths) unstopped = std::min(unstopped, Distance(robot, PlannedAt(tr.t), tr.centres, radii));
+  EXPECT_LT(unstopped, -0.03);
+  const PersonRun::Risk* stop = nullptr;
+  for (const auto& r : run.risks)
     if (r.r.verdict == msg::CollisionRisk::PROTECTIVE_STOP && r.r.reason.find("/ points)") != std::string::npos) {
       stop = &r;
       break;
     }
-  ASSERT_NE(stop, nullptr) << "never stopped for the points; last: " << (risks.empty() ? "" : risks.back().r.reason);
+  ASSERT_NE(stop, nullptr) << "never stopped for the points; last: " << (run.risks.empty() ? "" : run.risks.back().r.reason);
   double moved = 0, closest = std::numeric_limits<double>::infinity(), late_speed = 0;
-  for (const State& s : states) {
+  for (const auto& s : run.states) {
     if (s.t < stop->t) moved = std::max(moved, std::abs(s.qd[1]));
     if (s.t > stop->t + 0.6)
       for (double v : s.qd) late_speed = std::max(late_speed, std::abs(v));
     closest = std::min(closest, Distance(robot, s.q, s.body, radii));
   }
-  std::cout << "unstopped arm vs true body: " << unstopped << " m; first stop for the points at +" << stop->t
-            << " s: separation " << stop->r.min_separation << " m, S_p " << stop->r.protective_separation << " m: " << stop->r.reason
+  std::cout << "arm's hand at kReach " << hand.transpose() << ", person's hand target " << target.transpose()
+            << "\nunstopped arm vs true body: " << unstopped << " m; person's first points at +" << run.first_points_t
+            << " s after the reach started; first stop for the points at +" << stop->t << " s: separation "
+            << stop->r.min_separation << " m, S_p " << stop->r.protective_separation << " m: " << stop->r.reason
             << "\njoint 2 speed before the stop " << moved << " rad/s; closest executed arm vs true body " << closest
             << " m; joint speed from 0.6 s after the stop " << late_speed << " rad/s\n";
   EXPECT_GT(moved, 0.1) << "the arm never moved: the stop proves nothing";
   EXPECT_GT(closest, 0.0) << "contact with the true body";
   EXPECT_LT(late_speed, 1e-6) << "not at rest after the stop";
+}
+
+// ---------------------------------------------------------------- 2. box
+
+// A sweep of joint 1 across the front of the robot, the hand low over the table (as obstacle_avoidance_test).
+const std::vector<double> kStart = {0.45, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
+const std::vector<double> kGoal = {-0.75, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
+constexpr double kBoxAppears = 4.0;  // s after perception's activation
+
+// Smallest signed distance (m, FCL) of the robot's spheres to `box` over the states.
+double MinDistance(const collision::RobotModel& robot, const collision::SceneObject& box,
+                   const std::vector<std::vector<double>>& states) {
+  const collision::StaticScene scene(collision::SceneParams{{box}});
+  collision::RobotData d(robot);
+  std::vector<double> radii;
+  for (const auto& s : robot.spheres) radii.push_back(s.radius);
+  double best = std::numeric_limits<double>::infinity();
+  for (const auto& q : states) {
+    collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(q.data(), 7), &d);
+    best = std::min(best, scene.CalcMinimumDistance(d.p_WS, radii).distance);
+  }
+  return best;
+}
+
+// The joint-space straight line from kStart to kGoal (the plan of an optimiser that does not know the box), n states.
+std::vector<std::vector<double>> StraightLine(int n) {
+  std::vector<std::vector<double>> line;
+  for (int i = 0; i <= n; ++i) {
+    std::vector<double> q(7);
+    for (std::size_t j = 0; j < 7; ++j) q[j] = kStart[j] + (kGoal[j] - kStart[j]) * i / n;
+    line.push_back(q);
+  }
+  return line;
+}
+
+TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
+  const collision::RobotModel robot = Panda();
+  // The box stands on the table under the hand's lowest sphere at the middle of the straight sweep, 12 cm square,
+  // reaching 5 cm above the bottom of that sphere.
+  collision::RobotData d(robot);
+  const std::vector<double> mid = StraightLine(2)[1];
+  collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(mid.data(), 7), &d);
+  const int hand = robot.FindLink("panda_hand");
+  int low = -1;
+  for (int k = 0; k < d.p_WS.cols(); ++k)
+    if (robot.spheres[static_cast<std::size_t>(k)].link == hand &&
+        (low < 0 || d.p_WS(2, k) - robot.spheres[static_cast<std::size_t>(k)].radius <
+                        d.p_WS(2, low) - robot.spheres[static_cast<std::size_t>(low)].radius))
+      low = k;
+  ASSERT_GE(low, 0);
+  const double top = d.p_WS(2, low) - robot.spheres[static_cast<std::size_t>(low)].radius + 0.05;
+  ASSERT_GT(top, 0.1);
+  collision::SceneObject box;
+  box.name = "box";
+  box.X_WO.translation() = Eigen::Vector3d(d.p_WS(0, low), d.p_WS(1, low), 0.5 * top);
+  box.size = Eigen::Vector3d(0.12, 0.12, top);
+  const Eigen::Vector3d centre = box.X_WO.translation();
+  const double line_distance = MinDistance(robot, box, StraightLine(200));
+  ASSERT_LT(line_distance, -0.02) << "the box is not in the way of the straight sweep";
+  ASSERT_GT(MinDistance(robot, box, {kStart, kGoal}), 0.02);
+
+  Cell cell("depth-box", UniqueDomain(98));
+  const std::string box_file = (cell.dir / "box.yaml").string();
+  std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: " << List(centre) << ", size: " << List(box.size) << "}\n";
+  TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain);
+  framework::Node& node = *tc.node;
+  auto& cmd = node.Advertise(framework::topics::TaskCommand());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  std::optional<msg::TaskOutcome> outcome;
+  bool started = false;
+  std::vector<std::vector<double>> states;
+  struct Seen { double t; bool box; std::size_t n; };
+  std::vector<Seen> arrays;
+  const auto t_start = Clock::now();
+  auto since = [&] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };
+  framework::SubscribeOptions any{false};
+  node.Subscribe(framework::topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>([&](const msg::TaskOutcome& m, SI) {
+                   outcome = m;
+                 }), any);
+  node.Subscribe(framework::topics::JointStates(), std::function<void(const msg::JointState&, SI)>([&](const msg::JointState& m, SI) {
+                   if (started && !outcome) states.push_back(m.position);
+                 }));
+  msg::Obstacle seen_box;
+  node.Subscribe(framework::topics::Obstacles(), std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& a, SI) {
+                   bool b = false;
+                   for (const auto& o : a.obstacles)
+                     if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - centre).norm() < 0.04) {
+                       b = true;
+                       seen_box = o;
+                     }
+                   arrays.push_back({since(), b, a.obstacles.size()});
+                 }), any);
+  const std::string entitled = "node.entitled_writers./iplan/task/command=[test_cell]";
+  cell.Start("iplan-robot-sim", "robot_sim.yaml",
+             {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
+  cell.Start("iplan-trajopt", "trajopt.yaml", {"--set", entitled});
+  cell.Start("iplan-cloud", "cloud.yaml", {});
+  // No person in this test (human_body ""): the box is the only change in the scene.
+  cell.Start("iplan-perception", "perception.yaml",
+             DepthPerception({"--set", "perception.depth.simulated.human_body=\"\"", "--set",
+                              "perception.depth.simulated.added_scenes=[" + box_file + "]", "--set",
+                              "perception.depth.simulated.added_after=" + std::to_string(kBoxAppears)}));
+  // The cloud service reports the box, some time after it appears.
+  ASSERT_TRUE([&] {
+    while (since() < 40 && (arrays.empty() || !arrays.back().box)) node.SpinOnce(10ms);
+    return !arrays.empty() && arrays.back().box;
+  }()) << arrays.size() << " obstacle arrays, none with the box\n" << cell.procs["iplan-cloud"]->Stderr();
+  const double box_seen_at = arrays.back().t;
+  int before = 0, before_with_box = 0;
+  for (const Seen& s : arrays)
+    if (s.t < box_seen_at - 2.0) before += 1, before_with_box += s.box;
+  std::cout << "box on /iplan/obstacles at +" << box_seen_at << " s after start, " << before
+            << " obstacle arrays more than 2 s before it (" << before_with_box << " with the box); reported centre error "
+            << (Eigen::Vector3d(seen_box.centre.x, seen_box.centre.y, seen_box.centre.z) - centre).norm() << " m, half extents "
+            << seen_box.half_extents[0] << " " << seen_box.half_extents[1] << " " << seen_box.half_extents[2] << " m (true 0.06 0.06 "
+            << 0.5 * top << ")\n";
+  EXPECT_GT(before, 5) << "the box must appear while the cloud service is already running";
+  EXPECT_EQ(before_with_box, 0);
+
+  while (cmd.MatchedReaders() == 0 && since() < 45) node.SpinOnce(10ms);
+  msg::TaskCommand c;
+  c.header.stamp = msg::Now();
+  c.task_id = 7;
+  c.task_name = "reach_goal";
+  c.command = msg::TaskCommand::START;
+  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
+  c.goal_positions = kGoal;
+  c.time_limit = 30;
+  const auto start = Clock::now();
+  auto next_permit = start;
+  started = true;
+  cmd.Write(c);
+  while (!outcome && Clock::now() - start < 30s) {
+    if (Clock::now() >= next_permit) {
+      msg::SafetyPermit p;
+      p.header.stamp = msg::Now();
+      p.state = msg::SafetyPermit::PERMIT;
+      p.validity = 0.2;
+      p.source = "test";
+      permit.Write(p);
+      next_permit += 50ms;
+    }
+    node.SpinOnce(5ms);
+  }
+  int box_lost = 0;  // obstacle arrays without the box while the robot moved
+  for (const Seen& s : arrays) box_lost += s.t > box_seen_at && !s.box;
+  cell.Stop();
+  ASSERT_TRUE(outcome.has_value()) << "no outcome";
+  EXPECT_EQ(outcome->status, msg::TaskOutcome::SUCCEEDED) << outcome->reason;
+  ASSERT_GT(states.size(), 20u);
+  const double distance = MinDistance(robot, box, states);
+  std::cout << "straight sweep vs the box " << line_distance << " m; executed: " << states.size() << " joint states, closest "
+            << distance << " m to the true box, duration " << outcome->duration << " s; obstacle arrays without the box after it was seen: "
+            << box_lost << "\n";
+  EXPECT_GE(distance, 0.0);
 }
 
 }  // namespace
