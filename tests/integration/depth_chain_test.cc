@@ -22,6 +22,7 @@
 #include <fstream>
 #include <map>
 #include <optional>
+#include <sstream>
 
 #include <Eigen/Core>
 #include <gtest/gtest.h>
@@ -249,9 +250,10 @@ TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
 
 // ---------------------------------------------------------------- 2. box
 
-// A sweep of joint 1 across the front of the robot, the hand low over the table (as obstacle_avoidance_test).
-const std::vector<double> kStart = {0.45, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
-const std::vector<double> kGoal = {-0.75, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
+// A sweep of joint 1 across the front of the robot, the hand low over the table (obstacle_avoidance_test's, the
+// other way round: starting on the side away from the camera, the arm does not hide the box when it appears).
+const std::vector<double> kStart = {-0.75, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
+const std::vector<double> kGoal = {0.25, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};  // clear of the parts bin's (axis-aligned, larger) obstacle box
 constexpr double kBoxAppears = 4.0;  // s after perception's activation
 
 // Smallest signed distance (m, FCL) of the robot's spheres to `box` over the states.
@@ -328,6 +330,14 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
                    if (started && !outcome) states.push_back(m.position);
                  }));
   msg::Obstacle seen_box;
+  msg::ObstacleArray last_array;
+  auto describe = [&] {
+    std::ostringstream o;
+    for (const auto& b : last_array.obstacles)
+      o << "  obstacle " << b.id << " centre " << b.centre.x << " " << b.centre.y << " " << b.centre.z << " half extents "
+        << b.half_extents[0] << " " << b.half_extents[1] << " " << b.half_extents[2] << "\n";
+    return o.str();
+  };
   node.Subscribe(framework::topics::Obstacles(), std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& a, SI) {
                    bool b = false;
                    for (const auto& o : a.obstacles)
@@ -336,6 +346,7 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
                        seen_box = o;
                      }
                    arrays.push_back({since(), b, a.obstacles.size()});
+                   last_array = a;
                  }), any);
   const std::string entitled = "node.entitled_writers./iplan/task/command=[test_cell]";
   cell.Start("iplan-robot-sim", "robot_sim.yaml",
@@ -351,7 +362,7 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
   ASSERT_TRUE([&] {
     while (since() < 40 && (arrays.empty() || !arrays.back().box)) node.SpinOnce(10ms);
     return !arrays.empty() && arrays.back().box;
-  }()) << arrays.size() << " obstacle arrays, none with the box\n" << cell.procs["iplan-cloud"]->Stderr();
+  }()) << arrays.size() << " obstacle arrays, none with the box; the last:\n" << describe() << cell.procs["iplan-cloud"]->Stderr();
   const double box_seen_at = arrays.back().t;
   int before = 0, before_with_box = 0;
   for (const Seen& s : arrays)
@@ -389,8 +400,14 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
     }
     node.SpinOnce(5ms);
   }
-  int box_lost = 0;  // obstacle arrays without the box while the robot moved
-  for (const Seen& s : arrays) box_lost += s.t > box_seen_at && !s.box;
+  int box_lost = 0;  // obstacle arrays without the box (within 4 cm) after it was first seen, and the longest such gap
+  double gap = 0, last_with = box_seen_at;
+  for (const Seen& s : arrays) {
+    if (s.t <= box_seen_at) continue;
+    box_lost += !s.box;
+    if (s.box) last_with = s.t;
+    gap = std::max(gap, s.t - last_with);
+  }
   cell.Stop();
   ASSERT_TRUE(outcome.has_value()) << "no outcome";
   EXPECT_EQ(outcome->status, msg::TaskOutcome::SUCCEEDED) << outcome->reason;
@@ -398,7 +415,7 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
   const double distance = MinDistance(robot, box, states);
   std::cout << "straight sweep vs the box " << line_distance << " m; executed: " << states.size() << " joint states, closest "
             << distance << " m to the true box, duration " << outcome->duration << " s; obstacle arrays without the box after it was seen: "
-            << box_lost << "\n";
+            << box_lost << " (longest gap " << gap << " s)\n";
   EXPECT_GE(distance, 0.0);
 }
 
