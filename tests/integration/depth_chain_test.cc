@@ -222,7 +222,7 @@ TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
   // Without a stop the arm would run into the reaching hand: the planned arm against the true body at the same time.
   double unstopped = std::numeric_limits<double>::infinity();
   for (const auto& tr : run.truths) unstopped = std::min(unstopped, Distance(robot, PlannedAt(tr.t), tr.centres, radii));
-  EXPECT_LT(unstopped, -0.03);
+  EXPECT_LT(unstopped, -0.02);
   const PersonRun::Risk* stop = nullptr;
   for (const auto& r : run.risks)
     if (r.r.verdict == msg::CollisionRisk::PROTECTIVE_STOP && r.r.reason.find("/ points)") != std::string::npos) {
@@ -387,6 +387,7 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
   const auto start = Clock::now();
   auto next_permit = start;
   started = true;
+  const double t_command = since();
   cmd.Write(c);
   while (!outcome && Clock::now() - start < 30s) {
     if (Clock::now() >= next_permit) {
@@ -400,10 +401,11 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
     }
     node.SpinOnce(5ms);
   }
-  int box_lost = 0;  // obstacle arrays without the box (within 4 cm) after it was first seen, and the longest such gap
-  double gap = 0, last_with = box_seen_at;
+  const double t_done = since();
+  int box_lost = 0;  // obstacle arrays without the box (within 4 cm) while the arm moved, and the longest such gap
+  double gap = 0, last_with = t_command;
   for (const Seen& s : arrays) {
-    if (s.t <= box_seen_at) continue;
+    if (s.t <= t_command || s.t > t_done) continue;
     box_lost += !s.box;
     if (s.box) last_with = s.t;
     gap = std::max(gap, s.t - last_with);
@@ -414,9 +416,11 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
   ASSERT_GT(states.size(), 20u);
   const double distance = MinDistance(robot, box, states);
   std::cout << "straight sweep vs the box " << line_distance << " m; executed: " << states.size() << " joint states, closest "
-            << distance << " m to the true box, duration " << outcome->duration << " s; obstacle arrays without the box after it was seen: "
+            << distance << " m to the true box, duration " << outcome->duration << " s; obstacle arrays without the box while the arm moved: "
             << box_lost << " (longest gap " << gap << " s)\n";
   EXPECT_GE(distance, 0.0);
+  // The arm hiding part of the box does not make the cloud service forget it (trajopt would after obstacle_timeout).
+  EXPECT_LT(gap, 1.0);
 }
 
 }  // namespace
