@@ -282,100 +282,39 @@ std::vector<std::vector<double>> StraightLine(int n) {
   return line;
 }
 
-TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
-  const collision::RobotModel robot = Panda();
-  // The box stands on the table under the hand's lowest sphere at the middle of the straight sweep, 12 cm square,
-  // reaching 5 cm above the bottom of that sphere.
+// The box stands on the table under the hand's lowest sphere at the middle of the straight sweep, 12 cm square,
+// reaching 5 cm above the bottom of that sphere.
+collision::SceneObject BoxInTheWay(const collision::RobotModel& robot) {
   collision::RobotData d(robot);
   const std::vector<double> mid = StraightLine(2)[1];
   collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(mid.data(), 7), &d);
   const int hand = robot.FindLink("panda_hand");
+  auto bottom = [&](int k) { return d.p_WS(2, k) - robot.spheres[static_cast<std::size_t>(k)].radius; };
   int low = -1;
   for (int k = 0; k < d.p_WS.cols(); ++k)
-    if (robot.spheres[static_cast<std::size_t>(k)].link == hand &&
-        (low < 0 || d.p_WS(2, k) - robot.spheres[static_cast<std::size_t>(k)].radius <
-                        d.p_WS(2, low) - robot.spheres[static_cast<std::size_t>(low)].radius))
-      low = k;
-  ASSERT_GE(low, 0);
-  const double top = d.p_WS(2, low) - robot.spheres[static_cast<std::size_t>(low)].radius + 0.05;
-  ASSERT_GT(top, 0.1);
+    if (robot.spheres[static_cast<std::size_t>(k)].link == hand && (low < 0 || bottom(k) < bottom(low))) low = k;
   collision::SceneObject box;
   box.name = "box";
+  if (low < 0) return box;
+  const double top = bottom(low) + 0.05;
   box.X_WO.translation() = Eigen::Vector3d(d.p_WS(0, low), d.p_WS(1, low), 0.5 * top);
   box.size = Eigen::Vector3d(0.12, 0.12, top);
-  const Eigen::Vector3d centre = box.X_WO.translation();
-  const double line_distance = MinDistance(robot, box, StraightLine(200));
-  ASSERT_LT(line_distance, -0.02) << "the box is not in the way of the straight sweep";
-  ASSERT_GT(MinDistance(robot, box, {kStart, kGoal}), 0.02);
+  return box;
+}
 
-  Cell cell("depth-box", UniqueDomain(98));
-  const std::string box_file = (cell.dir / "box.yaml").string();
-  std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: " << List(centre) << ", size: " << List(box.size) << "}\n";
-  TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain);
-  framework::Node& node = *tc.node;
-  auto& cmd = node.Advertise(framework::topics::TaskCommand());
-  auto& permit = node.Advertise(framework::topics::SafetyPermit());
-  std::optional<msg::TaskOutcome> outcome;
-  bool started = false;
-  std::vector<std::vector<double>> states;
-  struct Seen { double t; bool box; std::size_t n; };
+struct BoxRun {
+  struct Seen { double t; bool box; };  // t: s since the test's start; the box: an obstacle within 4 cm of its centre
   std::vector<Seen> arrays;
-  const auto t_start = Clock::now();
-  auto since = [&] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };
-  framework::SubscribeOptions any{false};
-  node.Subscribe(framework::topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>([&](const msg::TaskOutcome& m, SI) {
-                   outcome = m;
-                 }), any);
-  node.Subscribe(framework::topics::JointStates(), std::function<void(const msg::JointState&, SI)>([&](const msg::JointState& m, SI) {
-                   if (started && !outcome) states.push_back(m.position);
-                 }));
-  msg::Obstacle seen_box;
-  msg::ObstacleArray last_array;
-  auto describe = [&] {
-    std::ostringstream o;
-    for (const auto& b : last_array.obstacles)
-      o << "  obstacle " << b.id << " centre " << b.centre.x << " " << b.centre.y << " " << b.centre.z << " half extents "
-        << b.half_extents[0] << " " << b.half_extents[1] << " " << b.half_extents[2] << "\n";
-    return o.str();
-  };
-  node.Subscribe(framework::topics::Obstacles(), std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& a, SI) {
-                   bool b = false;
-                   for (const auto& o : a.obstacles)
-                     if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - centre).norm() < 0.04) {
-                       b = true;
-                       seen_box = o;
-                     }
-                   arrays.push_back({since(), b, a.obstacles.size()});
-                   last_array = a;
-                 }), any);
-  const std::string entitled = "node.entitled_writers./iplan/task/command=[test_cell]";
-  cell.Start("iplan-robot-sim", "robot_sim.yaml",
-             {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
-  cell.Start("iplan-trajopt", "trajopt.yaml", {"--set", entitled});
-  cell.Start("iplan-cloud", "cloud.yaml", {});
-  // No person in this test (human_body ""): the box is the only change in the scene.
-  cell.Start("iplan-perception", "perception.yaml",
-             DepthPerception({"--set", "perception.depth.simulated.human_body=\"\"", "--set",
-                              "perception.depth.simulated.added_scenes=[" + box_file + "]", "--set",
-                              "perception.depth.simulated.added_after=" + std::to_string(kBoxAppears)}));
-  // The cloud service reports the box, some time after it appears.
-  ASSERT_TRUE([&] {
-    while (since() < 40 && (arrays.empty() || !arrays.back().box)) node.SpinOnce(10ms);
-    return !arrays.empty() && arrays.back().box;
-  }()) << arrays.size() << " obstacle arrays, none with the box; the last:\n" << describe() << cell.procs["iplan-cloud"]->Stderr();
-  const double box_seen_at = arrays.back().t;
-  int before = 0, before_with_box = 0;
-  for (const Seen& s : arrays)
-    if (s.t < box_seen_at - 2.0) before += 1, before_with_box += s.box;
-  std::cout << "box on /iplan/obstacles at +" << box_seen_at << " s after start, " << before
-            << " obstacle arrays more than 2 s before it (" << before_with_box << " with the box); reported centre error "
-            << (Eigen::Vector3d(seen_box.centre.x, seen_box.centre.y, seen_box.centre.z) - centre).norm() << " m, half extents "
-            << seen_box.half_extents[0] << " " << seen_box.half_extents[1] << " " << seen_box.half_extents[2] << " m (true 0.06 0.06 "
-            << 0.5 * top << ")\n";
-  EXPECT_GT(before, 5) << "the box must appear while the cloud service is already running";
-  EXPECT_EQ(before_with_box, 0);
+  msg::Obstacle seen_box;       // the newest report of the box
+  msg::ObstacleArray last;
+  std::optional<msg::TaskOutcome> outcome;
+  std::vector<std::vector<double>> states;  // executed joint positions from the command to the outcome
+  double box_seen_at = -1, t_command = -1, t_done = -1;
+};
 
-  while (cmd.MatchedReaders() == 0 && since() < 45) node.SpinOnce(10ms);
+// Commands the sweep and grants permits every 50 ms until the outcome (30 s at most).
+void Sweep(framework::Node& node, dds::Writer<msg::TaskCommand>& cmd, dds::Writer<msg::SafetyPermit>& permit, BoxRun* run) {
+  while (cmd.MatchedReaders() == 0) node.SpinOnce(10ms);
   msg::TaskCommand c;
   c.header.stamp = msg::Now();
   c.task_id = 7;
@@ -386,10 +325,8 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
   c.time_limit = 30;
   const auto start = Clock::now();
   auto next_permit = start;
-  started = true;
-  const double t_command = since();
   cmd.Write(c);
-  while (!outcome && Clock::now() - start < 30s) {
+  while (!run->outcome && Clock::now() - start < 30s) {
     if (Clock::now() >= next_permit) {
       msg::SafetyPermit p;
       p.header.stamp = msg::Now();
@@ -401,23 +338,95 @@ TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
     }
     node.SpinOnce(5ms);
   }
-  const double t_done = since();
-  int box_lost = 0;  // obstacle arrays without the box (within 4 cm) while the arm moved, and the longest such gap
-  double gap = 0, last_with = t_command;
-  for (const Seen& s : arrays) {
-    if (s.t <= t_command || s.t > t_done) continue;
+}
+
+// robot_sim, trajopt, cloud, perception (the box appears kBoxAppears s after its activation); once the cloud service
+// reports the box, the sweep.
+BoxRun RunBox(const collision::SceneObject& box) {
+  Cell cell("depth-box", UniqueDomain(98));
+  const Eigen::Vector3d centre = box.X_WO.translation();
+  const std::string box_file = (cell.dir / "box.yaml").string();
+  std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: " << List(centre) << ", size: " << List(box.size) << "}\n";
+  TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain);
+  framework::Node& node = *tc.node;
+  auto& cmd = node.Advertise(framework::topics::TaskCommand());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  BoxRun run;
+  const auto t_start = Clock::now();
+  auto since = [t_start] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };
+  framework::SubscribeOptions any{false};
+  node.Subscribe(framework::topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>([&](const msg::TaskOutcome& m, SI) {
+                   run.outcome = m;
+                 }), any);
+  node.Subscribe(framework::topics::JointStates(), std::function<void(const msg::JointState&, SI)>([&](const msg::JointState& m, SI) {
+                   if (run.t_command >= 0 && !run.outcome) run.states.push_back(m.position);
+                 }));
+  node.Subscribe(framework::topics::Obstacles(), std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& a, SI) {
+                   bool b = false;
+                   for (const auto& o : a.obstacles)
+                     if ((Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - centre).norm() < 0.04) b = true, run.seen_box = o;
+                   run.arrays.push_back({since(), b});
+                   run.last = a;
+                 }), any);
+  cell.Start("iplan-robot-sim", "robot_sim.yaml",
+             {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
+  cell.Start("iplan-trajopt", "trajopt.yaml", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]"});
+  cell.Start("iplan-cloud", "cloud.yaml", {});
+  // No person in this test (human_body ""): the box is the only change in the scene.
+  cell.Start("iplan-perception", "perception.yaml",
+             DepthPerception({"--set", "perception.depth.simulated.human_body=\"\"", "--set",
+                              "perception.depth.simulated.added_scenes=[" + box_file + "]", "--set",
+                              "perception.depth.simulated.added_after=" + std::to_string(kBoxAppears)}));
+  while (since() < 40 && (run.arrays.empty() || !run.arrays.back().box)) node.SpinOnce(10ms);
+  if (run.arrays.empty() || !run.arrays.back().box) {
+    std::ostringstream o;
+    for (const auto& b : run.last.obstacles)
+      o << "  obstacle " << b.id << " centre " << b.centre.x << " " << b.centre.y << " " << b.centre.z << "\n";
+    ADD_FAILURE() << run.arrays.size() << " obstacle arrays, none with the box; the last:\n" << o.str();
+    return run;
+  }
+  run.box_seen_at = run.arrays.back().t;
+  run.t_command = since();
+  Sweep(node, cmd, permit, &run);
+  run.t_done = since();
+  cell.Stop();
+  return run;
+}
+
+TEST(DepthChain, ABoxAppearingOnTheTableSeenOnlyByTheCameraIsAvoided) {
+  const collision::RobotModel robot = Panda();
+  const collision::SceneObject box = BoxInTheWay(robot);
+  ASSERT_GT(box.size.z(), 0.1) << "the sweep runs too low for a box under it";
+  const double line_distance = MinDistance(robot, box, StraightLine(200));
+  ASSERT_LT(line_distance, -0.02) << "the box is not in the way of the straight sweep";
+  ASSERT_GT(MinDistance(robot, box, {kStart, kGoal}), 0.02);
+  const BoxRun run = RunBox(box);
+  ASSERT_GE(run.box_seen_at, 0);
+
+  int before = 0, before_with_box = 0, box_lost = 0;  // box_lost: arrays without the box while the arm moved
+  double gap = 0, last_with = run.t_command;           // the longest time without it then
+  for (const auto& s : run.arrays) {
+    if (s.t < run.box_seen_at - 2.0) before += 1, before_with_box += s.box;
+    if (s.t <= run.t_command || s.t > run.t_done) continue;
     box_lost += !s.box;
     if (s.box) last_with = s.t;
     gap = std::max(gap, s.t - last_with);
   }
-  cell.Stop();
-  ASSERT_TRUE(outcome.has_value()) << "no outcome";
-  EXPECT_EQ(outcome->status, msg::TaskOutcome::SUCCEEDED) << outcome->reason;
-  ASSERT_GT(states.size(), 20u);
-  const double distance = MinDistance(robot, box, states);
-  std::cout << "straight sweep vs the box " << line_distance << " m; executed: " << states.size() << " joint states, closest "
-            << distance << " m to the true box, duration " << outcome->duration << " s; obstacle arrays without the box while the arm moved: "
-            << box_lost << " (longest gap " << gap << " s)\n";
+  const msg::Obstacle& o = run.seen_box;
+  std::cout << "box on /iplan/obstacles at +" << run.box_seen_at << " s after start, " << before
+            << " obstacle arrays more than 2 s before it (" << before_with_box << " with the box); reported centre error "
+            << (Eigen::Vector3d(o.centre.x, o.centre.y, o.centre.z) - box.X_WO.translation()).norm() << " m, half extents "
+            << o.half_extents[0] << " " << o.half_extents[1] << " " << o.half_extents[2] << " m (true " << (0.5 * box.size).transpose()
+            << ")\n";
+  EXPECT_GT(before, 5) << "the box must appear while the cloud service is already running";
+  EXPECT_EQ(before_with_box, 0);
+  ASSERT_TRUE(run.outcome.has_value()) << "no outcome";
+  EXPECT_EQ(run.outcome->status, msg::TaskOutcome::SUCCEEDED) << run.outcome->reason;
+  ASSERT_GT(run.states.size(), 20u);
+  const double distance = MinDistance(robot, box, run.states);
+  std::cout << "straight sweep vs the box " << line_distance << " m; executed: " << run.states.size() << " joint states, closest "
+            << distance << " m to the true box, duration " << run.outcome->duration
+            << " s; obstacle arrays without the box while the arm moved: " << box_lost << " (longest gap " << gap << " s)\n";
   EXPECT_GE(distance, 0.0);
   // The arm hiding part of the box does not make the cloud service forget it (trajopt would after obstacle_timeout).
   EXPECT_LT(gap, 1.0);
