@@ -6,9 +6,9 @@
 //    (perception.publish_skeleton=false: a person the tracker lost);
 //    iplan-cloud makes /iplan/human/points; iplan-collision-risk must stop
 //    iplan-robot-sim (which obeys only collision risk's permit) before the
-//    person's hand, reaching into the arm's path, is touched. This process
-//    plays trajopt (one scripted reach of the arm) and the supervisor's
-//    episode start (the person's script begins with it); contact is judged
+//    person, walking into the camera's view (perception.depth.simulated.
+//    human_after) with a hand reaching into the arm's path, is touched. This
+//    process plays trajopt (one scripted reach of the arm); contact is judged
 //    against the true body (/iplan/sim/human_truth) and the robot's spheres.
 // 2. A box that appears on the table while the cell runs, rendered by the
 //    simulated camera only (perception.depth.simulated.added_scenes /
