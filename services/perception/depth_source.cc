@@ -22,6 +22,10 @@ struct DepthSource::Impl {
   // simulated
   std::unique_ptr<SimulatedDepthCamera> camera;
   DepthScene fixed;  // the scene files' objects
+  DepthScene added;  // the added_scenes files' objects, rendered from added_after s after activation on
+  double added_after = 0;  // s
+  double human_after = 0;  // s after activation before the person is rendered (they walk into view then)
+  std::chrono::steady_clock::time_point activated;
   std::unique_ptr<collision::HumanBodyModel> body;
   std::unique_ptr<collision::RobotModel> robot;
   std::unique_ptr<collision::RobotData> robot_data;
@@ -90,23 +94,30 @@ framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection
   int seed = 1;
   sim.Read("seed", &seed);
   p.seed = static_cast<uint64_t>(seed);
-  std::vector<std::string> scenes = {"scenes/cell.yaml"};
+  std::vector<std::string> scenes = {"scenes/cell.yaml"}, added_scenes;
   std::string body_file = "humans/upper_body.yaml", robot_file = "robots/panda.yaml";
   sim.Read("scenes", &scenes);
+  sim.Read("added_scenes", &added_scenes);
+  sim.Read("added_after", &added_after, framework::NonNegative<double>());
+  sim.Read("human_after", &human_after, framework::NonNegative<double>());
   sim.Read("human_body", &body_file);
   sim.Read("robot", &robot_file);
   if (provider != "simulated" || !depth.Problems().empty()) return framework::Result::Ok();
   try {
     camera = std::make_unique<SimulatedDepthCamera>(p);
-    for (const std::string& f : scenes) {
-      for (const collision::SceneObject& o : collision::LoadSceneParams(sim.ResolvePath(f)).objects) {
-        if (o.shape == collision::SceneObject::Shape::kBox) {
-          fixed.boxes.push_back({o.X_WO, o.size});
-        } else {
-          fixed.cylinders.push_back({o.X_WO, o.radius, o.length});
+    auto load = [&sim](const std::vector<std::string>& files, DepthScene* into) {
+      for (const std::string& f : files) {
+        for (const collision::SceneObject& o : collision::LoadSceneParams(sim.ResolvePath(f)).objects) {
+          if (o.shape == collision::SceneObject::Shape::kBox) {
+            into->boxes.push_back({o.X_WO, o.size});
+          } else {
+            into->cylinders.push_back({o.X_WO, o.radius, o.length});
+          }
         }
       }
-    }
+    };
+    load(scenes, &fixed);
+    load(added_scenes, &added);
     if (!body_file.empty()) {
       body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(sim.ResolvePath(body_file)));
     }
@@ -178,7 +189,12 @@ bool DepthSource::Impl::Produce(framework::Node& node) {
     return true;
   }
   DepthScene scene = fixed;
-  if (body && truth) {
+  const double since = std::chrono::duration<double>(std::chrono::steady_clock::now() - activated).count();
+  if (since >= added_after) {
+    scene.boxes.insert(scene.boxes.end(), added.boxes.begin(), added.boxes.end());
+    scene.cylinders.insert(scene.cylinders.end(), added.cylinders.begin(), added.cylinders.end());
+  }
+  if (body && truth && since >= human_after) {
     const std::vector<double> radii = body->Radii();
     Eigen::Matrix3Xd J(3, body->num_joints());
     for (const std::vector<JointSample>& joints : truth()) {
@@ -220,6 +236,7 @@ void DepthSource::Activate(framework::Node& node, TruthFn truth) {
   Impl& s = *impl_;
   if (s.provider == "none") return;
   s.truth = std::move(truth);
+  s.activated = std::chrono::steady_clock::now();
   s.timer = node.AddTimer(std::chrono::nanoseconds(static_cast<int64_t>(1e9 / s.rate_hz)), [this, &node] { impl_->Tick(node); });
 }
 

@@ -25,6 +25,7 @@ class PerceptionService : public framework::Service {
     config.Read("rate_hz", &rate_hz_, framework::InRange(0.5, 1000.0));
     config.Read("frame_id", &frame_id_);
     config.Read("publish_truth", &publish_truth_);
+    config.Read("publish_skeleton", &publish_skeleton_);
     start_ = std::chrono::system_clock::now();
     ConfigSection syn = config.Section("synthetic");
     std::vector<SyntheticPersonParams> others;
@@ -52,7 +53,10 @@ class PerceptionService : public framework::Service {
                        framework::SubscribeOptions{false});
       }
     }
-    skeleton_writer_ = &node.Advertise(framework::topics::HumanSkeleton());
+    // Without the skeleton stream the person is seen (if at all) by the depth
+    // camera only: a person the skeleton tracker lost.
+    if (publish_skeleton_) skeleton_writer_ = &node.Advertise(framework::topics::HumanSkeleton());
+    node.SetDiagnosticValue("publish_skeleton", publish_skeleton_ ? "true" : "false");
     if (publish_truth_) truth_writer_ = &node.Advertise(framework::topics::HumanTruth());
     node.SetDiagnosticValue("provider", provider_);
     return depth_.Configure(config.Section("depth"), node);  // the depth camera, if any
@@ -138,7 +142,7 @@ class PerceptionService : public framework::Service {
     while (replay_->Next(now, &frame_)) {
       const msg::Time stamp = msg::TimeFromNanoseconds(start_ns_ + std::llround(frame_.play_time * 1e9));
       std::string err;
-      if (!skeleton_writer_->Write(ToMessage(frame_.joints, stamp, frame_.body_id), &err)) {
+      if (skeleton_writer_ && !skeleton_writer_->Write(ToMessage(frame_.joints, stamp, frame_.body_id), &err)) {
         node.log().warn("skeleton not published: {}", err);
       }
       ++published_;
@@ -186,7 +190,7 @@ class PerceptionService : public framework::Service {
     for (std::size_t i = 0; i < people_.size(); ++i) {
       const uint32_t body_id = static_cast<uint32_t>(i + 1);
       std::string err;
-      if (!skeleton_writer_->Write(ToMessage(people_[i]->Observe(t), stamp, body_id), &err)) {
+      if (skeleton_writer_ && !skeleton_writer_->Write(ToMessage(people_[i]->Observe(t), stamp, body_id), &err)) {
         node.log().warn("skeleton of body {} not published: {}", body_id, err);
       }
       if (truth_writer_) truth_writer_->Write(ToMessage(people_[i]->TruePose(t), stamp, body_id));
@@ -205,6 +209,7 @@ class PerceptionService : public framework::Service {
   double rate_hz_ = 30;
   std::string frame_id_ = "world";
   bool publish_truth_ = false;
+  bool publish_skeleton_ = true;
   SyntheticPersonParams params_;
   std::vector<std::unique_ptr<SyntheticPerson>> people_;  // body i + 1
   ScriptStart script_start_ = ScriptStart::kLoop;

@@ -25,6 +25,15 @@ void ClusterTracker::Observe(Track* t, const ClusterObservation& o) const {
   t->unseen = 0;
   const double edge = (o.box_max - o.box_min).maxCoeff();
   if (edge >= params_.person_extent) t->cls = TrackClass::kHuman;
+  // A static obstacle seen only in part (the arm passing in front of it, a
+  // hand over it): the visible box lies within the settled box, grown by
+  // static_motion. Its centroid moved, the object did not: it stays static,
+  // its box as settled.
+  if (t->cls == TrackClass::kStatic &&
+      (o.box_min.array() >= t->mean_min.array() - params_.static_motion).all() &&
+      (o.box_max.array() <= t->mean_max.array() + params_.static_motion).all()) {
+    return;
+  }
   if ((o.centroid - t->anchor).norm() > params_.static_motion) {
     // It moved: whatever moves in the cell is taken for a person (a box
     // being carried moves with a hand), for the rest of the track's life.

@@ -2,7 +2,9 @@
 // objects (a box left on the table) from moving ones (a person): a cluster
 // whose centroid stays within `static_motion` of where it settled for
 // `static_frames` frames is static; one that moves, or one as large as a
-// person, is human. Pure algorithm, no DDS types.
+// person, is human. A static one seen only in part (its visible box within
+// its settled box grown by `static_motion`: the arm in front of it) stays
+// static with its settled box. Pure algorithm, no DDS types.
 //
 // Frame: the cell frame W (`world`), metres; stamps in ns (wall clock).
 #pragma once

@@ -209,6 +209,17 @@ TEST(ClusterTrackerTest, SettlesMovesAndIsLost) {
   }
   EXPECT_EQ(t.tracks()[0].id, 1u);
   EXPECT_EQ(t.tracks()[0].first_seen_ns, 0);
+  // Seen only in part (its lower 2 cm: the arm hides the rest): the centroid
+  // is 4 cm lower, but the visible box is within the settled one: still static, box as settled.
+  ClusterObservation part = Obs({0.5, 0, 0.06});
+  part.box_min = Eigen::Vector3d(0.45, -0.05, 0.05);
+  part.box_max = Eigen::Vector3d(0.55, 0.05, 0.07);
+  t.Update({part}, 3);
+  ASSERT_EQ(t.tracks().size(), 1u);
+  EXPECT_EQ(t.tracks()[0].cls, TrackClass::kStatic);
+  EXPECT_NEAR(t.tracks()[0].mean_max.z(), 0.15, 1e-12);
+  t.Update({Obs({0.5, 0, 0.1})}, 3);
+  EXPECT_EQ(t.tracks()[0].cls, TrackClass::kStatic);
   // It moves 5 cm: a person (carried), same id.
   t.Update({Obs({0.55, 0, 0.1})}, 3);
   EXPECT_EQ(t.tracks()[0].cls, TrackClass::kHuman);
