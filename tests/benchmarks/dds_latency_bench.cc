@@ -456,9 +456,9 @@ int main(int argc, char** argv) {
   int domain = 150, iterations = 2000, runs = 3;
   double seconds = 60, throughput_seconds = 2;
   app.add_option("--role", role)->check(CLI::IsMember({"driver", "echo", "sink"}));
-  app.add_option("--impl", impl);
-  app.add_option("--vendor", vendor);
-  app.add_option("--msg", message);
+  app.add_option("--impl", impl, "echo/sink: the side to run; driver: only this impl (raw, framework)");
+  app.add_option("--vendor", vendor, "echo/sink: the vendor; driver: only this vendor (cyclonedds, fastdds)");
+  app.add_option("--msg", message, "echo/sink: the message; driver: only this message (skeleton, prediction)");
   app.add_option("--domain", domain);
   app.add_option("--seconds", seconds);
   app.add_option("--iterations", iterations, "ping-pongs per run")->capture_default_str();
@@ -479,9 +479,12 @@ int main(int argc, char** argv) {
             << "throughput msg/s (median)\n";
   int dom = domain;
   for (const std::string m : {"skeleton", "prediction"}) {
+    if (!message.empty() && m != message) continue;
     for (const std::string v : {"cyclonedds", "fastdds"}) {
+      if (!vendor.empty() && v != vendor) continue;
       double raw_p50 = 0;
       for (const std::string i : {"raw", "framework"}) {
+        if (!impl.empty() && i != impl) continue;
         const Case c{i, v, m};
         std::vector<double> p50s, p99s, rates;
         for (int r = 0; r < runs; ++r) {
