@@ -13,8 +13,15 @@
 // Throughput: the sender writes as fast as the writer accepts for a fixed
 // time (reliable, keep last 100); the receiver counts what it delivers.
 //
+// Raw and framework runs of a case alternate (raw 1, framework 1, raw 2, ...)
+// so that a change of the shared machine's speed between runs hits both; the
+// framework line also gives its overhead per pair of runs.
+//
 //   dds_latency_bench [--iterations N] [--runs R] [--json FILE]
-// (the echo/sink roles are the same binary started as child processes).
+//                     [--vendor V] [--msg M] [--impl I] [--lease-ms L]
+// (--vendor/--msg/--impl select cases; --lease-ms gives the framework's
+// topics a liveliness lease, as the services' topics have; the echo/sink
+// roles are the same binary started as child processes).
 #include <unistd.h>
 
 #include <chrono>
@@ -23,6 +30,8 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
+#include <sstream>
 #include <thread>
 
 #include <CLI/CLI.hpp>
@@ -62,8 +71,13 @@ namespace {
 
 const std::string kConfigDir = IPLAN_SOURCE_DIR "/config/dds";
 
+// Liveliness lease of the framework's topics, ms (--lease-ms); 0: infinite.
+// A finite lease is what the services' topics have: on Fast DDS each
+// framework reader then has a liveliness watch reader besides (docs/dds.md).
+int g_lease_ms = 0;
+
 idds::QosProfile BenchQos(int depth) {
-  idds::QosProfile q = idds::QosProfile::Command(std::chrono::nanoseconds(0));
+  idds::QosProfile q = idds::QosProfile::Command(std::chrono::milliseconds(g_lease_ms));
   q.depth = depth;
   return q;
 }
@@ -448,6 +462,61 @@ uint64_t Source(const Case& c, int domain, double seconds) {
   return n;
 }
 
+// ------------------------------------------------------------------ driver
+struct CaseRuns {
+  std::vector<double> p50s, p99s, rates;  // one per run
+};
+
+// One run of case `c`: a ping-pong latency run on `latency_domain`, then a
+// throughput run on `throughput_domain`.
+void MeasureRun(const std::string& self, const Case& c, int latency_domain, int throughput_domain, int iterations,
+                double throughput_seconds, CaseRuns* out) {
+  {
+    core::Process echo({self, "--role", "echo", "--impl", c.impl, "--vendor", c.vendor, "--msg", c.msg, "--domain",
+                        std::to_string(latency_domain), "--seconds", "120", "--lease-ms", std::to_string(g_lease_ms)});
+    echo.WaitForOutput("ready", 20s);
+    const auto s = core::Summarize(Ping(c, latency_domain, 200, iterations));
+    out->p50s.push_back(s.p50);
+    out->p99s.push_back(s.p99);
+  }
+  core::Process sink({self, "--role", "sink", "--impl", c.impl, "--vendor", c.vendor, "--msg", c.msg, "--domain",
+                      std::to_string(throughput_domain), "--seconds", std::to_string(throughput_seconds + 3),
+                      "--lease-ms", std::to_string(g_lease_ms)});
+  sink.WaitForOutput("ready", 20s);
+  Source(c, throughput_domain, throughput_seconds);
+  sink.Wait(30s);
+  const std::string text = sink.Stdout();
+  const auto pos = text.find("rate ");
+  out->rates.push_back(pos == std::string::npos ? 0.0 : std::stod(text.substr(pos + 5)));
+}
+
+std::string MedianSpread(const std::vector<double>& v, int precision) {
+  const auto s = core::Summarize(v);
+  std::ostringstream o;
+  o << std::fixed << std::setprecision(precision) << s.p50 << " [" << s.min << ", " << s.max << "]";
+  return o.str();
+}
+
+// One line of the table; with `raw`, also what the framework adds to the raw
+// p50: from the medians, and per pair of runs (run r of raw with run r of the
+// framework).
+void PrintCase(const std::string& m, const std::string& v, const std::string& i, const CaseRuns& cr,
+               const CaseRuns* raw) {
+  std::cout << std::left << std::setw(11) << m << std::setw(11) << v << std::setw(10) << i << std::setw(30)
+            << MedianSpread(cr.p50s, 1) << std::setw(30) << MedianSpread(cr.p99s, 1) << std::fixed
+            << std::setprecision(0) << core::Summarize(cr.rates).p50;
+  if (raw && !raw->p50s.empty()) {
+    const double raw_p50 = core::Summarize(raw->p50s).p50;
+    std::vector<double> pairs;
+    for (std::size_t r = 0; r < cr.p50s.size() && r < raw->p50s.size(); ++r) {
+      pairs.push_back(100.0 * (cr.p50s[r] - raw->p50s[r]) / raw->p50s[r]);
+    }
+    std::cout << "   framework adds " << std::setprecision(1) << 100.0 * (core::Summarize(cr.p50s).p50 - raw_p50) / raw_p50
+              << " % to the raw p50 (per run pair: " << MedianSpread(pairs, 1) << " %)";
+  }
+  std::cout << std::endl;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -456,15 +525,21 @@ int main(int argc, char** argv) {
   int domain = 150, iterations = 2000, runs = 3;
   double seconds = 60, throughput_seconds = 2;
   app.add_option("--role", role)->check(CLI::IsMember({"driver", "echo", "sink"}));
-  app.add_option("--impl", impl);
-  app.add_option("--vendor", vendor);
-  app.add_option("--msg", message);
+  app.add_option("--impl", impl, "echo/sink: the side to run; driver: only this impl")
+      ->check(CLI::IsMember({"raw", "framework"}));
+  app.add_option("--vendor", vendor, "echo/sink: the vendor; driver: only this vendor")
+      ->check(CLI::IsMember({"cyclonedds", "fastdds"}));
+  app.add_option("--msg", message, "echo/sink: the message; driver: only this message")
+      ->check(CLI::IsMember({"skeleton", "prediction"}));
   app.add_option("--domain", domain);
   app.add_option("--seconds", seconds);
   app.add_option("--iterations", iterations, "ping-pongs per run")->capture_default_str();
   app.add_option("--runs", runs, "runs per case (median and spread are over runs)")->capture_default_str();
   app.add_option("--throughput-seconds", throughput_seconds)->capture_default_str();
   app.add_option("--json", json_file, "also write the results as JSON");
+  app.add_option("--lease-ms", g_lease_ms, "liveliness lease of the framework's topics, ms (0: infinite)")
+      ->check(CLI::Range(0, 60000))
+      ->capture_default_str();
   CLI11_PARSE(app, argc, argv);
   if (role == "echo") return Echo({impl, vendor, message}, domain, seconds);
   if (role == "sink") return Sink({impl, vendor, message}, domain, seconds);
@@ -473,53 +548,34 @@ int main(int argc, char** argv) {
   const std::string self = core::ExecutableDir() + "/dds_latency_bench";
   nlohmann::json results = nlohmann::json::array();
   std::cout << "one-way latency = round trip / 2 over loopback, " << iterations << " ping-pongs x " << runs
-            << " runs; throughput over " << throughput_seconds << " s\n\n";
+            << " runs; throughput over " << throughput_seconds << " s; framework lease "
+            << (g_lease_ms > 0 ? std::to_string(g_lease_ms) + " ms" : std::string("infinite")) << "\n\n";
   std::cout << std::left << std::setw(11) << "message" << std::setw(11) << "vendor" << std::setw(10) << "impl"
             << std::setw(30) << "p50 us (median [min, max])" << std::setw(30) << "p99 us (median [min, max])"
             << "throughput msg/s (median)\n";
   int dom = domain;
   for (const std::string m : {"skeleton", "prediction"}) {
+    if (!message.empty() && m != message) continue;
     for (const std::string v : {"cyclonedds", "fastdds"}) {
-      double raw_p50 = 0;
+      if (!vendor.empty() && v != vendor) continue;
+      std::vector<std::string> impls;
       for (const std::string i : {"raw", "framework"}) {
-        const Case c{i, v, m};
-        std::vector<double> p50s, p99s, rates;
-        for (int r = 0; r < runs; ++r) {
-          {
-            const int d = dom++ % 200 + 1;
-            core::Process echo({self, "--role", "echo", "--impl", i, "--vendor", v, "--msg", m, "--domain",
-                                std::to_string(d), "--seconds", "120"});
-            echo.WaitForOutput("ready", 20s);
-            const auto s = core::Summarize(Ping(c, d, 200, iterations));
-            p50s.push_back(s.p50);
-            p99s.push_back(s.p99);
-          }
-          {
-            const int d = dom++ % 200 + 1;
-            core::Process sink({self, "--role", "sink", "--impl", i, "--vendor", v, "--msg", m, "--domain",
-                                std::to_string(d), "--seconds", std::to_string(throughput_seconds + 3)});
-            sink.WaitForOutput("ready", 20s);
-            Source(c, d, throughput_seconds);
-            sink.Wait(30s);
-            const std::string out = sink.Stdout();
-            const auto pos = out.find("rate ");
-            rates.push_back(pos == std::string::npos ? 0.0 : std::stod(out.substr(pos + 5)));
-          }
+        if (impl.empty() || i == impl) impls.push_back(i);
+      }
+      // Raw and framework alternate run by run, so a change of the shared
+      // machine's speed between runs hits both alike (paired runs).
+      std::map<std::string, CaseRuns> by_impl;
+      for (int r = 0; r < runs; ++r) {
+        for (const std::string& i : impls) {
+          const int latency_domain = dom++ % 200 + 1, throughput_domain = dom++ % 200 + 1;
+          MeasureRun(self, {i, v, m}, latency_domain, throughput_domain, iterations, throughput_seconds, &by_impl[i]);
         }
-        const auto a = core::Summarize(p50s), b = core::Summarize(p99s), t = core::Summarize(rates);
-        if (i == "raw") raw_p50 = a.p50;
-        std::ostringstream p50txt, p99txt;
-        p50txt << std::fixed << std::setprecision(1) << a.p50 << " [" << a.min << ", " << a.max << "]";
-        p99txt << std::fixed << std::setprecision(1) << b.p50 << " [" << b.min << ", " << b.max << "]";
-        std::cout << std::left << std::setw(11) << m << std::setw(11) << v << std::setw(10) << i << std::setw(30)
-                  << p50txt.str() << std::setw(30) << p99txt.str() << std::fixed << std::setprecision(0) << t.p50;
-        if (i == "framework" && raw_p50 > 0) {
-          std::cout << "   framework adds " << std::setprecision(1) << 100.0 * (a.p50 - raw_p50) / raw_p50
-                    << " % to the raw p50";
-        }
-        std::cout << std::endl;
-        results.push_back({{"message", m}, {"vendor", v}, {"impl", i}, {"p50_us_runs", p50s},
-                           {"p99_us_runs", p99s}, {"throughput_msgs_per_s_runs", rates}});
+      }
+      for (const std::string& i : impls) {
+        const CaseRuns& cr = by_impl[i];
+        PrintCase(m, v, i, cr, i == "framework" && by_impl.count("raw") ? &by_impl["raw"] : nullptr);
+        results.push_back({{"message", m}, {"vendor", v}, {"impl", i}, {"p50_us_runs", cr.p50s},
+                           {"p99_us_runs", cr.p99s}, {"throughput_msgs_per_s_runs", cr.rates}});
       }
     }
   }
