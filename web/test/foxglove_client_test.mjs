@@ -28,7 +28,7 @@ const xyz = new Float32Array(40 * 3).map((_, i) => (i % 3 === 0 ? 0.5 + 0.01 * M
 const cloud = { header: { frame_id: "world" }, height: 1, width: 40, is_bigendian: false, point_step: 12, row_step: 480,
   is_dense: true, data: Array.from(new Uint8Array(xyz.buffer)),
   fields: ["x", "y", "z"].map((name, i) => ({ name, offset: 4 * i, datatype: 7, count: 1 })) };
-const pubs = [pub("/iplan/human/skeleton", skeleton), pub("/joint_states", joints), pub("/iplan/obstacles", cloud)];
+const pubs = [pub("/iplan/human/skeleton", skeleton), pub("/joint_states", joints), pub("/iplan/depth/points", cloud)];
 
 const ws = new WebSocket(`ws://127.0.0.1:${viewer.port}/`, [FoxgloveClient.SUPPORTED_SUBPROTOCOL]);
 ws.binaryType = "arraybuffer";
