@@ -6,8 +6,14 @@
 // touches the person's true body, and trajectories come with an end-to-end
 // latency. The intent model is trained from the synthetic person on the first
 // run (cached in config/models).
+//
+// However `iplan demo` ends (SIGINT, SIGKILL), it leaves no service of its
+// cell running behind it.
+#include <signal.h>
+
 #include <filesystem>
 #include <fstream>
+#include <thread>
 
 #include <gtest/gtest.h>
 #include <nlohmann/json.hpp>
@@ -60,6 +66,58 @@ TEST_P(CellEpisode, TasksCompleteWithoutContact) {
   }
   std::filesystem::remove_all(dir);
 }
+
+// Pids of the running (not zombie) iplan services started with `--domain D`.
+std::vector<int> ServicesOnDomain(int domain) {
+  std::vector<int> pids;
+  for (const auto& e : std::filesystem::directory_iterator("/proc")) {
+    const std::string name = e.path().filename();
+    if (name.find_first_not_of("0123456789") != std::string::npos) continue;
+    std::ifstream cmd(e.path() / "cmdline");
+    std::vector<std::string> args;
+    for (std::string a; std::getline(cmd, a, '\0');) args.push_back(a);
+    if (args.empty() || args[0].find("/iplan-") == std::string::npos) continue;
+    bool on_domain = false;
+    for (size_t i = 0; i + 1 < args.size(); ++i) on_domain |= args[i] == "--domain" && args[i + 1] == std::to_string(domain);
+    std::ifstream stat(e.path() / "stat");
+    std::string line;
+    std::getline(stat, line);
+    const auto close = line.rfind(')');
+    const bool zombie = close != std::string::npos && close + 2 < line.size() && line[close + 2] == 'Z';
+    if (on_domain && !zombie) pids.push_back(std::stoi(name));
+  }
+  return pids;
+}
+
+class DemoEnds : public ::testing::TestWithParam<int> {};
+
+// The demo is ended by a signal while its cell runs: within 2 s of the
+// demo's end no service of that cell is left (SIGKILL: no clean-up code of
+// the demo runs; the services get their parent-death signal).
+TEST_P(DemoEnds, NoServiceOutlivesTheDemo) {
+  const int sig = GetParam();
+  const int domain = UniqueDomain(37 + sig);
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-demo-ends-" + std::to_string(getpid()));
+  std::filesystem::remove_all(dir);
+  Process demo({BinPath("iplan"), "demo", "--episodes", "20", "--timeout", "300", "--state-dir", dir.string(),
+                "--domain", std::to_string(domain), "--config-dir", std::string(IPLAN_SOURCE_DIR) + "/config"});
+  ASSERT_TRUE(demo.WaitForOutput("episodes: 20", 120s)) << demo.Stdout() << demo.Stderr();
+  // Every service is up (each announces itself by its diagnostics soon after).
+  std::this_thread::sleep_for(2s);
+  const auto before = ServicesOnDomain(domain);
+  ASSERT_EQ(before.size(), 6u) << "the cell's services, found by their --domain " << domain << "\n" << demo.Stdout();
+  demo.Signal(sig);
+  ASSERT_TRUE(demo.Wait(30s).has_value()) << "demo did not end on signal " << sig;
+  const auto end = std::chrono::steady_clock::now() + 2s;
+  while (!ServicesOnDomain(domain).empty() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
+  const auto left = ServicesOnDomain(domain);
+  for (const int pid : left) kill(pid, SIGKILL);
+  EXPECT_TRUE(left.empty()) << left.size() << " services still running 2 s after the demo ended by signal " << sig;
+  std::filesystem::remove_all(dir);
+}
+
+INSTANTIATE_TEST_SUITE_P(Signals, DemoEnds, ::testing::Values(SIGINT, SIGKILL),
+                         [](const auto& info) { return info.param == SIGKILL ? "sigkill" : "sigint"; });
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellEpisode,
                          ::testing::Values(Variant{"cyclonedds", {"--dds", "cyclonedds"}},

@@ -67,7 +67,9 @@ int RunView(const ViewOptions& o) {
           *participant, std::move(scene), bo,
           [&](std::size_t c, uint64_t t, const std::string& j) { server->Publish(ids[c], t, j); },
           [&](std::size_t c) { return server->HasSubscribers(ids[c]); });
-      for (const auto& c : bridge->channels()) ids.push_back(server->AddChannel({c.topic, c.schema_name, c.schema}));
+      for (const auto& c : bridge->channels()) {
+        ids.push_back(server->AddChannel({c.topic, c.schema_name, c.schema, "json", c.topic != viewer::kCellTopic}));
+      }
     }
   } catch (const std::exception& e) {
     std::cerr << "iplan view: " << e.what() << "\n";

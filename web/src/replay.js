@@ -9,7 +9,7 @@ import { decompress } from "fzstd";
 export class Replay {
   constructor(url, deliver, reset) {
     this.url = url;
-    this.deliver = deliver;  // (topic, json, logTimeNs) => void
+    this.deliver = deliver;  // (topic, json) => void
     this.reset = reset;
     this.messages = [];
     this.index = 0;
@@ -53,7 +53,7 @@ export class Replay {
     while (this.index < this.messages.length && this.messages[this.index].t <= until) {
       const m = this.messages[this.index++];
       this.state.delivered[m.topic] = (this.state.delivered[m.topic] ?? 0) + 1;
-      this.deliver(m.topic, this.parse(m), m.t);
+      this.deliver(m.topic, this.parse(m));
     }
     this.state.t = Math.min(t, this.state.duration);
     this.state.finished = this.index >= this.messages.length;
@@ -78,9 +78,9 @@ export class Replay {
     for (let i = 0; i < end; i++) {
       const m = this.messages[i];
       if (m.entity !== null) latestScene.set(m.entity, m);
-      else if (m.topic !== "/iplan/viewer/scene") this.deliver(m.topic, this.parse(m), m.t);
+      else if (m.topic !== "/iplan/viewer/scene") this.deliver(m.topic, this.parse(m));
     }
-    for (const m of latestScene.values()) this.deliver(m.topic, this.parse(m), m.t);
+    for (const m of latestScene.values()) this.deliver(m.topic, this.parse(m));
     this.index = end;
     this.state.delivered = {};  // counts restart: they count in-order playback only
     this.state.t = t;

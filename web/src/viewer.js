@@ -22,7 +22,11 @@ const state = {
   mode: params.has("replay") ? "replay" : "live",
   status: "connecting",  // connected | disconnected | connecting | replay
   connected: false,      // WebSocket open
-  cellAlive: false,      // the viewer hears the cell
+  cellAlive: false,      // the viewer hears the cell (as of now, see cellAge)
+  cellAgeS: null,        // s since the cell's last message, as the page knows now
+  lagS: 0,               // how late the page got the viewer's last message (s)
+  maxLagS: 0,            // the most it was behind on this page
+  skippedFrames: 0,      // frames not drawn to catch up with the stream
   channels: [],
   received: {},          // messages per topic
   entities: {},
@@ -37,7 +41,12 @@ const state = {
 // update per entity per frame however fast they come, and parses only those
 // (an update is a JSON text until then).
 const pending = new Map();  // entity id -> SceneUpdate (object or JSON text)
-let lastCellStatus = 0;
+// The latest /iplan/viewer/cell status, when it came, and how late.
+let cellStatus = null;
+// Clock offset page - viewer (ms): the smallest (receipt - stamp) seen on
+// this connection, i.e. the transit of the promptest message. A message
+// received later than that was queued (the page or the network is behind).
+let minOffsetMs = Infinity;
 
 // The entity id is the first "id" of the text (keys are sorted; no
 // primitive has one); the static scene's comes after its cubes.
@@ -51,9 +60,9 @@ function applyPending() {
   pending.clear();
 }
 
-// `m`: the message, parsed or as JSON text. The viewer sends one entity per
+// `m`: the message, parsed or as JSON text; `lagMs`: how late it came. The viewer sends one entity per
 // scene update and no deletions; any other update is applied at once.
-function deliver(topic, m) {
+function deliver(topic, m, lagMs = 0) {
   state.received[topic] = (state.received[topic] ?? 0) + 1;
   if (topic === SCENE && typeof m === "string") {
     pending.set(entityId(m), m);
@@ -64,25 +73,37 @@ function deliver(topic, m) {
     if ((m.entities ?? []).length === 1 && !(m.deletions ?? []).length) pending.set(m.entities[0].id, m);
     else { applyPending(); view.apply(m); }
   } else if (topic === CELL) {
-    state.cellAlive = !!m.alive;
-    lastCellStatus = performance.now();
+    cellStatus = { ...m, receivedMs: performance.now(), lagMs };
+    updateStatus();
   } else {
     applyStrip(state.strip, topic, m);
   }
 }
 
 function setStatus(s) {
+  if (state.status !== s) state.statusSinceMs = Date.now();  // wall clock, for tests
   state.status = s;
   const el = document.getElementById("status");
   el.textContent = s;
   el.className = `badge ${s === "connected" || s === "replay" ? "ok" : "bad"}`;
 }
 
+// The cell is alive while its last message, as of now, is at most
+// `alive_after_s` old: the age the viewer stated, plus how late the status
+// reached the page, plus the time since. So a page that is behind, or a
+// viewer that went quiet, turns "disconnected" alive_after_s after the
+// cell's last message, however slow the machine.
 function updateStatus() {
   if (state.mode === "replay") return;
-  // The cell counts as gone when the viewer says so or stops saying anything.
-  const fresh = performance.now() - lastCellStatus < 2000;
-  setStatus(state.connected && state.cellAlive && fresh ? "connected" : "disconnected");
+  let age = null;
+  if (state.connected && cellStatus && cellStatus.last_message_age_s >= 0) {
+    age = cellStatus.last_message_age_s + (cellStatus.lagMs + performance.now() - cellStatus.receivedMs) / 1000;
+  }
+  state.cellAgeS = age;
+  state.cellAlive = age !== null && !!cellStatus.alive && age <= (cellStatus.alive_after_s ?? 1);
+  state.aliveAfterS = cellStatus?.alive_after_s ?? null;
+  state.statusPeriodS = cellStatus?.status_period_s ?? null;
+  setStatus(state.cellAlive ? "connected" : "disconnected");
 }
 
 function connect() {
@@ -90,7 +111,11 @@ function connect() {
   const client = new FoxgloveClient({ ws });
   const byChannel = new Map(), bySubscription = new Map();
   const decoder = new TextDecoder();
-  client.on("open", () => { state.connected = true; });
+  client.on("open", () => {
+    state.connected = true;
+    minOffsetMs = Infinity;  // a new connection, maybe to another viewer
+    cellStatus = null;
+  });
   client.on("advertise", (channels) => {
     for (const c of channels) {
       byChannel.set(c.id, c);
@@ -100,13 +125,19 @@ function connect() {
       }
     }
   });
-  client.on("message", ({ subscriptionId, data }) => {
+  client.on("message", ({ subscriptionId, timestamp, data }) => {
     const topic = bySubscription.get(subscriptionId);
-    if (topic) deliver(topic, decoder.decode(data));
+    if (!topic) return;
+    const offset = Date.now() - Number(timestamp / 1000000n);
+    minOffsetMs = Math.min(minOffsetMs, offset);
+    const lagMs = offset - minOffsetMs;
+    state.lagS = lagMs / 1000;
+    state.maxLagS = Math.max(state.maxLagS, state.lagS);
+    deliver(topic, decoder.decode(data), lagMs);
   });
   client.on("close", () => {
     state.connected = false;
-    state.cellAlive = false;
+    cellStatus = null;
     state.channels = [];
     updateStatus();
     setTimeout(connect, 1000);  // the viewer may come back
@@ -122,7 +153,8 @@ function togglePause() {
 document.getElementById("pause").addEventListener("click", togglePause);
 window.addEventListener("keydown", (e) => { if (e.code === "Space") togglePause(); });
 
-let replay = null, lastFrame = performance.now();
+let replay = null, lastFrame = performance.now(), lastRender = 0;
+const LAG_SKIP_S = 0.25, MIN_FRAME_MS = 500;
 async function startReplay() {
   setStatus("replay");
   replay = new Replay(params.get("replay"), deliver, () => { view.clear(); state.strip = emptyStrip(); });
@@ -171,6 +203,14 @@ function frame(now) {
   }
   if (replay?.state.loaded) showReplayTime();
   lastFrame = now;
+  // Behind the live stream (messages wait in the socket while the machine
+  // renders): skip drawing (but draw at least 2 frames a second), so the page catches up
+  // instead of falling further behind.
+  if (state.mode === "live" && state.lagS > LAG_SKIP_S && now - lastRender < MIN_FRAME_MS) {
+    state.skippedFrames += 1;
+    return;
+  }
+  lastRender = now;
   const t0 = performance.now();
   if (!state.paused) applyPending();
   controls.update();
@@ -185,7 +225,8 @@ function frame(now) {
     fpsSince = now;
     adaptResolution();
     document.getElementById("fps").textContent = `${state.fps.toFixed(0)} fps` +
-      (state.resolution < 0.99 ? ` (${Math.round(100 * state.resolution)} % res.)` : "");
+      (state.resolution < 0.99 ? ` (${Math.round(100 * state.resolution)} % res.)` : "") +
+      (state.mode === "live" && state.lagS > LAG_SKIP_S ? `, ${state.lagS.toFixed(1)} s behind` : "");
   }
   state.entities = view.summaries();
   renderStrip(state.strip);
@@ -205,6 +246,6 @@ if (state.mode === "replay") {
 } else {
   setStatus("connecting");
   connect();
-  setInterval(updateStatus, 250);
+  setInterval(updateStatus, 100);
 }
 requestAnimationFrame(frame);

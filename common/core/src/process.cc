@@ -2,10 +2,11 @@
 
 #include <fcntl.h>
 #include <signal.h>
-#include <spawn.h>
+#include <sys/prctl.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <cerrno>
 #include <cstdlib>
 #include <cstring>
 #include <fstream>
@@ -52,20 +53,69 @@ Process::Process(std::vector<std::string> argv, std::map<std::string, std::strin
   for (auto& s : argv) args.push_back(s.data());
   args.push_back(nullptr);
 
-  posix_spawn_file_actions_t fa;
-  posix_spawn_file_actions_init(&fa);
-  posix_spawn_file_actions_addopen(&fa, 0, "/dev/null", O_RDONLY, 0);
-  if (!inherit_output) {
-    posix_spawn_file_actions_addopen(&fa, 1, out_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
-    posix_spawn_file_actions_addopen(&fa, 2, err_path_.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+  // fork + exec rather than posix_spawn: the child has to ask for a
+  // parent-death signal before it runs the executable, so that a child
+  // never outlives the process that started it, however that one ends
+  // (SIGKILL and crashes included). Between fork and exec only
+  // async-signal-safe calls (the parent may have DDS threads).
+  const char* out = out_path_.c_str();
+  const char* err = err_path_.c_str();
+  int report[2];  // the child writes errno here when it cannot start
+  if (pipe2(report, O_CLOEXEC) != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(errno));
+  const pid_t parent = getpid();
+  pid_ = fork();
+  if (pid_ < 0) {
+    const int e = errno;
+    close(report[0]);
+    close(report[1]);
+    throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(e));
   }
-  const int rc = posix_spawn(&pid_, args[0], &fa, nullptr, args.data(), envp.data());
-  posix_spawn_file_actions_destroy(&fa);
-  if (rc != 0) throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(rc));
+  if (pid_ == 0) {
+    close(report[0]);
+    auto die = [&](int e) {
+      ssize_t ignored = write(report[1], &e, sizeof e);
+      (void)ignored;
+      _exit(127);
+    };
+    if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0) die(errno);
+    if (getppid() != parent) _exit(128 + SIGTERM);  // the parent died before the line above
+    const int in = open("/dev/null", O_RDONLY);
+    if (in < 0 || dup2(in, 0) < 0) die(errno);
+    if (!inherit_output) {
+      const int o = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (o < 0 || dup2(o, 1) < 0) die(errno);
+      const int e = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      if (e < 0 || dup2(e, 2) < 0) die(errno);
+    }
+    // The parent's signal dispositions that are not defaults (an ignored
+    // SIGINT, say) must not reach the service, nor its blocked mask.
+    struct sigaction dfl {};
+    dfl.sa_handler = SIG_DFL;
+    for (const int sig : {SIGINT, SIGTERM, SIGPIPE, SIGHUP}) sigaction(sig, &dfl, nullptr);
+    sigset_t none;
+    sigemptyset(&none);
+    sigprocmask(SIG_SETMASK, &none, nullptr);
+    execve(args[0], args.data(), envp.data());
+    die(errno);
+  }
+  close(report[1]);
+  int child_errno = 0;
+  ssize_t n;
+  do {
+    n = read(report[0], &child_errno, sizeof child_errno);
+  } while (n < 0 && errno == EINTR);
+  close(report[0]);
+  if (n == static_cast<ssize_t>(sizeof child_errno)) {
+    int status = 0;
+    waitpid(pid_, &status, 0);
+    pid_ = -1;
+    exit_code_ = 127;
+    throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(child_errno));
+  }
 }
 
 Process::~Process() {
-  if (Running()) {
+  if (pid_ > 0 && Running()) {
     kill(pid_, SIGKILL);
     Wait(std::chrono::milliseconds(5000));
   }
@@ -76,7 +126,7 @@ Process::~Process() {
 }
 
 void Process::Signal(int sig) {
-  if (!exit_code_) kill(pid_, sig);
+  if (!exit_code_ && pid_ > 0) kill(pid_, sig);
 }
 
 std::optional<int> Process::Wait(std::chrono::milliseconds timeout) {

@@ -157,8 +157,9 @@ struct CellBridge::Impl {
     const double age = last_message == Clock::time_point::min() ? -1.0
                                                                  : std::chrono::duration<double>(now - last_message).count();
     alive = age >= 0 && age <= o.alive_after;
-    Emit(cell_channel, NowNs(), {{"alive", alive}, {"last_message_age_s", age}, {"forwarded", stats.forwarded},
-                                 {"scene_rejected", stats.scene_rejected}});
+    Emit(cell_channel, NowNs(),
+         {{"alive", alive}, {"last_message_age_s", age}, {"alive_after_s", o.alive_after},
+          {"status_period_s", o.status_period}, {"forwarded", stats.forwarded}, {"scene_rejected", stats.scene_rejected}});
   }
 };
 
@@ -178,8 +179,13 @@ CellBridge::CellBridge(dds::Participant& participant, std::optional<SceneBuilder
   s.cell_channel = s.channels.size();
   const json cell_schema = {{"type", "object"},
                             {"title", "iplan viewer cell status"},
-                            {"properties", {{"alive", {{"type", "boolean"}}}, {"last_message_age_s", {{"type", "number"}}},
-                                            {"forwarded", {{"type", "integer"}}}, {"scene_rejected", {{"type", "integer"}}}}}};
+                            {"properties",
+                             {{"alive", {{"type", "boolean"}}},
+                              {"last_message_age_s", {{"type", "number"}}},
+                              {"alive_after_s", {{"type", "number"}}},
+                              {"status_period_s", {{"type", "number"}}},
+                              {"forwarded", {{"type", "integer"}}},
+                              {"scene_rejected", {{"type", "integer"}}}}}};
   s.channels.push_back({kCellTopic, "iplan_viewer/CellStatus", cell_schema.dump()});
   s.counts.assign(s.channels.size(), 0);
   framework::NodeOptions no;
@@ -215,7 +221,7 @@ void CellBridge::SpinOnce(std::chrono::nanoseconds max_wait) {
     s.Emit(s.scene_channel, NowNs(), s.scene->Static(msg::Now()));
   }
   if (now >= s.next_status) {
-    s.next_status = now + std::chrono::milliseconds(500);
+    s.next_status = now + std::chrono::microseconds(static_cast<int64_t>(s.o.status_period * 1e6));
     s.Status();
   }
 }

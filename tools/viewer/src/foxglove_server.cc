@@ -174,7 +174,7 @@ struct FoxgloveServer::Impl {
         if (ch != channel) continue;
         websocketpp::lib::error_code ec;
         auto con = server.get_con_from_hdl(h, ec);
-        if (ec || con->get_buffered_amount() > o.max_buffered_bytes) {
+        if (ec || (channels[channel - 1].droppable && con->get_buffered_amount() > o.max_buffered_bytes)) {
           ++dropped;
           continue;
         }
@@ -202,6 +202,11 @@ FoxgloveServer::FoxgloveServer(FoxgloveServerOptions options) : impl_(std::make_
   s.server.set_http_handler([&s](Hdl h) { s.OnHttp(h); });
   s.server.set_validate_handler([&s](Hdl h) { return s.OnValidate(h); });
   s.server.set_open_handler([&s](Hdl h) { s.OnOpen(h); });
+  s.server.set_socket_init_handler([&s](Hdl, asio::ip::tcp::socket& socket) {
+    asio::error_code sec;
+    if (s.o.socket_send_buffer_bytes > 0) socket.set_option(asio::socket_base::send_buffer_size(s.o.socket_send_buffer_bytes), sec);
+    socket.set_option(asio::ip::tcp::no_delay(true), sec);
+  });
   s.server.set_close_handler([&s](Hdl h) { s.OnClose(h); });
   s.server.set_fail_handler([&s](Hdl h) { s.OnClose(h); });
   s.server.set_message_handler([&s](Hdl h, WsServer::message_ptr m) { s.OnMessage(h, m); });

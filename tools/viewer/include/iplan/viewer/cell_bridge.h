@@ -5,9 +5,12 @@
 //   /iplan/viewer/scene  foxglove.SceneUpdate entities (SceneBuilder) from the
 //                        checked joint states, skeletons, predictions,
 //                        trajectories and collision risk;
-//   /iplan/viewer/cell   {"alive": bool, "last_message_age_s": s, ...} once a
-//                        second: alive while some cell topic delivered within
-//                        `alive_after`.
+//   /iplan/viewer/cell   {"alive": bool, "last_message_age_s": s,
+//                        "alive_after_s": s, "status_period_s": s, ...} every
+//                        `status_period`: alive while some cell topic
+//                        delivered within `alive_after`. A client that gets
+//                        the status late (a page that is behind) adds its
+//                        delay to last_message_age_s (web/src/viewer.js).
 // The scene's inputs come through a framework Node, so they pass the same
 // writer and content checks as in a service (not the stamp order: a viewer
 // draws late and reordered messages too); a message the scene cannot use is
@@ -49,6 +52,7 @@ struct CellBridgeOptions {
   double robot_rate_hz = 30;       ///< most robot scene updates per second
   double prediction_rate_hz = 10;  ///< most prediction scene updates per second
   double alive_after = 1.0;        ///< s without any cell message: the cell is gone
+  double status_period = 0.5;      ///< s between two /iplan/viewer/cell statuses
   std::size_t max_payload_bytes = 8u << 20;  ///< larger JSON messages are dropped (counted)
 };
 

@@ -6,7 +6,11 @@
 // websocketpp and asio stay inside foxglove_server.cc. The server runs on a
 // thread of its own; every public method is thread-safe. A client that does
 // not keep up (more than `max_buffered_bytes` queued) misses messages, which
-// are counted, rather than slowing the caller.
+// are counted, rather than slowing the caller; the socket's own send buffer
+// is kept small too, so that what waits for a slow client is bounded by
+// these two sizes and a page that cannot keep up (software rendering on a
+// busy machine) gets recent messages, not ever older ones. Channels marked
+// not droppable (small status channels) are always sent.
 #pragma once
 
 #include <cstdint>
@@ -23,7 +27,10 @@ struct FoxgloveServerOptions {
   std::string name = "iplan";      ///< serverInfo name
   /// Extra files served as-is: URL path (e.g. "/recording.mcap") -> file path.
   std::map<std::string, std::string> files;
-  std::size_t max_buffered_bytes = 4u << 20;
+  /// Bytes queued for a client above which its droppable messages are dropped.
+  std::size_t max_buffered_bytes = 256u << 10;
+  /// SO_SNDBUF of each client's socket (0: the kernel's autotuned default, MBs on loopback).
+  int socket_send_buffer_bytes = 64 << 10;
 };
 
 struct Channel {
@@ -31,6 +38,7 @@ struct Channel {
   std::string schema_name;  ///< e.g. "sensor_msgs/msg/JointState", "foxglove.SceneUpdate"
   std::string schema;       ///< JSON Schema text
   std::string encoding = "json";
+  bool droppable = true;  ///< false: sent even to a client that is behind (keep such channels small)
 };
 
 struct FoxgloveServerStats {
