@@ -301,10 +301,12 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--subjects", t.subjects, "Training subjects, comma separated")->required();
   train->add_option("--out", t.out, "Model file to write")->required();
   train->add_option("--joints", t.joints,
-                    "Model joints, any names of the data, 1 or more (default: upper-body set found in the data)");
+                    "Model joints, any names of the data, 1 or more (default: the upper-body set found in the "
+                    "data, else every joint the data has, e.g. a one-joint wrist recording)");
   train->add_option("--torso", t.torso,
                     "Joints whose mean is the torso reference, or 'none': positions in the data frame "
-                    "(default: torso, spine, or shoulder_l+shoulder_r among the model joints)");
+                    "(default: torso, spine, or shoulder_l+shoulder_r among the model joints, else all model "
+                    "joints: for one joint, itself)");
   train->add_option("--hands", t.hands,
                     "Hand joints for object distances, or 'none' (default: hand_l/hand_r, else "
                     "wrist_l/wrist_r, among the model joints)");

@@ -85,12 +85,10 @@ JointConfig ResolveJointConfig(const std::vector<std::string>& available,
           pick(available, {"hand_r", "wrist_r"})}) {
       if (!j.empty()) c.joints.push_back(j);
     }
-    if (c.joints.size() < 2) {
-      throw std::invalid_argument(
-          "the data has fewer than two of the default "
-          "upper-body joints (head, neck, torso, shoulder/elbow/hand l/r); "
-          "name the model joints (data joints: " + Join(available) + ")");
-    }
+    // Not an upper body by these names (a wrist tracker, a tracker with
+    // names of its own): every joint the data has, in its order.
+    if (c.joints.size() < 2) c.joints = available;
+    if (c.joints.empty()) throw std::invalid_argument("the data has no joints");
   }
   if (selection.torso.has_value()) {
     c.torso = *selection.torso;
@@ -99,10 +97,9 @@ JointConfig ResolveJointConfig(const std::vector<std::string>& available,
   } else if (Has(c.joints, "shoulder_l") && Has(c.joints, "shoulder_r")) {
     c.torso = {"shoulder_l", "shoulder_r"};
   } else {
-    throw std::invalid_argument(
-        "no default torso reference among the joints " + Join(c.joints) +
-        " (torso, spine, or shoulder_l and shoulder_r): name the torso "
-        "joints, e.g. one of the joints itself, or none");
+    // No torso by name: the mean of the model joints (for one joint, the
+    // joint itself: the features are its motion, not where it is).
+    c.torso = c.joints;
   }
   if (selection.hands.has_value()) {
     c.hands = *selection.hands;

@@ -105,7 +105,9 @@ TEST(FeaturesTest, DefaultJointSetsPerDataset) {
   const JointConfig asm_ = DefaultJointConfig({"wrist_l", "wrist_r", "elbow_l", "elbow_r", "shoulder_l", "shoulder_r"});
   EXPECT_EQ(asm_.joints.size(), 6u);
   EXPECT_EQ(asm_.torso, (std::vector<std::string>{"shoulder_l", "shoulder_r"}));
-  EXPECT_THROW(DefaultJointConfig({"knee_l"}), std::invalid_argument);
+  // No upper body by name: every joint of the data.
+  EXPECT_EQ(DefaultJointConfig({"knee_l"}).joints, std::vector<std::string>{"knee_l"});
+  EXPECT_THROW(DefaultJointConfig({}), std::invalid_argument);
 }
 
 TEST(FeaturesTest, FeaturesRelativeToTorsoAndObjects) {
@@ -148,7 +150,18 @@ TEST(FeaturesTest, SelectedJointsAreHonouredBeforeAnyDefault) {
   // A tracker that gives one wrist only: no default skeleton exists, so the
   // default must not be computed for the parts that are named.
   const std::vector<std::string> wrist = {"wrist_r"};
-  ExpectInvalid([&] { DefaultJointConfig(wrist); }, "fewer than two of the default");
+  // With nothing named, a one-joint tracker's data gives that joint, the
+  // joint itself as the torso reference and as the hand.
+  const JointConfig tracked = DefaultJointConfig(wrist);
+  EXPECT_EQ(tracked.joints, wrist);
+  EXPECT_EQ(tracked.torso, wrist);
+  EXPECT_EQ(tracked.hands, wrist);
+  // Names of a tracker's own: every joint, the torso their mean.
+  const std::vector<std::string> custom = {"nose", "left_index", "right_index"};
+  EXPECT_EQ(DefaultJointConfig(custom).joints, custom);
+  EXPECT_EQ(DefaultJointConfig(custom).torso, custom);
+  EXPECT_TRUE(DefaultJointConfig(custom).hands.empty());
+  ExpectInvalid([&] { DefaultJointConfig({}); }, "the data has no joints");
   JointSelection one;
   one.joints = wrist;
   one.torso = wrist;
@@ -163,7 +176,7 @@ TEST(FeaturesTest, SelectedJointsAreHonouredBeforeAnyDefault) {
   one.hands.reset();
   EXPECT_EQ(ResolveJointConfig(wrist, one).hands, wrist);
   one.torso.reset();
-  ExpectInvalid([&] { ResolveJointConfig(wrist, one); }, "no default torso reference among the joints [wrist_r]");
+  EXPECT_EQ(ResolveJointConfig(wrist, one).torso, wrist);  // no torso by name: the joint itself
   // Names are the data's own, e.g. a 33-joint body tracker's.
   JointSelection own;
   own.joints = std::vector<std::string>{"left_index", "right_index", "nose"};

@@ -54,11 +54,13 @@ struct JointConfig {
 /// every part that is set is used as given; only the unset parts get a
 /// default, computed from the chosen joints (not from the data's).
 struct JointSelection {
-  /// Model joints; unset: the default upper-body set found in the data.
+  /// Model joints; unset: the default upper-body set found in the data, or,
+  /// when fewer than two of its joints are there (a one-joint wrist tracker,
+  /// a tracker with names of its own), every joint of the data.
   std::optional<std::vector<std::string>> joints;
   /// Torso reference joints; unset: the default among `joints` (torso or
-  /// spine, else shoulder_l and shoulder_r); set and empty: no torso (see
-  /// JointConfig::torso).
+  /// spine, else shoulder_l and shoulder_r, else all of `joints`: for one
+  /// joint the joint itself); set and empty: no torso (see JointConfig::torso).
   std::optional<std::vector<std::string>> torso;
   /// Hand joints; unset: hand_l/hand_r, else wrist_l/wrist_r, among `joints`;
   /// set and empty: none.
@@ -81,19 +83,18 @@ struct FrameFeatureOptions {
 /// accepting the usual aliases: neck = shoulder_center, torso = spine, hand =
 /// wrist when there is no hand joint. Joints the dataset lacks are left out;
 /// when there is no torso joint the torso is the mean of the shoulders.
-/// Hands are hand_l/hand_r, else wrist_l/wrist_r, when present. Same as
-/// ResolveJointConfig(available, {}).
-/// Throws std::invalid_argument when fewer than two default joints or no
-/// torso reference can be found (other joint sets must be named: see
-/// ResolveJointConfig).
+/// Data with fewer than two of these joints (a one-joint wrist tracker, a
+/// tracker with names of its own) gets every joint it has, the torso being
+/// their mean (one joint: itself). Hands are hand_l/hand_r, else
+/// wrist_l/wrist_r, when present. Same as ResolveJointConfig(available, {}).
+/// Throws std::invalid_argument when the data has no joints.
 JointConfig DefaultJointConfig(const std::vector<std::string>& available);
 
 /// The joint configuration for data providing the joints `available`: the
 /// parts set in `selection` as given, defaults (see JointSelection) only for
 /// the unset ones. Objects are left empty.
 /// Throws std::invalid_argument, naming the joint, when a selected joint is
-/// not in `available`, when a default is needed but cannot be found (fewer
-/// than two default joints; no torso reference among the chosen joints), or
+/// not in `available`, when the data has no joints, or
 /// when the result is invalid (JointConfig::Validate, e.g. a torso joint that
 /// is not a model joint).
 JointConfig ResolveJointConfig(const std::vector<std::string>& available,
