@@ -74,7 +74,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   c.replanner.cycle_budget = 0.0;
   planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file, topt.planner_overrides);
   if (planner_threads > 0) pp.num_threads = planner_threads;
-  c.planner = std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(topt.robot_file),
+  c.planner = std::make_unique<planning::Planner>(collision::LoadRobotModel(topt.robot_file),
                                                   collision::LoadSceneParams(topt.scene_file), pp);
   c.body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(topt.human_body_file));
 

@@ -45,7 +45,7 @@ class CloudService : public framework::Service {
       if (!overrides.empty()) throw std::runtime_error("--set into " + pipeline_file + " is not supported; edit the file");
       p.pipeline = cloud::LoadCloudParams(pipeline_file);
       std::optional<collision::RobotModel> robot;
-      if (!robot_file.empty()) robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));
+      if (!robot_file.empty()) robot = collision::LoadRobotModel(config.ResolvePath(robot_file));
       stage_ = std::make_unique<CloudStage>(p, robot ? &*robot : nullptr);
     } catch (const std::exception& e) {
       return Result::Fail(config.file() + ": key 'cloud': " + e.what());

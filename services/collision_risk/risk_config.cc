@@ -21,7 +21,7 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
 }
 
 RiskMonitor MakeRiskMonitor(const RiskConfig& config) {
-  return RiskMonitor(collision::LoadRobotModelFromYaml(config.robot_file),
+  return RiskMonitor(collision::LoadRobotModel(config.robot_file),
                      collision::LoadHumanBodyParams(config.human_body_file), config.params);
 }
 

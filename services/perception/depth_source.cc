@@ -122,7 +122,7 @@ framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection
       body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(sim.ResolvePath(body_file)));
     }
     if (!robot_file.empty()) {
-      robot = std::make_unique<collision::RobotModel>(collision::LoadRobotModelFromYaml(sim.ResolvePath(robot_file)));
+      robot = std::make_unique<collision::RobotModel>(collision::LoadRobotModel(sim.ResolvePath(robot_file)));
       robot_data = std::make_unique<collision::RobotData>(*robot);
       robot_joints = robot->JointNames();
     }

@@ -36,7 +36,7 @@ class RobotSimService : public framework::Service {
     const safety::PermitGateParams& permits = settings.permits;
     gate_ = std::make_unique<safety::PermitGate>(permits);
     try {
-      auto robot = collision::LoadRobotModelFromYaml(config.ResolvePath(robot_file));
+      auto robot = collision::LoadRobotModel(config.ResolvePath(robot_file));
       sim_ = std::make_unique<RobotSimulator>(std::move(robot), Eigen::Map<const Eigen::VectorXd>(q0.data(), static_cast<Eigen::Index>(q0.size())), params);
       body_ = std::make_unique<collision::HumanBodyModel>(
           collision::LoadHumanBodyParams(config.ResolvePath(body_file)));

@@ -28,7 +28,7 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
 }
 
 std::unique_ptr<planning::Planner> MakePlanner(const TrajoptConfig& config) {
-  return std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(config.robot_file),
+  return std::make_unique<planning::Planner>(collision::LoadRobotModel(config.robot_file),
                                              collision::LoadSceneParams(config.scene_file),
                                              planning::LoadPlannerParams(config.planner_file, config.planner_overrides));
 }

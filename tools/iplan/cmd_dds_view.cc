@@ -117,7 +117,7 @@ void Register(CLI::App& app) {
   v->add_option("--config-dir", o.config_dir,
                 "cell configuration; the robot, scene and body come from its trajopt.yaml (default: $IPLAN_CONFIG_DIR, "
                 "installed, or source)");
-  v->add_option("--robot", o.robot, "robot model instead (config/robots/*.yaml or a URDF)");
+  v->add_option("--robot", o.robot, "robot model instead: a DH YAML, a URDF or a URDF overlay (docs/robots.md)");
   v->add_option("--scene", o.scene, "scene file instead (config/scenes/*.yaml)");
   v->add_option("--body", o.body, "human body file instead (config/humans/*.yaml)");
   v->add_option("--topics", o.topics, "bridge only these topics (default: every iplan topic)");

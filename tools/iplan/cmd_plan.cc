@@ -16,7 +16,8 @@ const bool kRegistered = iplan::cli::RegisterCommand("plan", [](CLI::App& app) {
       "Plan a joint trajectory (ITOMP-style optimisation, docs/planning.md).\n"
       "Exit code 0 on success, 1 when no safe feasible trajectory was found, 2 on bad input.");
   cmd->add_option("--scene", opts->scene, "scene YAML (config/scenes/cell.yaml)")->required();
-  cmd->add_option("--robot", opts->robot, "robot YAML")->capture_default_str();
+  cmd->add_option("--robot", opts->robot, "robot: a DH YAML, a URDF or a URDF overlay (docs/robots.md)")
+      ->capture_default_str();
   cmd->add_option("--config", opts->config, "planner params YAML (config/planner.yaml)");
   cmd->add_option("--start", opts->start, "start joint positions q1,...,q7 (rad)")
       ->delimiter(',')->required();

@@ -18,7 +18,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
     if (o.scene.empty()) throw std::invalid_argument("--scene is required");
     if (o.goal.empty() == o.goal_pose.empty())
       throw std::invalid_argument("give exactly one of --goal and --goal-pose");
-    collision::RobotModel robot = collision::LoadRobotModelFromYaml(o.robot);
+    collision::RobotModel robot = collision::LoadRobotModel(o.robot);
     collision::SceneParams scene = collision::LoadSceneParams(o.scene);
     PlannerParams params = o.config.empty() ? PlannerParams{} : LoadPlannerParams(o.config);
     if (o.threads) params.num_threads = *o.threads;

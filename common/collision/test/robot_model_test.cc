@@ -1,6 +1,9 @@
 #include "iplan/collision/robot_model.h"
 
+#include <unistd.h>
+
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <functional>
 #include <limits>
@@ -455,6 +458,55 @@ TEST(RobotModelTest, LockedFingersLeaveSevenJoints) {
   const Eigen::Vector3d left = d.X_WL[m.FindLink("panda_leftfinger")].translation();
   const Eigen::Vector3d right = d.X_WL[m.FindLink("panda_rightfinger")].translation();
   EXPECT_NEAR((left - right).norm(), 0.04, 1e-12);
+}
+
+// LoadRobotModel takes every form a config may name: the DH YAML, a URDF,
+// and a URDF overlay whose locked joints and limits apply.
+TEST(RobotModelTest, LoadRobotModelTakesYamlUrdfAndOverlay) {
+  const RobotModel yaml = LoadRobotModel(kYaml);
+  EXPECT_EQ(yaml.nq, 7);
+  EXPECT_EQ(yaml.spheres.size(), LoadRobotModelFromYaml(kYaml).spheres.size());
+  const RobotModel urdf = LoadRobotModel(kUrdf);
+  EXPECT_EQ(urdf.nq, LoadRobotModelFromUrdf(kUrdf).nq);
+  EXPECT_EQ(urdf.joints[static_cast<std::size_t>(urdf.q_joints[0])].limits.acceleration,
+            RobotModelOptions{}.default_acceleration);
+
+  const std::filesystem::path dir =
+      std::filesystem::temp_directory_path() / ("iplan-overlay-" + std::to_string(::getpid()));
+  std::filesystem::create_directories(dir);
+  const std::string overlay = (dir / "panda_urdf.yaml").string();
+  std::ofstream(overlay) << "urdf: " << std::filesystem::relative(kUrdf, dir).string() << "\n"
+                         << "locked_joints: [{name: panda_finger_joint1, value: 0.02}, {name: panda_finger_joint2, value: 0.02}]\n"
+                         << "acceleration: 5.0\njerk: 2000.0\n";
+  const RobotModel over = LoadRobotModel(overlay);
+  EXPECT_EQ(over.nq, 7);
+  EXPECT_EQ(over.JointNames(), yaml.JointNames());
+  for (const int j : over.q_joints) {
+    EXPECT_EQ(over.joints[static_cast<std::size_t>(j)].limits.acceleration, 5.0);
+    EXPECT_EQ(over.joints[static_cast<std::size_t>(j)].limits.jerk, 2000.0);
+  }
+  // The same arm as the DH file: the flange in the same place.
+  RobotData dy(yaml), du(over);
+  const Eigen::VectorXd q = (Eigen::VectorXd(7) << 0.3, -0.5, 0.2, -2.0, 0.1, 1.8, 0.7).finished();
+  CalcForwardKinematics(yaml, q, &dy);
+  CalcForwardKinematics(over, q, &du);
+  EXPECT_LT((dy.X_WL[static_cast<std::size_t>(yaml.FindLink("panda_link8"))].translation() -
+             du.X_WL[static_cast<std::size_t>(over.FindLink("panda_link8"))].translation()).norm(), 1e-6);
+
+  // Errors name the file: a missing URDF, an unknown key, a bad limit.
+  std::ofstream(overlay) << "urdf: nowhere.urdf\n";
+  EXPECT_THROW(LoadRobotModel(overlay), std::runtime_error);
+  try {
+    LoadRobotModel(overlay);
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("(named by " + overlay + ")"), std::string::npos) << e.what();
+  }
+  std::ofstream(overlay) << "urdf: " << kUrdf << "\nacceleration: 0\n";
+  EXPECT_THROW(LoadRobotModel(overlay), std::runtime_error);
+  std::ofstream(overlay) << "urdf: " << kUrdf << "\ntool: x\n";
+  EXPECT_THROW(LoadRobotModel(overlay), std::runtime_error);
+  EXPECT_THROW(LoadRobotModel((dir / "missing.yaml").string()), std::runtime_error);
+  std::filesystem::remove_all(dir);
 }
 
 }  // namespace

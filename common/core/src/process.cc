@@ -26,6 +26,40 @@ std::string ReadFile(const std::string& path) {
   return ss.str();
 }
 
+// The child's side of Process: stdin from /dev/null, stdout and stderr to
+// the log files (out == nullptr: inherited), default signal dispositions, a
+// parent-death signal, then the executable. Async-signal-safe only; on
+// failure the errno goes to `report` and the child exits 127.
+[[noreturn]] void ExecChild(char* const* argv, char* const* envp, const char* out, const char* err, pid_t parent,
+                            int report) {
+  auto die = [&](int e) {
+    ssize_t ignored = write(report, &e, sizeof e);
+    (void)ignored;
+    _exit(127);
+  };
+  if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0) die(errno);
+  if (getppid() != parent) _exit(128 + SIGTERM);  // the parent died before the line above
+  const int in = open("/dev/null", O_RDONLY);
+  if (in < 0 || dup2(in, 0) < 0) die(errno);
+  if (out) {
+    const int o = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (o < 0 || dup2(o, 1) < 0) die(errno);
+    const int e = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (e < 0 || dup2(e, 2) < 0) die(errno);
+  }
+  // The parent's signal dispositions that are not defaults (an ignored
+  // SIGINT, say) must not reach the service, nor its blocked mask.
+  struct sigaction dfl {};
+  dfl.sa_handler = SIG_DFL;
+  for (const int sig : {SIGINT, SIGTERM, SIGPIPE, SIGHUP}) sigaction(sig, &dfl, nullptr);
+  sigset_t none;
+  sigemptyset(&none);
+  sigprocmask(SIG_SETMASK, &none, nullptr);
+  execve(argv[0], argv, envp);
+  die(errno);
+  _exit(127);  // not reached: die exits
+}
+
 }  // namespace
 
 Process::Process(std::vector<std::string> argv, std::map<std::string, std::string> env, bool inherit_output,
@@ -70,34 +104,7 @@ Process::Process(std::vector<std::string> argv, std::map<std::string, std::strin
     close(report[1]);
     throw std::runtime_error("cannot start " + argv[0] + ": " + std::strerror(e));
   }
-  if (pid_ == 0) {
-    close(report[0]);
-    auto die = [&](int e) {
-      ssize_t ignored = write(report[1], &e, sizeof e);
-      (void)ignored;
-      _exit(127);
-    };
-    if (prctl(PR_SET_PDEATHSIG, SIGTERM) != 0) die(errno);
-    if (getppid() != parent) _exit(128 + SIGTERM);  // the parent died before the line above
-    const int in = open("/dev/null", O_RDONLY);
-    if (in < 0 || dup2(in, 0) < 0) die(errno);
-    if (!inherit_output) {
-      const int o = open(out, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (o < 0 || dup2(o, 1) < 0) die(errno);
-      const int e = open(err, O_WRONLY | O_CREAT | O_TRUNC, 0644);
-      if (e < 0 || dup2(e, 2) < 0) die(errno);
-    }
-    // The parent's signal dispositions that are not defaults (an ignored
-    // SIGINT, say) must not reach the service, nor its blocked mask.
-    struct sigaction dfl {};
-    dfl.sa_handler = SIG_DFL;
-    for (const int sig : {SIGINT, SIGTERM, SIGPIPE, SIGHUP}) sigaction(sig, &dfl, nullptr);
-    sigset_t none;
-    sigemptyset(&none);
-    sigprocmask(SIG_SETMASK, &none, nullptr);
-    execve(args[0], args.data(), envp.data());
-    die(errno);
-  }
+  if (pid_ == 0) ExecChild(args.data(), envp.data(), inherit_output ? nullptr : out, err, parent, report[1]);
   close(report[1]);
   int child_errno = 0;
   ssize_t n;

@@ -69,8 +69,7 @@ const Rgba kActionColors[] = {{0.85, 0.1, 0.6, 1}, {0.6, 0.2, 0.9, 1}, {0.1, 0.7
 
 CellModel LoadCellModel(const std::string& robot_file, const std::string& scene_file, const std::string& body_file) {
   CellModel m;
-  const bool urdf = robot_file.size() > 5 && robot_file.substr(robot_file.size() - 5) == ".urdf";
-  m.robot = urdf ? collision::LoadRobotModelFromUrdf(robot_file) : collision::LoadRobotModelFromYaml(robot_file);
+  m.robot = collision::LoadRobotModel(robot_file);
   m.scene = collision::LoadSceneParams(scene_file);
   if (const std::string why = m.scene.Validate(); !why.empty()) throw std::runtime_error(scene_file + ": " + why);
   try {

@@ -17,6 +17,7 @@
 #include <Eigen/Geometry>
 
 #include "iplan/collision/sphere_cover.h"
+#include "iplan/core/name_value.h"
 
 namespace iplan::collision {
 
@@ -167,5 +168,50 @@ RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptio
 /// @throws std::runtime_error naming the file, the key and the value.
 /// Thread-safe (no shared state); allocates.
 RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptions& options = {});
+
+/// A URDF and what URDF does not say, as a small YAML file (the "overlay";
+/// paths relative to it), so that a cell's configs name a URDF robot the
+/// way they name a YAML one:
+///   urdf: ur5e/ur5e.urdf
+///   locked_joints: [{name: panda_finger_joint1, value: 0.0}]
+///   acceleration: 7.5   # rad/s^2 (m/s^2), every joint
+///   jerk: 3750.0        # rad/s^3 (m/s^3), every joint
+struct UrdfOverlay {
+  struct LockedJoint {
+    std::string name;
+    double value = 0.0;  ///< rad or m
+    template <class Archive>
+    void Serialize(Archive* a) {
+      a->Visit(IPLAN_NVP_REQUIRED(name, "joint name in the URDF"));
+      a->Visit(IPLAN_NVP(value, "rad or m, the joint's fixed value"));
+    }
+  };
+  std::string urdf;
+  std::vector<LockedJoint> locked_joints;
+  double acceleration = RobotModelOptions{}.default_acceleration;
+  double jerk = RobotModelOptions{}.default_jerk;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP_REQUIRED(urdf, "the URDF file, relative to this file"));
+    a->Visit(IPLAN_NVP(locked_joints, "joints held at a fixed value (e.g. gripper fingers); they leave q"));
+    a->Visit(IPLAN_NVP(acceleration, "rad/s^2 (m/s^2) limit of every joint (URDF has none), > 0"));
+    a->Visit(IPLAN_NVP(jerk, "rad/s^3 (m/s^3) limit of every joint (URDF has none), > 0"));
+  }
+  /// Empty when valid, else the reason.
+  std::string Validate() const {
+    if (urdf.empty()) return "urdf must name the URDF file";
+    if (!(acceleration > 0)) return "acceleration must be > 0";
+    if (!(jerk > 0)) return "jerk must be > 0";
+    return "";
+  }
+};
+
+/// Loads the robot a config names, whatever form its file has: a URDF
+/// (`.urdf`, or a file that starts as XML) with `options` as given; a URDF
+/// overlay (a YAML file with a top-level `urdf` key, see UrdfOverlay) whose
+/// values replace those of `options`; else a modified-DH YAML file
+/// (LoadRobotModelFromYaml). What every service and tool calls.
+/// @throws std::runtime_error naming the file and the problem.
+RobotModel LoadRobotModel(const std::string& path, const RobotModelOptions& options = {});
 
 }  // namespace iplan::collision
