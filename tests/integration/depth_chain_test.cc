@@ -31,6 +31,7 @@
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
+#include "robot_distance.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -255,21 +256,6 @@ TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
 const std::vector<double> kStart = {-0.75, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};
 const std::vector<double> kGoal = {0.25, 0.2, 0.0, -2.2, 0.0, 2.4, 0.8};  // clear of the parts bin's (axis-aligned, larger) obstacle box
 constexpr double kBoxAppears = 4.0;  // s after perception's activation
-
-// Smallest signed distance (m, FCL) of the robot's spheres to `box` over the states.
-double MinDistance(const collision::RobotModel& robot, const collision::SceneObject& box,
-                   const std::vector<std::vector<double>>& states) {
-  const collision::StaticScene scene(collision::SceneParams{{box}});
-  collision::RobotData d(robot);
-  std::vector<double> radii;
-  for (const auto& s : robot.spheres) radii.push_back(s.radius);
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& q : states) {
-    collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(q.data(), 7), &d);
-    best = std::min(best, scene.CalcMinimumDistance(d.p_WS, radii).distance);
-  }
-  return best;
-}
 
 // The joint-space straight line from kStart to kGoal (the plan of an optimiser that does not know the box), n states.
 std::vector<std::vector<double>> StraightLine(int n) {

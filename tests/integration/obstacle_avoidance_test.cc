@@ -17,6 +17,7 @@
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
+#include "robot_distance.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -115,21 +116,6 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
   if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << opt.Stderr() << "\n";  // the optimiser's log, to debug
   return e;
-}
-
-// Smallest signed distance (m, FCL) of the robot's spheres to `box` over the states.
-double MinDistance(const collision::RobotModel& robot, const collision::SceneObject& box,
-                   const std::vector<std::vector<double>>& states) {
-  const collision::StaticScene scene(collision::SceneParams{{box}});
-  collision::RobotData d(robot);
-  std::vector<double> radii;
-  for (const auto& s : robot.spheres) radii.push_back(s.radius);
-  double best = std::numeric_limits<double>::infinity();
-  for (const auto& q : states) {
-    collision::CalcForwardKinematics(robot, Eigen::Map<const Eigen::VectorXd>(q.data(), 7), &d);
-    best = std::min(best, scene.CalcMinimumDistance(d.p_WS, radii).distance);
-  }
-  return best;
 }
 
 TEST(ObstacleAvoidance, ABoxAppearingOnTheTableIsAvoidedWithNoContact) {
