@@ -63,6 +63,10 @@ TEST_P(PermitWriterConflict, ForgedMonitorNamesDoNotLiftAStopAndAreReportedNamin
   ASSERT_TRUE(cell.SpinUntil([&] { return cell.AtRest() && cell.RestSince(Clock::now() - 1s); }, 5s));
   ASSERT_FALSE(cell.Permits("supervisor"));
 
+  // The forgers' writers must have matched the cell's permit readers
+  // (robot-sim, trajopt, the observer), or the test would prove nothing.
+  ASSERT_TRUE(cell.SpinUntil([&] { return sup_w.MatchedReaders() >= 3 && risk_w.MatchedReaders() >= 3; }, 10s))
+      << "forged writers matched " << sup_w.MatchedReaders() << " and " << risk_w.MatchedReaders() << " readers";
   // The forgery: PERMITs claiming both monitors, 50 Hz, 3 s, fresh stamps.
   const auto attack = Clock::now();
   bool reason_named_both = false;
