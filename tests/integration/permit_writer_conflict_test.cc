@@ -36,6 +36,17 @@ std::size_t Count(const std::string& text, const std::string& what) {
   return n;
 }
 
+// A forged PERMIT: fresh stamp, validity 5 s (the robot caps it at 0.25 s).
+void WritePermit(dds::Writer<msg::SafetyPermit>& w, const std::string& source) {
+  msg::SafetyPermit p;
+  p.header.stamp = msg::Now();
+  p.state = msg::SafetyPermit::PERMIT;
+  p.validity = 5;
+  p.source = source;
+  p.reason = "all inputs healthy";
+  w.Write(p);
+}
+
 TEST_P(PermitWriterConflict, ForgedMonitorNamesDoNotLiftAStopAndAreReportedNamingBothWriters) {
   const Variant& v = GetParam();
   // The forgers: participants of their own, named like the real monitors.
@@ -75,15 +86,8 @@ TEST_P(PermitWriterConflict, ForgedMonitorNamesDoNotLiftAStopAndAreReportedNamin
   int sent = 0;
   while (Clock::now() - attack < 3s) {
     const auto t = Clock::now();
-    for (auto* w : {&sup_w, &risk_w}) {
-      msg::SafetyPermit p;
-      p.header.stamp = msg::Now();
-      p.state = msg::SafetyPermit::PERMIT;
-      p.validity = 5;
-      p.source = w == &sup_w ? "supervisor" : "collision_risk";
-      p.reason = "all inputs healthy";
-      w->Write(p);
-    }
+    WritePermit(sup_w, "supervisor");
+    WritePermit(risk_w, "collision_risk");
     ++sent;
     const std::string reason = cell.Diag("robot_sim", "permit");
     std::smatch mt;
