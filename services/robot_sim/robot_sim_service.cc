@@ -54,12 +54,14 @@ class RobotSimService : public framework::Service {
                      node.CountRejection("trajectory", sim_->SetTrajectory(services::TrajectoryStartNs(m, info.reception_ns),
                                                                            m.joint_names, times, pos));
                    }));
-    // Permits count only from the configured monitors' writers.
+    // Permits count only from the configured monitors' writers; the writer's
+    // identity (info.writer_id) lets the gate hold a stop against another
+    // writer's permits and catch two writers claiming one monitor.
     auto permit_topic = framework::topics::SafetyPermit();
     permit_topic.writers = permits.monitors;
     node.Subscribe(permit_topic,
                    std::function<void(const msg::SafetyPermit&, SI)>([this, &node](const msg::SafetyPermit& m, SI info) {
-                     node.CountRejection("permit", gate_->OnPermit(info.writer_name, m.state == msg::SafetyPermit::PERMIT,
+                     node.CountRejection("permit", gate_->OnPermit(info.writer_name, info.writer_id, m.state == msg::SafetyPermit::PERMIT,
                                                                    m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
                                                                    msg::ToNanoseconds(msg::Now())));
                    }));
@@ -108,6 +110,8 @@ class RobotSimService : public framework::Service {
         node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
         node.SetDiagnosticValue("stopped", sim_->stopped() ? "true" : "false");
         node.SetDiagnosticValue("permit", permit_reason_);
+        node.SetDiagnosticValue("permit_writer_conflicts", std::to_string(writer_conflicts_));
+        if (!writer_conflict_.empty()) node.SetDiagnosticValue("permit_writer_conflict", writer_conflict_);
         node.SetDiagnosticValue("last_stopping_distance_m", std::to_string(sim_->last_stopping_distance()));
       }
       node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
@@ -142,6 +146,18 @@ class RobotSimService : public framework::Service {
   // Stop at once when any permit is missing, lapsed or a stop; resume when
   // every monitor permits again (their own hysteresis decides when).
   void ApplyPermits(Node& node, int64_t now_ns) {
+    // Two writers claiming one monitor: logged once when it begins and once
+    // when it ends; the diagnostics keep the latest one.
+    for (const safety::WriterConflictEvent& e : gate_->TakeConflictEvents(now_ns)) {
+      if (e.raised) {
+        ++writer_conflicts_;
+        writer_conflict_ = e.description;
+        node.log().error("PERMIT WRITER CONFLICT: {}", e.description);
+      } else {
+        writer_conflict_ += " (cleared: " + e.description + ")";
+        node.log().warn("permit writer conflict cleared: {}", e.description);
+      }
+    }
     const safety::PermitDecision d = gate_->Evaluate(now_ns);
     permit_reason_ = d.reason;
     if (!d.permitted && !sim_->stopped()) {
@@ -158,6 +174,8 @@ class RobotSimService : public framework::Service {
   double control_rate_hz_ = 100, publish_rate_hz_ = 50;
   std::unique_ptr<safety::PermitGate> gate_;
   std::string permit_reason_;
+  std::string writer_conflict_;  // the latest writer conflict ("" when none yet)
+  uint64_t writer_conflicts_ = 0;
   bool ever_permitted_ = false;
   std::unique_ptr<RobotSimulator> sim_;
   std::unique_ptr<collision::HumanBodyModel> body_;
