@@ -112,7 +112,9 @@ TEST_P(DdsEvents, WriterThatStopsPublishingIsReportedAsDeadlineMiss) {
   }, &samples);
   EXPECT_GT(samples, 20);
   EXPECT_EQ(misses_while_publishing, 0);
-  ASSERT_TRUE(writer->WaitForOutput("paused", 5s));
+  ASSERT_TRUE(writer->WaitForOutput("paused", 5s))
+      << "the writer " << (writer->Running() ? "is still running" : "exited with " + std::to_string(*writer->Wait(0ms)))
+      << "; its stdout:\n" << writer->Stdout() << "its stderr:\n" << writer->Stderr();
   const auto paused = Clock::now();
   ASSERT_TRUE(WaitForEvent(*p, reader, 3s, [](const dds::ReaderEvent& e) {
     return e.kind == dds::EventKind::kDeadlineMissed;
