@@ -141,6 +141,7 @@ class AttackRun {
     pt.time_from_start = msg::DurationFromSeconds(0.1 * k);
     away.points.push_back(pt);
   }
+  auto next_trajectory = attack;  // 10 Hz by the clock, whatever each iteration takes
   while (Clock::now() - attack < 3s) {
     const auto t = Clock::now();
     msg::SafetyPermit p;
@@ -158,9 +159,10 @@ class AttackRun {
       v.reason = "clear";
       risk_w.Write(v);
     }
-    if (std::chrono::duration_cast<std::chrono::milliseconds>(t - attack).count() % 100 < 10) {
+    if (t >= next_trajectory) {
       away.header.stamp = msg::Now();
       traj_w.Write(away);
+      next_trajectory += 100ms;
     }
     cell.SpinFor(std::chrono::milliseconds(10) - std::chrono::duration_cast<std::chrono::milliseconds>(Clock::now() - t));
   }
