@@ -22,7 +22,7 @@ const state = {
   mode: params.has("replay") ? "replay" : "live",
   status: "connecting",  // connected | disconnected | connecting | replay
   connected: false,      // WebSocket open
-  cellAlive: false,      // the viewer hears the cell (as of now, see cellAge)
+  cellAlive: false,      // the viewer hears the cell (as of now, see cellAgeS)
   cellAgeS: null,        // s since the cell's last message, as the page knows now
   lagS: 0,               // how late the page got the viewer's last message (s)
   maxLagS: 0,            // the most it was behind on this page
