@@ -72,7 +72,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // Simulated time: a wall-clock budget would make the benchmark depend on
   // the machine's load; it plans every cycle to the end.
   c.replanner.cycle_budget = 0.0;
-  planning::PlannerParams pp = planning::LoadPlannerParams(topt.planner_file, topt.planner_overrides);
+  planning::PlannerParams pp = trajopt::LoadPlannerParams(topt);  // delta_cl, SSM: the cell's safety file
   if (planner_threads > 0) pp.num_threads = planner_threads;
   c.planner = std::make_unique<planning::Planner>(collision::LoadRobotModel(topt.robot_file),
                                                   collision::LoadSceneParams(topt.scene_file), pp);

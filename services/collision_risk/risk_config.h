@@ -16,6 +16,7 @@ struct RiskConfig {
   double permit_validity = 0.2;  ///< s, validity of the permit published with every evaluation
   std::string robot_file;     ///< resolved against the configuration file
   std::string human_body_file;
+  std::string safety_file;    ///< the cell's safety file (key `safety`), empty when not named
 };
 
 /// Reads `section` (collision_risk); every problem, RiskParams::Validate()'s
@@ -24,7 +25,10 @@ struct RiskConfig {
 /// delta_cl, stop_horizon, slow_down_fraction, slow_down_margin, stale_after,
 /// iso_ts_15066.{measure_human_speed, default_human_speed, speed_window,
 /// reaction_time, stopping_time, stopping_distance, intrusion_distance,
-/// sensing_uncertainty, robot_uncertainty}.
+/// sensing_uncertainty, robot_uncertainty}; `safety` names the cell's
+/// safety file (iplan/cell/safety.h), the one source of delta_cl and
+/// iso_ts_15066 (a value given here as well that disagrees is an error
+/// naming both files).
 RiskConfig ReadRiskConfig(framework::ConfigSection& section);
 
 /// Loads the robot and human models named by `config` and builds the

@@ -22,6 +22,9 @@ struct TrajoptConfig {
   std::string planner_file;
   /// --set trajopt.planner.KEY=VALUE overrides, for LoadPlannerParams.
   core::Overrides planner_overrides;
+  /// The cell's safety file (key `safety`, iplan/cell/safety.h), empty when
+  /// not named: the planner's delta_cl and iso_ts_15066 come from it.
+  std::string safety_file;
   /// false: the planner ignores the person (no prediction enters the plan;
   /// only the collision-risk monitor protects), for ablations.
   bool use_prediction = true;
@@ -41,6 +44,12 @@ struct TrajoptConfig {
 /// robot, human_body, scene, planner (file names, relative to the
 /// configuration file), use_prediction, replan_on_prediction, obstacle_timeout and ReplannerParams::Serialize's.
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& section);
+
+/// The planner parameters named by `config`: the planner file with its
+/// overrides, delta_cl and iso_ts_15066 from the safety file. A planner
+/// file (or override) that gives either and disagrees with the safety file
+/// is refused. @throws core::ConfigError naming both files.
+planning::PlannerParams LoadPlannerParams(const TrajoptConfig& config);
 
 /// Loads the robot model, static scene and planner parameters named by
 /// `config`. Throws std::exception (unreadable or invalid files).

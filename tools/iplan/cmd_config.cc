@@ -12,6 +12,7 @@
 #include "supervisor/core/task_planner.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/core/params.h"
+#include "iplan/cell/safety.h"
 #include "iplan/planning/planner_params.h"
 #include "trajopt/trajopt_config.h"
 
@@ -26,8 +27,13 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"planner",
        {"config/planner.yaml (top level); PlannerParams",
         [] { return iplan::core::DescribeParams(iplan::planning::PlannerParams{}); }}},
+      {"safety",
+       {"config/safety.yaml (top level, named by `safety:` in collision_risk.yaml and trajopt.yaml); SafetyParams: "
+        "the one source of delta_cl and iso_ts_15066 for monitor, planner, benchmark and cell-check",
+        [] { return iplan::core::DescribeParams(iplan::cell::SafetyParams{}); }}},
       {"collision-risk",
-       {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066)",
+       {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066; with "
+        "`safety:` both come from the safety file)",
         [] { return iplan::core::DescribeParams(iplan::collision_risk::RiskParams{}); }}},
       {"replanner",
        {"config/trajopt.yaml, section trajopt; ReplannerParams",

@@ -1,8 +1,20 @@
 #include "iplan/cell/ssm.h"
 
 #include <algorithm>
+#include <cmath>
 
 namespace iplan::cell {
+
+std::string SsmParams::Validate() const {
+  for (double v : {default_human_speed, speed_window, reaction_time, stopping_time, stopping_distance,
+                   intrusion_distance, sensing_uncertainty, robot_uncertainty}) {
+    if (!(v >= 0)) return "ISO/TS 15066 parameters must be >= 0";
+  }
+  if (!(speed_window > 0)) return "speed_window must be > 0";
+  if (!(stopping_speed > 0)) return "stopping_speed must be > 0";
+  if (!std::isfinite(retreat_speed)) return "retreat_speed must be finite";
+  return "";
+}
 
 double StoppingDistance(const SsmParams& p, double v_r) {
   return p.directed ? p.stopping_distance * std::min(1.0, v_r / p.stopping_speed) : p.stopping_distance;
@@ -13,6 +25,21 @@ double ProtectiveSeparationDistance(const SsmParams& p, double v_h, double v_r) 
   const double s_r = v_r * p.reaction_time;
   const double fixed = p.intrusion_distance + p.sensing_uncertainty + p.robot_uncertainty;
   return s_h + s_r + StoppingDistance(p, v_r) + fixed;
+}
+
+SsmPair SsmPairRule(const SsmParams& p, const Eigen::Vector3d& delta, double radii, const Eigen::Vector3d& v_human,
+                    const Eigen::Vector3d& v_robot) {
+  SsmPair r;
+  const double centres = delta.norm();
+  r.separation = centres - radii;
+  const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();  // human -> robot
+  r.v_h = std::max(0.0, v_human.dot(u));
+  const double away = v_robot.dot(u);  // the robot sphere's speed away from the human sphere
+  r.v_r = std::max(0.0, -away);
+  r.protective_separation = ProtectiveSeparationDistance(p, r.v_h, r.v_r);
+  r.margin = r.separation - r.protective_separation;
+  r.retreating = r.margin < 0 && p.retreat_speed > 0 && centres > 1e-9 && away >= p.retreat_speed;
+  return r;
 }
 
 }  // namespace iplan::cell

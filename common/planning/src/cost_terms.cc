@@ -11,7 +11,7 @@ namespace iplan::planning::internal {
 
 void PlannerModel::Evaluate(const Problem& at, const Eigen::MatrixXd& Q, Workspace* ws, CostTerms* ev,
                             Eigen::MatrixXd* G) const {
-  ev->smooth = ev->obstacle = ev->dynamic = ev->goal = ev->limits = ev->separation = 0.0;
+  ev->smooth = ev->obstacle = ev->dynamic = ev->goal = ev->limits = ev->separation = ev->ssm = 0.0;
   if (G) G->setZero(at.nq, at.n + 1);
   // Accelerations a_i, i = 0..n, and velocities v_i, i = 0..n-1.
   cell::FiniteDifferenceAccelerations(Q, at.qdot0, at.dt, &ws->A);
@@ -21,10 +21,14 @@ void PlannerModel::Evaluate(const Problem& at, const Eigen::MatrixXd& Q, Workspa
   AddLimitCost(at, ws, ev, G);
   // Forward kinematics of the free waypoints (the only ones the costs use).
   for (int i = at.k; i < at.n; ++i) collision::CalcForwardKinematics(robot, Q.col(i), &ws->data[i]);
+  // The separation monitor's rule also needs the plan's speed at the last free waypoint.
+  const bool ssm = SsmLastWaypoint(at) >= at.k;
+  if (ssm) collision::CalcForwardKinematics(robot, Q.col(at.n), &ws->data[at.n]);
   AddObstacleCost(at, ws, ev, G);
   if (!at.people.empty()) AddDynamicCost(at, ws, ev, G);
   if (!at.people.empty() && params.human_separation > 0.0) AddSeparationCost(at, ws, ev, G);
-  ev->total = ev->smooth + ev->obstacle + ev->dynamic + ev->goal + ev->limits + ev->separation;
+  if (ssm) AddSsmCost(at, ws, ev, G);
+  ev->total = ev->smooth + ev->obstacle + ev->dynamic + ev->goal + ev->limits + ev->separation + ev->ssm;
 }
 
 // smoothness = w sum_i dt ||a_i||^2.

@@ -46,7 +46,8 @@ void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, 
       if (c->first_unsafe < 0 && c->bounds[i] >= Threshold()) c->first_unsafe = i;
     }
   }
-  c->safe = c->first_unsafe < 0;
+  c->ssm = JudgeSsm(at, Q, at.ssm_from, at.n);
+  c->safe = c->first_unsafe < 0 && c->ssm.ok();
 }
 
 // Initial trajectory from the base (perturbed for o > 0: a smooth bump of

@@ -158,6 +158,7 @@ void Fill(const Candidate& c, int num_frozen, PlanningResult* result) {
   result->max_bound = c.max_bound;
   result->bounds = c.bounds;
   result->min_clearance = c.min_clearance;
+  result->ssm_margin = c.ssm.min_margin;
   result->num_frozen = num_frozen;
 }
 
@@ -177,8 +178,16 @@ void DescribeFailure(const PlannerModel& M, const Problem& at, const Candidate& 
   std::ostringstream s;
   if (any_static && !at.people.empty()) {
     result->status = PlanStatus::kNoSafeTrajectory;
-    s << "no trajectory kept the bound below " << M.Threshold() << " after " << result->num_waits
-      << " waits; best max bound " << best.max_bound;
+    if (best.first_unsafe >= 0 || best.ssm.ok()) {
+      s << "no trajectory kept the bound below " << M.Threshold() << " after " << result->num_waits
+        << " waits; best max bound " << best.max_bound;
+    } else {
+      const cell::SsmPair& v = best.ssm.violation;
+      s << "the separation monitor would stop every trajectory after " << result->num_waits
+        << " waits; best: separation " << v.separation << " m below S_p " << v.protective_separation << " + "
+        << M.params.ssm_margin << " m (v_h " << v.v_h << ", v_r " << v.v_r << " m/s) at waypoint "
+        << best.ssm.first_violation;
+    }
   } else {
     result->status = PlanStatus::kInfeasible;
     const std::string lim = CheckLimits(M.robot, best.Q, M.params.dt, at.qdot0);

@@ -18,6 +18,7 @@
 #pragma once
 
 #include <chrono>
+#include <functional>
 #include <cstdint>
 #include <limits>
 #include <memory>
@@ -26,6 +27,7 @@
 #include <Eigen/Core>
 
 #include "clearance.h"
+#include "iplan/cell/ssm.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/scene.h"
 #include "iplan/collision/trajectory_bound.h"
@@ -72,6 +74,9 @@ struct Problem {
   // per attempt by FixBounds.
   std::vector<double> fixed_bounds;
   bool perturb_base = true;
+  // First waypoint judged by the separation monitor's rule: the request's
+  // frozen prefix is executing already; waits inserted after it are judged.
+  int ssm_from = 1;
   // Wall time at which the optimisers stop (PlanningRequest::time_budget);
   // time_point::max() without a budget.
   Clock::time_point deadline = Clock::time_point::max();
@@ -80,12 +85,29 @@ struct Problem {
 
 /// Cost terms of one trajectory (PlannerParams::weights applied).
 struct CostTerms {
-  double total = 0.0, smooth = 0.0, obstacle = 0.0, dynamic = 0.0, goal = 0.0, limits = 0.0, separation = 0.0;
+  double total = 0.0, smooth = 0.0, obstacle = 0.0, dynamic = 0.0, goal = 0.0, limits = 0.0, separation = 0.0,
+         ssm = 0.0;
   std::vector<collision::WaypointBound> bounds;  // free waypoints k..n-1 (dynamic term)
+};
+
+/// Where a sphere pair judged by the separation monitor's rule is
+/// (ssm_cost.cc): waypoint, person, action and robot sphere.
+struct SsmVisit {
+  int waypoint = 0, person = 0, action = 0, sphere = 0;
+  double probability = 0.0;  // the action's
+  bool retreat = false;      // the robot sphere moves away fast enough
+};
+/// A pair within the ssm cost's activation band.
+struct SsmNearPair {
+  SsmVisit at;
+  Eigen::Vector3d delta;  // robot - human sphere centre (m, W)
+  cell::SsmPair pair;
 };
 
 /// Scratch space of one thread.
 struct Workspace {
+  std::vector<SsmNearPair> ssm_near;         // AddSsmCost's pairs
+  std::vector<std::uint64_t> ssm_actions;    // [waypoint * persons + person]: their actions (bits)
   std::vector<collision::RobotData> data;
   std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
   Eigen::MatrixXd A, V, G;
@@ -101,6 +123,15 @@ struct Workspace {
   std::vector<collision::WaypointBound> active_bounds;
 };
 
+/// A trajectory judged by the separation monitor's rule (ssm_cost.cc).
+struct SsmJudgement {
+  double min_margin = std::numeric_limits<double>::infinity();  // m, smallest d - S_p of the non-retreating pairs
+  int first_violation = -1;  // first waypoint with a pair below ssm_margin, -1: none
+  cell::SsmPair violation;   // its tightest pair
+  double stop_probability = 0.0;  // of the actions stopped there
+  bool ok() const { return first_violation < 0; }
+};
+
 /// A checked trajectory of one optimiser.
 struct Candidate {
   Eigen::MatrixXd Q;
@@ -111,6 +142,7 @@ struct Candidate {
   double min_clearance = 0.0;
   std::vector<double> bounds;
   int first_unsafe = -1;
+  SsmJudgement ssm;         // the monitor's rule (PlannerParams::predict_ssm); part of `safe`
   double first_feasible_time = -1.0;
 };
 
@@ -200,6 +232,19 @@ struct PlannerModel {
   void AddSeparationCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
   void AddPersonSeparationCost(const Problem::Person& person, const Problem& at, Workspace* ws, CostTerms* ev,
                                Eigen::MatrixXd* G) const;
+  // --- ssm_cost.cc: the separation monitor's rule along a plan -------------
+  // Last waypoint the rule judges (ssm_horizon), -1 when off or nobody.
+  int SsmLastWaypoint(const Problem& at) const;
+  // Called per sphere pair near enough to matter (margin < ssm_activation):
+  // where it is, delta (robot - human centre, m) and the pair rule's
+  // result; returns false to stop.
+  using SsmPairVisitor = std::function<bool(const SsmVisit& at, const Eigen::Vector3d& delta, const cell::SsmPair& pair)>;
+  // Waypoints [from, to] with the FK in data[from .. min(to + 1, n)].
+  void VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
+                     const SsmPairVisitor& visit) const;
+  void AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
+  // The rule over the waypoints [from, min(to, SsmLastWaypoint)] of Q.
+  SsmJudgement JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q, int from, int to) const;
   // The dynamic term's parts: waypoints whose bound may exceed its
   // activation, their bounds, and the gradient at one waypoint.
   // Each for one person `p`; the person's bounds of the free waypoints into *out.

@@ -48,6 +48,13 @@ std::string PlannerParams::Validate() const {
     return "wait_duration must be >= dt, got " + Num(wait_duration);
   if (max_waits < 0) return "max_waits must be >= 0, got " + std::to_string(max_waits);
   if (!nonneg(human_separation)) return "human_separation must be >= 0, got " + Num(human_separation);
+  if (!nonneg(ssm_margin)) return "ssm_margin must be >= 0, got " + Num(ssm_margin);
+  if (!(std::isfinite(ssm_activation) && ssm_activation >= ssm_margin))
+    return "ssm_activation must be >= ssm_margin (" + Num(ssm_margin) + "), got " + Num(ssm_activation);
+  if (!positive(ssm_horizon)) return "ssm_horizon must be > 0, got " + Num(ssm_horizon);
+  if (!(ssm_stop_probability > 0.0 && ssm_stop_probability <= 1.0))
+    return "ssm_stop_probability must be in (0, 1], got " + Num(ssm_stop_probability);
+  if (std::string why = ssm.Validate(); !why.empty()) return "iso_ts_15066: " + why;
   if (!nonneg(position_margin)) return "position_margin must be >= 0, got " + Num(position_margin);
   if (!(limit_scale > 0.0 && limit_scale <= 1.0))
     return "limit_scale must be in (0, 1], got " + Num(limit_scale);
@@ -67,7 +74,8 @@ std::string PlannerParams::Validate() const {
                                               {"dynamic", weights.dynamic},
                                               {"goal", weights.goal},
                                               {"limits", weights.limits},
-                                              {"separation", weights.separation}};
+                                              {"separation", weights.separation},
+                                              {"ssm", weights.ssm}};
   for (const auto& [name, v] : w)
     if (!nonneg(v)) return std::string("weights.") + name + " must be >= 0, got " + Num(v);
   if (!(weights.smoothness > 0.0)) return "weights.smoothness must be > 0 (it is the metric)";

@@ -91,6 +91,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   const bool stretched = need > at.n;
   if (stretched) at.n = std::min(need, 2 * horizon_n);
   at.k = req.num_frozen;
+  at.ssm_from = at.k;
   if (at.k >= at.n)
     Bad("num_frozen = " + std::to_string(at.k) + " leaves no free waypoint in a horizon of " +
         std::to_string(at.n) + " intervals");

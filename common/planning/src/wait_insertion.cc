@@ -1,6 +1,8 @@
 // Wait insertion (METHOD.md section 5): when no optimiser found a safe
 // trajectory, the robot holds a safe pose for a while and the optimisers
 // run again on the longer trajectory.
+#include <algorithm>
+
 #include "iplan/cell/people.h"
 #include "planner_model.h"
 
@@ -16,7 +18,9 @@ void PlannerModel::InsertWait(Problem* at, const Candidate* ref, int wait_steps)
   if (ref != nullptr) {
     const Candidate& c = *ref;
     src = c.Q;
-    const int start = (c.first_unsafe < 0 ? at->n : c.first_unsafe) - 1;
+    int first = c.first_unsafe < 0 ? at->n : c.first_unsafe;
+    if (c.ssm.first_violation >= 0) first = std::min(first, c.ssm.first_violation);
+    const int start = first - 1;
     Workspace ws;
     for (int cand = start; cand > at->k - 1; --cand) {
       // The robot must be able to stop at q_cand within the acceleration limits.
@@ -46,6 +50,13 @@ void PlannerModel::InsertWait(Problem* at, const Candidate* ref, int wait_steps)
       }
       bool safe = true;
       for (const auto& b : shares) safe = safe && cell::UnionBound(b) < Threshold();
+      // And the separation monitor must let it stand there (predict_ssm).
+      if (safe && SsmLastWaypoint(hold) >= at->ssm_from) {
+        Eigen::MatrixXd held(at->nq, hold.n + 1);
+        held.leftCols(cand + 1) = c.Q.leftCols(cand + 1);
+        for (int w = 0; w < wait_steps; ++w) held.col(cand + 1 + w) = c.Q.col(cand);
+        safe = JudgeSsm(hold, held, at->ssm_from, hold.n).ok();
+      }
       if (safe) {
         j = cand;
         break;

@@ -24,13 +24,7 @@ std::string RiskParams::Validate() const {
   if (!(slow_down_margin >= 0)) return "slow_down_margin must be >= 0";
   if (!(stale_after > 0)) return "stale_after must be > 0";
   if (!(joint_limit_tolerance >= 0)) return "joint_limit_tolerance must be >= 0";
-  const SsmParams& s = ssm;
-  for (double v : {s.default_human_speed, s.speed_window, s.reaction_time, s.stopping_time, s.stopping_distance,
-                   s.intrusion_distance, s.sensing_uncertainty, s.robot_uncertainty}) {
-    if (!(v >= 0)) return "ISO/TS 15066 parameters must be >= 0";
-  }
-  if (!(s.speed_window > 0)) return "speed_window must be > 0";
-  if (!(s.stopping_speed > 0)) return "stopping_speed must be > 0";
+  if (std::string why = ssm.Validate(); !why.empty()) return why;
   return human_points.Validate();
 }
 
@@ -178,6 +172,7 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
 // fastest robot sphere; the smallest over the persons seen.
 struct RiskMonitor::SeparationSearch {
   double best = std::numeric_limits<double>::infinity(), best_margin = best;
+  bool retreating = false;  // the binding pair is a retreat inside S_p
   std::size_t closest_k = 0, binding_k = 0;
   int closest_h = 0, binding_h = 0;
   cell::BodyId body = 0;  // the person searched now
@@ -213,6 +208,7 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
   r.separation_robot_link = link(search.closest_k);
   r.separation_human_segment = segment(search.closest_h);
   r.separation_margin = search.best_margin;
+  r.retreating = search.retreating;
   r.binding_robot_link = link(search.binding_k);
   r.binding_human_segment = segment(search.binding_h);
 }
@@ -240,21 +236,32 @@ void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure,
       const Eigen::Vector3d delta = data_.p_WS.col(ki) - c;  // human -> robot
       const double centres = delta.norm();
       const double d = centres - robot_spheres[k].radius - human_radius;
-      double v_h = v_h_max, v_r = v_r_max, sp = sp_undirected;
+      double v_h = v_h_max, v_r = v_r_max, sp = sp_undirected, margin = d - sp_undirected;
+      bool retreating = false;
       if (s.directed) {
-        // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
+        // The pair rule the planner predicts (cell::SsmPairRule). Without a
+        // measured speed the person comes at the default speed, straight
+        // at the robot sphere.
         const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
-        v_h = measured ? std::max(0.0, v_c.dot(u)) : s.default_human_speed;
-        v_r = std::max(0.0, -v_robot.col(ki).dot(u));
-        sp = cell::ProtectiveSeparationDistance(s, v_h, v_r);
+        const cell::SsmPair pair = cell::SsmPairRule(s, delta, robot_spheres[k].radius + human_radius,
+                                                     measured ? v_c : Eigen::Vector3d(s.default_human_speed * u),
+                                                     v_robot.col(ki));
+        v_h = pair.v_h;
+        v_r = pair.v_r;
+        sp = pair.protective_separation;
+        retreating = pair.retreating;
+        // A retreat inside S_p is no violation: it binds as a margin of 0
+        // (slow down, not stop) unless a pair outside S_p binds tighter.
+        margin = retreating ? 0.0 : pair.margin;
       }
       if (d < f.best) {
         f.best = d;
         f.closest_k = k;
         f.closest_h = h;
       }
-      if (d - sp < f.best_margin) {
-        f.best_margin = d - sp;
+      if (margin < f.best_margin) {
+        f.best_margin = margin;
+        f.retreating = retreating;
         f.binding_k = k;
         f.binding_h = h;
         r.binding_separation = d;
@@ -387,6 +394,11 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   } else if (r.max_bound >= params_.slow_down_fraction * threshold) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "collision bound " + Fmt(r.max_bound) + " approaching " + Fmt(threshold) + likeliest;
+  } else if (seen && r.retreating) {
+    r.verdict = Verdict::kSlowDown;
+    r.reason = "retreating: separation " + separation + " m (" + r.binding_robot_link + " / " +
+               r.binding_human_segment + ") below the protective separation " + Fmt(r.protective_separation) +
+               " m, the robot moving away" + nearest;
   } else if (seen && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +

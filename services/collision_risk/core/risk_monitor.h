@@ -18,6 +18,11 @@
 // at rest or moving away travels nothing towards the person while it stops).
 // So a stopped robot whose plan moves it away from a person standing
 // still may resume, and a hand moving sideways does not inflate S_p.
+// Retreat (SsmParams::retreat_speed): a pair inside S_p whose robot sphere
+// moves away from the human sphere at retreat_speed or faster does not stop
+// the robot (it binds with margin 0: SLOW_DOWN, "retreating"); the planner
+// predicts the same rule (cell::SsmPairRule), so that a robot in the
+// person's way can get out of it.
 // Verdict: PROTECTIVE_STOP when the separation is below S_p, or the bound
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
 // unknown, or (person_required) no person is tracked; SLOW_DOWN when within
@@ -124,7 +129,8 @@ struct RiskReport {
   double human_speed = 0;                ///< m/s used for that S_p (towards the robot when directed)
   double robot_speed = 0;                ///< m/s used for that S_p (towards the person when directed)
   cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
-  cell::Separation separation_margin;    ///< m, binding_separation - protective_separation; < 0 stops
+  cell::Separation separation_margin;    ///< m, binding_separation - protective_separation (0 for a retreat); < 0 stops
+  bool retreating = false;               ///< the binding pair is inside S_p, its robot sphere moving away (cell::SsmPair)
   std::string binding_robot_link, binding_human_segment;
   cell::BodyId binding_body_id = 0;      ///< person of the binding pair (0: nobody seen)
   Verdict verdict = Verdict::kProtectiveStop;
@@ -176,6 +182,7 @@ class RiskMonitor {
 
   const collision::RobotModel& robot() const { return robot_; }
   const collision::HumanBodyModel& body() const { return body_; }
+  const RiskParams& params() const { return params_; }
 
  private:
   /// What Evaluate knows before it looks at the layers.

@@ -258,6 +258,14 @@ void Replanner::ApplyPlan(const planning::PlanningRequest& req, const planning::
       t.waiting = true;
       ++t.waits;
       r->status = prefix + "planned with " + std::to_string(res.num_waits) + " wait(s)";
+    } else if (res.ssm_margin < planner_.params().ssm_activation) {
+      // The separation monitor's rule (predicted) shapes this plan: the
+      // robot slows down, goes round, holds off or withdraws so that the
+      // monitor need not stop it. Counted as delay, not as a wait.
+      r->held_off = true;
+      t.waiting = true;
+      r->status = prefix + "planned, held off by the monitor's rule (predicted margin " +
+                  std::to_string(res.ssm_margin) + " m)";
     } else if (res.human_separation < planner_.params().human_separation) {
       // The keep-out from the person shapes this plan: the robot goes round
       // or holds off instead of taking its free path. Counted as delay (the

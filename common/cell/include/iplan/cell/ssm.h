@@ -15,6 +15,9 @@
 #pragma once
 
 #include <optional>
+#include <string>
+
+#include <Eigen/Core>
 
 #include "iplan/core/name_value.h"
 
@@ -36,9 +39,17 @@ struct SsmParams {
   double intrusion_distance = 0.1;  ///< m, C
   double sensing_uncertainty = 0.05;  ///< m, Z_d
   double robot_uncertainty = 0.02;    ///< m, Z_r
+  /// Moving away is not stopped (directed only): a sphere pair inside S_p
+  /// whose robot sphere moves away from the human sphere at retreat_speed or
+  /// faster is a retreat, not a violation (SsmPairRule). A stop would leave
+  /// the robot where the person is heading; its retreat only widens the gap.
+  /// <= 0: off (every pair inside S_p stops the robot).
+  double retreat_speed = 0.05;        ///< m/s
 
-  /// The keys of a configuration's iso_ts_15066 mapping; ranges: the
-  /// owner's Validate() (RiskParams).
+  /// Empty when valid, else the reason naming the field.
+  std::string Validate() const;
+
+  /// The keys of a configuration's iso_ts_15066 mapping; ranges: Validate().
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(directed, "speeds towards each other per sphere pair; false: fastest joint and sphere, S_s always"));
@@ -53,6 +64,7 @@ struct SsmParams {
     a->Visit(IPLAN_NVP(intrusion_distance, "m; C, >= 0"));
     a->Visit(IPLAN_NVP(sensing_uncertainty, "m; Z_d, >= 0"));
     a->Visit(IPLAN_NVP(robot_uncertainty, "m; Z_r, >= 0"));
+    a->Visit(IPLAN_NVP(retreat_speed, "m/s; a pair inside S_p whose robot sphere moves away this fast is a retreat, not a stop (<= 0: off; directed only)"));
   }
 };
 
@@ -65,6 +77,29 @@ double StoppingDistance(const SsmParams& p, double v_r);
 
 /// S_p above for the person's speed v_h and the robot's speed v_r (m/s, >= 0).
 double ProtectiveSeparationDistance(const SsmParams& p, double v_h, double v_r);
+
+/// One robot / human sphere pair as the monitor judges it and the planner
+/// predicts it (the same rule for both, so that a plan the planner accepts
+/// is one the monitor lets run).
+struct SsmPair {
+  double separation = 0;  ///< m, surface distance d
+  double v_h = 0;         ///< m/s, the human sphere's speed towards the robot sphere (>= 0)
+  double v_r = 0;         ///< m/s, the robot sphere's speed towards the human sphere (>= 0)
+  double protective_separation = 0;  ///< m, S_p(v_h, v_r)
+  double margin = 0;      ///< m, d - S_p; < 0 is inside S_p
+  bool retreating = false;  ///< inside S_p, but the robot sphere moves away at retreat_speed or faster
+  /// Inside S_p and not retreating: the monitor stops the robot.
+  bool violates() const { return margin < 0 && !retreating; }
+};
+
+/// The pair rule with directed speeds: `delta` is the robot sphere's centre
+/// minus the human sphere's (m, W), `radii` their sum (m), `v_human` and
+/// `v_robot` the spheres' velocities (m/s, W). v_h and v_r are the
+/// components towards each other (clamped at 0); the robot sphere retreats
+/// when its component away from the person is at least retreat_speed
+/// (> 0). Coincident centres give S_p > 0 > d, never a retreat.
+SsmPair SsmPairRule(const SsmParams& p, const Eigen::Vector3d& delta, double radii, const Eigen::Vector3d& v_human,
+                    const Eigen::Vector3d& v_robot);
 
 /// A robot-person separation (m): nullopt when no person is seen. Negative
 /// values are penetration depths.

@@ -140,6 +140,10 @@ struct PlanningResult {
   /// m, smallest distance of the free waypoints to the predicted person
   /// (as the human_separation cost measures it; +inf without prediction).
   double human_separation = std::numeric_limits<double>::infinity();
+  /// m, smallest d - S_p of the separation monitor's rule over the judged
+  /// waypoints, retreats left out (PlannerParams::predict_ssm; +inf when
+  /// off, without people or with no pair within ssm_activation).
+  double ssm_margin = std::numeric_limits<double>::infinity();
   int winning_optimizer = -1;
   int num_feasible = 0;          ///< optimisers feasible and safe in the last attempt
 };

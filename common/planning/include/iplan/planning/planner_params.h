@@ -8,6 +8,7 @@
 #include <utility>
 #include <vector>
 
+#include "iplan/cell/ssm.h"
 #include "iplan/core/name_value.h"
 
 namespace iplan::planning {
@@ -21,6 +22,7 @@ struct CostWeights {
   double goal = 0.5;         ///< x sum_i dt ||q_i - q_goal||^2 (rad^2 s)
   double limits = 50.0;      ///< x squared velocity/acceleration limit excess (normalised)
   double separation = 2000.0; ///< x sum max(0, human_separation - d)^2 (d in m), per robot/human sphere pair
+  double ssm = 2000.0;        ///< x sum p(c) max(0, ssm_activation - (d - S_p))^2 (m), per violating sphere pair (predict_ssm)
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -30,6 +32,7 @@ struct CostWeights {
     a->Visit(IPLAN_NVP(goal, "x sum_i dt ||q_i - q_goal||^2 (rad^2 s); >= 0"));
     a->Visit(IPLAN_NVP(limits, "x squared velocity/acceleration limit excess (normalised); >= 0"));
     a->Visit(IPLAN_NVP(separation, "x sum max(0, human_separation - d)^2 (d in m), per robot/human sphere pair; >= 0"));
+    a->Visit(IPLAN_NVP(ssm, "x sum p(c) max(0, ssm_activation - (d - S_p))^2 (m), per sphere pair (predict_ssm); >= 0"));
   }
 };
 
@@ -89,6 +92,24 @@ struct PlannerParams {
   /// person, or hold off, before the separation monitor has to stop the
   /// robot. A soft cost: it shapes plans but never makes one infeasible.
   double human_separation = 0.0;
+  /// Predicting the separation monitor (ISO/TS 15066 SSM): with
+  /// predict_ssm, every free waypoint within ssm_horizon of waypoint 0 is
+  /// judged by the monitor's own pair rule (cell::SsmPairRule, with `ssm`,
+  /// the monitor's parameters) against the predicted person: each action at
+  /// its mean, moving as its mean moves between prediction steps, and the
+  /// robot sphere moving as the plan moves it to the next waypoint. A
+  /// waypoint is unsafe (the monitor would stop the plan there) when the
+  /// actions under which some pair is inside S_p + ssm_margin without
+  /// retreating have ssm_stop_probability or more; the ssm cost, weighted
+  /// by each action's probability, starts at ssm_activation (>= ssm_margin)
+  /// so that plans keep clear of that, slow down near the person and, when
+  /// the person comes towards the robot, get out of their way.
+  bool predict_ssm = false;
+  cell::SsmParams ssm;
+  double ssm_margin = 0.03;          ///< m, >= 0
+  double ssm_activation = 0.05;      ///< m, >= ssm_margin
+  double ssm_horizon = 1.0;          ///< s, > 0
+  double ssm_stop_probability = 0.5;  ///< in (0, 1]
   /// Joint limits are shrunk by this margin (rad) for the optimiser (>= 0).
   double position_margin = 1e-3;
   /// Velocity/acceleration limits are scaled by this factor in (0, 1] for the
@@ -137,6 +158,12 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(wait_duration, "s; one inserted wait, >= dt"));
   a->Visit(IPLAN_NVP(max_waits, "waits inserted before giving up, >= 0"));
   a->Visit(IPLAN_NVP(human_separation, "m; soft keep-out from the predicted person, >= 0 (0 = off)"));
+  a->Visit(IPLAN_NVP(predict_ssm, "judge plans by the separation monitor's rule against the predicted person"));
+  a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "the monitor's ISO/TS 15066 parameters (trajopt: from the cell's safety file)"));
+  a->Visit(IPLAN_NVP(ssm_margin, "m; a safe plan keeps d - S_p >= this at every free waypoint within ssm_horizon, >= 0"));
+  a->Visit(IPLAN_NVP(ssm_activation, "m; the ssm cost starts below this margin, >= ssm_margin"));
+  a->Visit(IPLAN_NVP(ssm_horizon, "s; waypoints judged by the monitor's rule, > 0"));
+  a->Visit(IPLAN_NVP(ssm_stop_probability, "a waypoint is unsafe when the actions the monitor would stop have this probability, in (0, 1]"));
   a->Visit(IPLAN_NVP(position_margin, "rad; joint limits shrunk by this for the optimiser, >= 0"));
   a->Visit(IPLAN_NVP(limit_scale, "velocity/acceleration limits x this in the penalty, in (0, 1]"));
   a->Visit(IPLAN_NVP(end_effector_link, "link of pose goals, not empty"));

@@ -1,0 +1,170 @@
+// The planner predicts the separation monitor (PlannerParams::predict_ssm):
+// plans are checked here against the monitor's ISO/TS 15066 pair rule
+// (cell::SsmPairRule) waypoint by waypoint, independently of the planner's
+// own bookkeeping.
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include <gtest/gtest.h>
+
+#include "iplan/cell/ssm.h"
+#include "iplan/planning/planner.h"
+#include "test_util.h"
+
+namespace iplan::planning {
+namespace {
+
+using testing::DownOrientation;
+
+Eigen::VectorXd Ready() {
+  Eigen::VectorXd q(7);
+  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+  return q;
+}
+
+// One hand sphere (radius 5 cm) of one action, at `at(k)` at step k (0.1 s apart).
+template <class F>
+collision::HumanPrediction Hand(int steps, F at, double probability = 1.0) {
+  collision::HumanPrediction hand(1, steps, {0.05});
+  hand.set_action_probability(0, probability);
+  for (int k = 0; k < steps; ++k) EXPECT_TRUE(hand.SetSphere(0, k, 0, at(k), 0.0004 * Eigen::Matrix3d::Identity()));
+  hand.UpdateSummaries();
+  return hand;
+}
+
+// The smallest monitor margin d - S_p over the waypoints 1 .. last of Q
+// against the hand (action 0) whose step k is at waypoint k; pairs whose
+// robot sphere moves away at `retreat` m/s or faster are left out.
+double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& Q, double dt,
+                     const collision::HumanPrediction& hand, const cell::SsmParams& ssm, int last, double retreat) {
+  double worst = std::numeric_limits<double>::infinity();
+  collision::RobotData d0(robot), d1(robot);
+  for (int i = 1; i <= std::min<int>(last, static_cast<int>(Q.cols()) - 1); ++i) {
+    collision::CalcForwardKinematics(robot, Q.col(i), &d0);
+    collision::CalcForwardKinematics(robot, Q.col(std::min<Eigen::Index>(i + 1, Q.cols() - 1)), &d1);
+    const int k = std::min(i, hand.num_steps() - 2);
+    const Eigen::Vector3d mu = hand.sphere(0, std::min(i, hand.num_steps() - 1), 0).mean;
+    const Eigen::Vector3d v_h = (hand.sphere(0, k + 1, 0).mean - hand.sphere(0, k, 0).mean) / dt;
+    for (int s = 0; s < static_cast<int>(robot.spheres.size()); ++s) {
+      const Eigen::Vector3d delta = d0.p_WS.col(s) - mu;
+      const Eigen::Vector3d v_r = (d1.p_WS.col(s) - d0.p_WS.col(s)) / dt;
+      if (v_r.dot(delta.normalized()) >= retreat) continue;
+      const cell::SsmPair pair = cell::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h, v_r);
+      worst = std::min(worst, pair.margin);
+    }
+  }
+  return worst;
+}
+
+class PredictedMonitorTest : public ::testing::Test {
+ protected:
+  PredictedMonitorTest() : robot_(testing::LoadPanda()), scene_(testing::LoadCell()) {
+    on_.predict_ssm = true;
+  }
+  collision::RobotModel robot_;
+  collision::SceneParams scene_;
+  PlannerParams off_, on_;
+};
+
+TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
+  // A hand held still 0.22 m beside the middle of the straight path: the
+  // collision bound is negligible there, but a robot passing at speed is
+  // inside the protective separation (S_p = 0.17 m + 0.25 s x v_r).
+  const Planner plain(robot_, scene_, off_);
+  const IkResult s = plain.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = plain.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction hand = Hand(31, [](int) { return Eigen::Vector3d(0.70, -0.10, 0.30); });
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.people = {{&hand, 0.1, 0.0}};
+  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+  const double retreat = 2.0 * on_.ssm.retreat_speed;
+
+  const PlanningResult blind = plain.Plan(req);
+  ASSERT_TRUE(blind.success()) << blind.reason;
+  EXPECT_LT(blind.max_bound, 1.0 - off_.delta_cl);  // the bound alone is content
+  EXPECT_LT(MonitorMargin(robot_, blind.positions, 0.1, hand, on_.ssm, last, retreat), 0.0);  // the monitor is not
+
+  const Planner predicting(robot_, scene_, on_);
+  const PlanningResult seen = predicting.Plan(req);
+  ASSERT_TRUE(seen.success()) << seen.reason;
+  EXPECT_GE(MonitorMargin(robot_, seen.positions, 0.1, hand, on_.ssm, last, retreat), on_.ssm_margin - 1e-9);
+  EXPECT_GE(seen.ssm_margin, on_.ssm_margin - 1e-9);
+  EXPECT_EQ(seen.positions.col(seen.positions.cols() - 1), g.q);  // it still gets there
+}
+
+TEST_F(PredictedMonitorTest, ARobotInThePersonsWayGetsOutOfIt) {
+  // The robot rests at its goal; the hand is predicted to come straight at
+  // the tool at 0.25 m/s, from 0.5 m away to 0.25 m in 1 s. Holding still
+  // there is what the monitor would stop (and where the contact would be);
+  // the plan withdraws instead, within the monitor's rule.
+  const Planner predicting(robot_, scene_, on_);
+  const IkResult at = predicting.SolveIk({0.50, 0.0, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(at.success);
+  collision::RobotData d(robot_);
+  collision::CalcForwardKinematics(robot_, at.q, &d);
+  const int tool = static_cast<int>(robot_.spheres.size()) - 1;
+  const Eigen::Vector3d tool_W = d.p_WS.col(tool);
+  const collision::HumanPrediction hand =
+      Hand(16, [&](int k) { return Eigen::Vector3d(tool_W + Eigen::Vector3d(0.5 - 0.025 * std::min(k, 10), 0, 0)); });
+  PlanningRequest req;
+  req.start_q = at.q;
+  req.goal = Goal::Joint(at.q);
+  req.people = {{&hand, 0.1, 0.0}};
+  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+
+  const Eigen::MatrixXd hold = at.q.replicate(1, last + 2);
+  EXPECT_LT(MonitorMargin(robot_, hold, 0.1, hand, on_.ssm, last, 2.0 * on_.ssm.retreat_speed), 0.0);
+
+  const PlanningResult r = predicting.Plan(req);
+  ASSERT_TRUE(r.success()) << r.reason;
+  EXPECT_GE(MonitorMargin(robot_, r.positions, 0.1, hand, on_.ssm, last, 2.0 * on_.ssm.retreat_speed),
+            on_.ssm_margin - 1e-9);
+  // It moved the tool away from where the hand is going.
+  collision::CalcForwardKinematics(robot_, r.positions.col(last), &d);
+  const Eigen::Vector3d hand_end = hand.sphere(0, last, 0).mean;
+  EXPECT_GT((d.p_WS.col(tool) - hand_end).norm(), (tool_W - hand_end).norm() + 0.05);
+}
+
+TEST_F(PredictedMonitorTest, AnUnlikelyActionDoesNotBlockTheGoal) {
+  // The same approach, predicted with 30 % (below ssm_stop_probability
+  // 0.5): the monitor would more likely than not let the robot stand, so
+  // it stays at its goal instead of withdrawing.
+  const Planner predicting(robot_, scene_, on_);
+  const IkResult at = predicting.SolveIk({0.50, 0.0, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(at.success);
+  collision::RobotData d(robot_);
+  collision::CalcForwardKinematics(robot_, at.q, &d);
+  const Eigen::Vector3d tool_W = d.p_WS.col(static_cast<int>(robot_.spheres.size()) - 1);
+  const collision::HumanPrediction hand = Hand(
+      16, [&](int k) { return Eigen::Vector3d(tool_W + Eigen::Vector3d(0.5 - 0.025 * std::min(k, 10), 0, 0)); }, 0.3);
+  PlanningRequest req;
+  req.start_q = at.q;
+  req.goal = Goal::Joint(at.q);
+  req.people = {{&hand, 0.1, 0.0}};
+  const PlanningResult r = predicting.Plan(req);
+  ASSERT_TRUE(r.success()) << r.reason;
+  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+  EXPECT_LT((r.positions.col(last) - at.q).cwiseAbs().maxCoeff(), 0.01);
+}
+
+TEST(PredictedMonitorParams, BadValuesAreRefusedByName) {
+  PlannerParams p;
+  p.ssm_margin = -0.01;
+  EXPECT_NE(p.Validate().find("ssm_margin"), std::string::npos);
+  p = PlannerParams{};
+  p.ssm_activation = 0.01;  // below ssm_margin 0.03
+  EXPECT_NE(p.Validate().find("ssm_activation"), std::string::npos);
+  p = PlannerParams{};
+  p.ssm_stop_probability = 0.0;
+  EXPECT_NE(p.Validate().find("ssm_stop_probability"), std::string::npos);
+  p = PlannerParams{};
+  p.ssm.stopping_speed = 0.0;
+  EXPECT_NE(p.Validate().find("iso_ts_15066"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace iplan::planning
