@@ -90,7 +90,7 @@ TEST_F(CellCheck, RetreatInsideThePersonsSpaceIsNamed) {
 TEST_F(CellCheck, UndirectedSpeedsMakeTheSameCellInconsistent) {
   // The fastest joint and the fastest sphere, whatever their direction, and
   // S_s always: hand_over would be stopped even while the person idles.
-  Edit(dir_ / "collision_risk.yaml", R"(directed: true )", "directed: false ");
+  Edit(dir_ / "safety.yaml", R"(directed: true )", "directed: false ");  // the cell's one safety file
   std::string out;
   EXPECT_EQ(Run(&out), 1) << out;
   EXPECT_NE(out.find("inconsistent: 'hand_over' is declared harmless during 'idle'"), std::string::npos) << out;

@@ -194,6 +194,44 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
               1e-9);
 }
 
+// Inside S_p, moving away is a retreat (SsmParams::retreat_speed): the
+// monitor lets it run (SLOW_DOWN), where standing still or coming closer
+// stops; with retreat_speed 0 every pair inside S_p stops.
+TEST_F(RiskMonitorTest, InsideTheProtectiveSeparationARetreatRunsAndRestStops) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  const Eigen::Vector3d torso(0.86, 0, 0.5);  // the hand about 0.15 m from the robot, standing still
+  SeePerson(t - 2 * kSec / 10, torso, 0.3);
+  SeePerson(t, torso, 0.3);
+  const RiskReport rest = monitor_.Evaluate(t);
+  ASSERT_LT(rest.min_separation.value(), 0.17 - 0.005);
+  ASSERT_GT(rest.min_separation.value(), 0.05);
+  EXPECT_EQ(rest.verdict, Verdict::kProtectiveStop) << rest.reason;
+  EXPECT_FALSE(rest.retreating);
+  // Folding the shoulder back at about 0.5 rad/s moves the spheres away.
+  const std::vector<std::vector<double>> back = {{0, -0.785, 0, -2.356, 0, 1.571, 0.785},
+                                                 {0, -1.3, 0, -2.356, 0, 1.571, 0.785}};
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 1.0}, back), std::nullopt);
+  const RiskReport away = monitor_.Evaluate(t);
+  EXPECT_EQ(away.verdict, Verdict::kSlowDown) << away.reason;
+  EXPECT_TRUE(away.retreating);
+  EXPECT_EQ(away.reason.rfind("retreating: separation ", 0), 0u) << away.reason;
+  EXPECT_EQ(away.separation_margin.value(), 0.0);
+  // Too slow to count as a retreat (0.01 rad/s): a stop.
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 51.5}, back), std::nullopt);
+  EXPECT_EQ(monitor_.Evaluate(t).verdict, Verdict::kProtectiveStop);
+  // The strict reading: no retreat inside S_p.
+  RiskParams strict = monitor_.params();
+  strict.ssm.retreat_speed = 0.0;
+  RiskMonitor m(monitor_.robot(), collision::HumanBodyParams::DefaultUpperBody(), strict);
+  ASSERT_EQ(m.UpdateRobotState(t, kRobotJoints, back[0]), std::nullopt);
+  ASSERT_EQ(m.UpdateTrajectory(t, kRobotJoints, {0.0, 1.0}, back), std::nullopt);
+  for (int64_t ts : {t - 2 * kSec / 10, t})
+    ASSERT_EQ(m.UpdateSkeleton(ts, kJoints, Person(torso, 0.3)), std::nullopt);
+  const RiskReport strict_away = m.Evaluate(t);
+  EXPECT_EQ(strict_away.verdict, Verdict::kProtectiveStop) << strict_away.reason;
+}
+
 TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
   const int64_t t = 100 * kSec;
   RobotAtReady(t);

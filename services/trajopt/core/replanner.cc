@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <stdexcept>
 #include <utility>
 
@@ -75,6 +76,7 @@ TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int6
   o.max_collision_bound = task_->max_bound;
   task_.reset();
   previous_.reset();
+  park_ = q_ ? std::optional<Eigen::VectorXd>(q_->second) : std::nullopt;
   return o;
 }
 
@@ -138,7 +140,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
     r.status = "waiting for a current robot state";
     return r;
   }
-  if (!task_) return Hold(now_ns, q_->second, "idle");
+  if (!task_) return StandBy(now_ns);
   Active& t = *task_;
   // The robot waited from the previous cycle until now (cycles can be longer
   // than the planning step while the planner inserts waits).
@@ -149,7 +151,8 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (std::optional<CycleResult> over = CheckProgress(now_ns, &r)) return *over;
 
   int64_t start_ns = now_ns;
-  const planning::PlanningRequest req = MakeRequest(now_ns, &start_ns, &r);
+  const planning::PlanningRequest req =
+      MakeRequest(now_ns, t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal, &start_ns, &r);
   planning::PlanningResult res;
   try {
     res = planner_.Plan(req);
@@ -173,6 +176,105 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   ApplyPlan(req, res, &r);
   previous_ = std::make_pair(start_ns, r.positions);
   return r;
+}
+
+// Without a task the robot stays where it was left (the park pose), unless
+// the person is predicted to come where it stands: with predict_ssm the
+// planner plans to the park pose against the prediction, which moves the
+// arm out of the person's way (the monitor's retreat rule) and back once
+// they have gone. Without predict_ssm or a fresh prediction: a hold.
+CycleResult Replanner::StandBy(int64_t now_ns) {
+  if (!park_) park_ = q_->second;
+  const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
+  predictions_.Expire(now_ns, stale);
+  if (!planner_.params().predict_ssm || predictions_.CountFresh(now_ns, stale) == 0) {
+    previous_.reset();
+    park_ = q_->second;
+    return Hold(now_ns, q_->second, "idle");
+  }
+  CycleResult r;
+  int64_t start_ns = now_ns;
+  planning::PlanningRequest req = MakeRequest(now_ns, planning::Goal::Joint(*park_), &start_ns, &r);
+  planning::PlanningResult res;
+  try {
+    res = planner_.Plan(req);
+    // The park pose itself is where the person is going: make way to a
+    // pose beside it instead (the plan's goal cannot be unsafe).
+    if (!res.success()) {
+      if (const std::optional<planning::Goal> aside = AsideGoal(req)) {
+        req.goal = *aside;
+        planning::PlanningResult other = planner_.Plan(req);
+        if (other.success()) {
+          res = std::move(other);
+          r.status = "stepping aside; ";
+        }
+      }
+    }
+  } catch (const std::exception& e) {
+    previous_.reset();
+    return Hold(now_ns, q_->second, std::string("idle (planning refused the request: ") + e.what() + ")");
+  }
+  r.planning_time = res.planning_time;
+  r.budget_exhausted = res.budget_exhausted;
+  r.publish = true;
+  r.start_ns = start_ns;
+  r.dt = planner_.params().dt;
+  if (res.success()) {
+    r.positions = res.positions;
+    r.max_bound = res.max_bound;
+    const double away = (res.positions.colwise() - *park_).cwiseAbs().maxCoeff();
+    r.held_off = away > params_.goal_tolerance;
+    r.status += !r.held_off                ? "idle"
+                : std::isfinite(res.ssm_margin) ? "idle, yielding to the person (predicted margin " +
+                                                     std::to_string(res.ssm_margin) + " m)"
+                                                : "idle, returning to where it was left";
+  } else {
+    const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);
+    const int keep = std::max(1, std::min<int>(req.num_frozen, static_cast<int>(base.cols())));
+    r.positions.resize(base.rows(), keep + 1);
+    r.positions.leftCols(keep) = base.leftCols(keep);
+    r.positions.col(keep) = base.col(keep - 1);
+    r.waiting = true;
+    r.status += "idle, no safe trajectory: holding (" + res.reason + ")";
+  }
+  previous_ = std::make_pair(start_ns, r.positions);
+  return r;
+}
+
+// The end effector moved kAsideDistance horizontally away from the person's
+// predicted sphere nearest to it (the newest step of every action of every
+// fresh prediction), its orientation kept; nullopt without a person or a
+// direction.
+std::optional<planning::Goal> Replanner::AsideGoal(const planning::PlanningRequest& req) const {
+  constexpr double kAsideDistance = 0.25;  // m
+  const collision::RobotModel& robot = planner_.robot();
+  const int ee = robot.FindLink(planner_.params().end_effector_link);
+  if (ee < 0 || req.people.empty()) return std::nullopt;
+  collision::RobotData d(robot);
+  const Eigen::VectorXd q = req.warm_start.cols() > 0 ? Eigen::VectorXd(req.warm_start.col(0)) : req.start_q;
+  collision::CalcForwardKinematics(robot, q, &d);
+  const Eigen::Vector3d offset(planner_.params().end_effector_offset[0], planner_.params().end_effector_offset[1],
+                               planner_.params().end_effector_offset[2]);
+  const Eigen::Vector3d p_WE = d.X_WL[static_cast<std::size_t>(ee)] * offset;
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d nearest = Eigen::Vector3d::Zero();
+  for (const planning::PersonPrediction& person : req.people) {
+    const collision::HumanPrediction& hp = *person.spheres;
+    for (int a = 0; a < hp.num_actions(); ++a) {
+      for (int l = 0; l < hp.num_spheres(); ++l) {
+        const Eigen::Vector3d& mu = hp.sphere(a, hp.num_steps() - 1, l).mean;
+        if ((mu - p_WE).norm() < best) {
+          best = (mu - p_WE).norm();
+          nearest = mu;
+        }
+      }
+    }
+  }
+  Eigen::Vector3d away = p_WE - nearest;
+  away.z() = 0;
+  if (!std::isfinite(best) || away.norm() < 1e-6) return std::nullopt;
+  const Eigen::Quaterniond R_WE(d.X_WL[static_cast<std::size_t>(ee)].rotation());
+  return planning::Goal::Pose(p_WE + kAsideDistance * away.normalized(), R_WE);
 }
 
 // Arrived? At the goal of a task with a retreat, the task goes on to it.
@@ -202,8 +304,8 @@ std::optional<CycleResult> Replanner::CheckProgress(int64_t now_ns, CycleResult*
 // The request of this cycle: from the executing plan (its frozen prefix kept)
 // when the robot follows it, else from the robot's state; the goal; the
 // prediction when it is fresh. *start_ns is the time of waypoint 0.
-planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_ns, CycleResult* r) {
-  const Active& t = *task_;
+planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning::Goal& goal, int64_t* start_ns,
+                                                CycleResult* r) {
   const double dt = planner_.params().dt;
   planning::PlanningRequest req;
   if (previous_) {
@@ -229,7 +331,7 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, int64_t* start_
     req.start_qdot = Eigen::VectorXd::Zero(req.start_q.size());
     req.num_frozen = 1;
   }
-  req.goal = t.goal_q ? planning::Goal::Joint(*t.goal_q) : t.spec.goal;
+  req.goal = goal;
   req.time_budget = params_.cycle_budget;
   req.obstacles = obstacles_;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);

@@ -106,7 +106,7 @@ struct CycleResult {
   int64_t prediction_t0_ns = 0;      ///< stamp of the observation behind the newest prediction planned against (0: none)
   int num_people = 0;                ///< persons planned against (fresh predictions)
   bool waiting = false;              ///< the plan holds the robot (waits inserted or no safe trajectory)
-  bool held_off = false;             ///< the plan keeps out of the person's space (PlannerParams::human_separation)
+  bool held_off = false;             ///< the plan keeps out of the person's space (human_separation, predict_ssm) or, idle, yields to them
   double max_bound = 0;              ///< highest per-waypoint collision bound of the plan
   bool budget_exhausted = false;     ///< planning ran out of ReplannerParams::cycle_budget
   std::optional<TaskOutcome> outcome;
@@ -158,7 +158,9 @@ class Replanner {
   TaskOutcome Finish(TaskStatus status, const std::string& reason, int64_t now_ns);
   CycleResult Hold(int64_t now_ns, const Eigen::VectorXd& q, const std::string& status);
   std::optional<CycleResult> CheckProgress(int64_t now_ns, CycleResult* r);
-  planning::PlanningRequest MakeRequest(int64_t now_ns, int64_t* start_ns, CycleResult* r);
+  planning::PlanningRequest MakeRequest(int64_t now_ns, const planning::Goal& goal, int64_t* start_ns, CycleResult* r);
+  CycleResult StandBy(int64_t now_ns);
+  std::optional<planning::Goal> AsideGoal(const planning::PlanningRequest& req) const;
   void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
 
   const planning::Planner& planner_;
@@ -184,6 +186,8 @@ class Replanner {
     int64_t last_cycle_ns = 0;
   };
   std::optional<Active> task_;
+  // Where the robot was left without a task (it returns there after yielding).
+  std::optional<Eigen::VectorXd> park_;
   // Previous plan (the trajectory being executed).
   std::optional<std::pair<int64_t, Eigen::MatrixXd>> previous_;
 };

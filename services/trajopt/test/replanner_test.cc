@@ -118,6 +118,60 @@ TEST_F(ReplannerTest, IdleHoldsTheCurrentPose) {
   EXPECT_FALSE(replanner_.Cycle(10 * kSec).publish);  // the state went stale
 }
 
+// A person coming at the idle robot: with the monitor's rule predicted, the
+// arm withdraws from where their hand is heading (instead of standing in
+// their way until the monitor stops it, or they touch it), and returns to
+// where it was left once they have gone back.
+TEST_F(ReplannerTest, AnIdleRobotYieldsToAPersonComingAtItAndReturns) {
+  // The cell's replanning settings (predict_ssm on).
+  const planning::PlannerParams pp = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+  ASSERT_TRUE(pp.predict_ssm);
+  const planning::Planner predicting(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                     collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), pp);
+  Replanner replanner(predicting, body_, ReplannerParams{});
+  const collision::RobotModel& robot = predicting.robot();
+  collision::RobotData d(robot);
+  collision::CalcForwardKinematics(robot, Ready(), &d);
+  const int tool = static_cast<int>(robot.spheres.size()) - 1;
+  const Eigen::Vector3d tool_W = d.p_WS.col(tool);
+  // The hand's x offset from the tool: 0.60 m, in at 0.35 m/s to 0.20 m
+  // (inside S_p of a robot at rest), held there until 3 s, then back to 0.9 m.
+  auto offset = [](double s) { return s < 3.0 ? std::max(0.20, 0.60 - 0.35 * s) : 0.90; };
+  const int64_t t_start = 100 * kSec;
+  int64_t t = t_start;
+  Eigen::VectorXd q = Ready();
+  std::vector<std::string> statuses;
+  double closest = std::numeric_limits<double>::infinity();  // tool to hand, while the hand is in
+  for (int k = 0; k < 60; ++k) {
+    const std::vector<double> qv(q.data(), q.data() + q.size());
+    ASSERT_EQ(replanner.UpdateRobotState(t, replanner.joint_names(), qv, std::vector<double>(7, 0.0)), std::nullopt);
+    collision::JointMixture m = PersonAt(t, tool_W + Eigen::Vector3d(offset((t - t_start) * 1e-9), 0, 0));
+    for (int step = 0; step < m.num_steps; ++step) {  // the hand where it will be at each step
+      const Eigen::Vector3d hand = tool_W + Eigen::Vector3d(offset((t - t_start) * 1e-9 + 0.1 * step), 0, 0);
+      const Eigen::Vector3d now = m.means[0][static_cast<std::size_t>(step) * m.joint_names.size() + 8];
+      for (std::size_t j = 0; j < m.joint_names.size(); ++j)
+        m.means[0][static_cast<std::size_t>(step) * m.joint_names.size() + j] += hand - now;
+    }
+    ASSERT_EQ(replanner.UpdatePrediction(m), std::nullopt);
+    const CycleResult c = replanner.Cycle(t);
+    ASSERT_TRUE(c.publish) << c.status;
+    statuses.push_back(c.status);
+    t += kSec / 10;
+    q = At(c, t);
+    collision::CalcForwardKinematics(robot, q, &d);
+    if ((t - t_start) * 1e-9 < 3.0)
+      closest = std::min(closest, (d.p_WS.col(tool) - (tool_W + Eigen::Vector3d(offset((t - t_start) * 1e-9), 0, 0))).norm());
+  }
+  EXPECT_NE(std::find_if(statuses.begin(), statuses.end(),
+                         [](const std::string& s) { return s.find("yielding") != std::string::npos; }),
+            statuses.end());
+  // Standing still, the tool would have had the hand 0.20 m from its centre.
+  EXPECT_GT(closest, 0.20 + 0.08);
+  // Back where it was left.
+  EXPECT_LT((q - Ready()).cwiseAbs().maxCoeff(), 0.02);
+  EXPECT_EQ(statuses.back().rfind("idle", 0), 0u) << statuses.back();
+}
+
 TEST_F(ReplannerTest, ReachesAJointGoalWithoutDelay) {
   int64_t t = 100 * kSec;
   SetState(t, Ready(), Eigen::VectorXd::Zero(7));
