@@ -46,7 +46,7 @@ void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, 
       if (c->first_unsafe < 0 && c->bounds[i] >= Threshold()) c->first_unsafe = i;
     }
   }
-  c->ssm = JudgeSsm(at, Q, at.ssm_from, at.n);
+  c->ssm = JudgeSsm(at, Q, at.ssm_from, at.n, ws);
   c->safe = c->first_unsafe < 0 && c->ssm.ok();
 }
 

@@ -108,6 +108,7 @@ struct SsmNearPair {
 struct Workspace {
   std::vector<SsmNearPair> ssm_near;         // AddSsmCost's pairs
   std::vector<std::uint64_t> ssm_actions;    // [waypoint * persons + person]: their actions (bits)
+  std::vector<cell::SsmPair> ssm_tightest;   // JudgeSsm: the tightest violating pair there
   std::vector<collision::RobotData> data;
   std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
   Eigen::MatrixXd A, V, G;
@@ -244,7 +245,8 @@ struct PlannerModel {
                      const SsmPairVisitor& visit) const;
   void AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;
   // The rule over the waypoints [from, min(to, SsmLastWaypoint)] of Q.
-  SsmJudgement JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q, int from, int to) const;
+  // FK and bookkeeping in ws (its data are overwritten).
+  SsmJudgement JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q, int from, int to, Workspace* ws) const;
   // The dynamic term's parts: waypoints whose bound may exceed its
   // activation, their bounds, and the gradient at one waypoint.
   // Each for one person `p`; the person's bounds of the free waypoints into *out.

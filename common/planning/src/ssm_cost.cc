@@ -88,9 +88,17 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
         for (int l = 0; l < H; ++l) {
           const collision::HumanPrediction::Summary& sm = hp.summary(t, l);
           // Any pair of this group and sphere l: S_p is at most that of the
-          // fastest robot sphere and a person at the fastest of the actions' speeds.
+          // fastest robot sphere and the fastest action's mean speed.
           const double far = (c - sm.centre).norm() - sm.spread - cover - hp.radius(l);
-          if (far >= reach + cell::ProtectiveSeparationDistance(s, 3.0 * s.default_human_speed, v_r_max)) continue;
+          if (far >= reach + cell::ProtectiveSeparationDistance(s, 0.0, v_r_max)) {
+            double v_h_max = 0.0;
+            if (t_next > t_prev) {
+              for (int a = 0; a < hp.num_actions(); ++a)
+                v_h_max = std::max(v_h_max, (hp.sphere(a, t_next, l).mean - hp.sphere(a, t_prev, l).mean).norm());
+              v_h_max /= person.dt * (t_next - t_prev);
+            }
+            if (far >= reach + cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max)) continue;
+          }
           for (int a = 0; a < hp.num_actions(); ++a) {
             const double pa = hp.action_probability(a);
             if (pa < kMinProbability) continue;
@@ -158,18 +166,23 @@ void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, E
   }
 }
 
-SsmJudgement PlannerModel::JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q, int from, int to) const {
+SsmJudgement PlannerModel::JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q, int from, int to,
+                                    Workspace* ws) const {
   SsmJudgement j;
   const int last = std::min(to, SsmLastWaypoint(at));
   from = std::max(from, 1);
   if (last < from) return j;
-  std::vector<collision::RobotData> data(static_cast<std::size_t>(at.n + 1), collision::RobotData(robot));
+  // FK into the thread's scratch (ws->data: Evaluate recomputes what it needs).
+  std::vector<collision::RobotData>& data = ws->data;
+  while (static_cast<int>(data.size()) < at.n + 1) data.emplace_back(robot);
   for (int i = from; i <= std::min(at.n, last + 1); ++i) collision::CalcForwardKinematics(robot, Q.col(i), &data[i]);
   // Per waypoint and person: the actions with a violating pair (bit a), and
   // the tightest such pair.
   const std::size_t P = at.people.size();
-  std::vector<std::uint64_t> stopped(static_cast<std::size_t>(last + 1) * P, 0);
-  std::vector<cell::SsmPair> tightest(stopped.size());
+  std::vector<std::uint64_t>& stopped = ws->ssm_actions;
+  stopped.assign(static_cast<std::size_t>(last + 1) * P, 0);
+  std::vector<cell::SsmPair>& tightest = ws->ssm_tightest;
+  tightest.resize(stopped.size());
   VisitSsmPairs(at, data, from, last, [&](const SsmVisit& v, const Eigen::Vector3d&, const cell::SsmPair& pair) {
     if (v.retreat) return true;
     if (v.probability >= kSeparationMinProbability) j.min_margin = std::min(j.min_margin, pair.margin);

@@ -55,7 +55,7 @@ void PlannerModel::InsertWait(Problem* at, const Candidate* ref, int wait_steps)
         Eigen::MatrixXd held(at->nq, hold.n + 1);
         held.leftCols(cand + 1) = c.Q.leftCols(cand + 1);
         for (int w = 0; w < wait_steps; ++w) held.col(cand + 1 + w) = c.Q.col(cand);
-        safe = JudgeSsm(hold, held, at->ssm_from, hold.n).ok();
+        safe = JudgeSsm(hold, held, at->ssm_from, hold.n, &ws).ok();
       }
       if (safe) {
         j = cand;
