@@ -1,9 +1,12 @@
 // `iplan eval interaction`: the closed-loop interaction benchmark. Seeded
 // scenarios in the cell (a robot task while a recorded or the synthetic
-// person moves near or across its path), each run in one process and in
-// simulated time through the services' cores once per predictor, and the
-// figures per predictor: task time, protective stops, time in stop, minimum
-// true separation, maximum true bound, true contacts (median and [p10, p90]
+// person moves near or across its path; `--suite shared-space`: hand-overs,
+// a parts bin both reach into, co-assembly, the person crossing the path,
+// every one bringing the person within reach of the robot's path), each run
+// in one process and in simulated time through the services' cores once per
+// predictor, and the figures per predictor: task time, protective stops,
+// time in stop, minimum true separation, maximum true bound, true contacts
+// split into those with the robot moving and at rest (median and [p10, p90]
 // over the scenarios, paired ratios against `none`). The work is done by
 // services/cell_sim; this file parses options, prepares the intent model as
 // `iplan demo --prepare-only` does, and prints.
@@ -46,6 +49,7 @@ struct InteractionOptions {
   int scenarios = 40;
   uint64_t seed = 1;
   std::string json_file, config_dir, recordings, model_dir, monitor = "same";
+  std::string suite = "default";
   int threads = 1;
   int trace = -1;  // scenario whose runs are traced (-1: none)
   double time_limit = 20;
@@ -115,6 +119,12 @@ bool CheckOptions(const InteractionOptions& o) {
     std::cerr << "iplan eval interaction: --monitor-prediction must be 'same' or 'model', got '" << o.monitor << "'\n";
     return false;
   }
+  if (!cell_sim::ParseSuite(o.suite)) {
+    std::string known;
+    for (const auto& n : cell_sim::SuiteNames()) known += (known.empty() ? "'" : " or '") + n + "'";
+    std::cerr << "iplan eval interaction: --suite must be " << known << ", got '" << o.suite << "'\n";
+    return false;
+  }
   return true;
 }
 
@@ -152,14 +162,20 @@ void LoadInputs(const InteractionOptions& o, EvalInputs* in) {
 
 void PrintHeader(const InteractionOptions& o, const EvalInputs& in, const cell_sim::BenchmarkSetup& setup,
                  const std::vector<Predictor>& predictors, std::size_t num_scenarios) {
-  std::cout << "iplan eval interaction: " << num_scenarios << " scenarios, seed " << o.seed << ", predictors";
+  std::cout << "iplan eval interaction: " << num_scenarios << " scenarios of the " << o.suite << " suite, seed " << o.seed
+            << ", predictors";
   for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
   std::cout << "\n  configuration " << in.dir << "\n  recorded motion " << in.recordings_file << "\n  " << in.model.summary
             << "\n  monitor prediction: "
             << (setup.monitor_input == cell_sim::MonitorInput::kModel ? "the model's, for every predictor"
                                                                         : "the planner's (with none: the model's)")
-            << "; planner threads " << (o.threads > 0 ? std::to_string(o.threads) : std::string("as configured"))
-            << "\n  baseline covariance growth per joint, fitted on the model's training demonstrations:";
+            << "; planner threads " << (o.threads > 0 ? std::to_string(o.threads) : std::string("as configured"));
+  if (o.suite == cell_sim::ToString(cell_sim::Suite::kSharedSpace)) {
+    std::cout << "\n  shared space: every scenario's person within " << Fixed(setup.shared_space.max_path_distance, 2)
+              << " m of the straight joint path from start to goal, within " << Fixed(setup.shared_space.window, 1)
+              << " s of the task command (path_distance_m per scenario in the JSON)";
+  }
+  std::cout << "\n  baseline covariance growth per joint, fitted on the model's training demonstrations:";
   const auto& body_joints = in.cell.body->params().joints;
   for (const auto* b : {&setup.constant_position, &setup.constant_velocity}) {
     std::cout << "\n    " << (b == &setup.constant_position ? "constant-position speed_std m/s:       "
@@ -190,6 +206,24 @@ Json ScenarioJson(const cell_sim::ScenarioSpec& s, Predictor predictor, const ce
   if (s.retreat_q.size() > 0) j["retreat_q"] = VectorJson(s.retreat_q);
   if (s.task == "reach") j["reach_p_m"] = VectorJson(s.reach_p_WE);
   j["noise_seed"] = s.seed;
+  if (!s.kind.empty()) {
+    j["kind"] = s.kind;
+    j["shared_point_m"] = VectorJson(s.shared_point_W);
+    if (s.path_distance) j["path_distance_m"] = *s.path_distance;
+    j["draws"] = s.draws;
+    for (const auto& a : s.person_actions) {
+      if (a.kind == perception::MotionKind::kRest) continue;
+      j["person_action"] = Json{{"name", a.name},
+                                {"hand", a.kind == perception::MotionKind::kWork ? "both" : (a.right_hand ? "right" : "left")},
+                                {"target_m", VectorJson(a.target_W)},
+                                {"period_s", a.period}};
+    }
+    if (s.sweep) {
+      j["sweep"] = Json{{"hand", s.sweep->right_hand ? "right" : "left"}, {"from_m", VectorJson(s.sweep->from_W)},
+                        {"to_m", VectorJson(s.sweep->to_W)},         {"start_s", s.sweep->start},
+                        {"approach_s", s.sweep->approach},           {"duration_s", s.sweep->duration}};
+    }
+  }
   j["succeeded"] = r.finished && r.status == trajopt::TaskStatus::kSucceeded;
   if (!r.reason.empty()) j["reason"] = r.reason;
   j["task_time_s"] = r.task_time;
@@ -200,6 +234,13 @@ Json ScenarioJson(const cell_sim::ScenarioSpec& s, Predictor predictor, const ce
   j["min_separation_m"] = r.min_separation;
   j["max_bound"] = r.max_bound;
   j["true_contacts"] = r.true_contacts;
+  j["robot_moving_contacts"] = r.robot_moving_contacts;
+  j["robot_at_rest_contacts"] = r.robot_at_rest_contacts;
+  if (!r.contact_speeds.empty()) {
+    Json speeds = Json::array();
+    for (double v : r.contact_speeds) speeds.push_back(v);
+    j["contact_robot_speeds_rad_s"] = speeds;
+  }
   j["waits"] = r.waits;
   j["planner_delay_s"] = r.planner_delay;
   if (!r.first_stop_reason.empty()) j["first_stop"] = r.first_stop_reason;
@@ -223,6 +264,8 @@ Json SummaryJson(const cell_sim::PredictorSummary& s) {
   j["min_separation_m"] = SpreadJson(s.min_separation);
   j["max_bound"] = SpreadJson(s.max_bound);
   j["true_contacts"] = s.true_contacts;
+  j["robot_moving_contacts"] = s.robot_moving_contacts;
+  j["robot_at_rest_contacts"] = s.robot_at_rest_contacts;
   if (s.has_reference) {
     j["vs_none"] = Json{{"task_time_median_ratio", RatioJson(s.task_time_median_ratio)},
                         {"task_time_paired_ratio", SpreadJson(s.task_time_ratio)},
@@ -246,15 +289,17 @@ void PrintTable(const std::vector<cell_sim::PredictorSummary>& summary) {
   const int w = 19;
   std::cout << std::left << std::setw(w) << "predictor" << std::setw(24) << "task time s" << std::setw(20)
             << "stops tot sep/bnd" << std::setw(24) << "time in stop s" << std::setw(24) << "min separation m"
-            << std::setw(24) << "max true bound" << std::setw(9) << "contacts" << "done\n";
+            << std::setw(24) << "max true bound" << std::setw(9) << "contacts" << std::setw(8) << "moving"
+            << std::setw(9) << "at rest" << "done\n";
   for (const auto& s : summary) {
     std::cout << std::left << std::setw(w) << cell_sim::ToString(s.predictor) << std::setw(24)
               << SpreadText(s.task_time, 2) << std::setw(20)
               << (std::to_string(s.protective_stops_total) + " " + std::to_string(s.stops_separation_total) + "/" +
                   std::to_string(s.stops_bound_total))
               << std::setw(24) << SpreadText(s.stop_time, 2) << std::setw(24) << SpreadText(s.min_separation, 3)
-              << std::setw(24) << SpreadText(s.max_bound, 3) << std::setw(9) << s.true_contacts << s.succeeded << "/"
-              << s.scenarios << "\n";
+              << std::setw(24) << SpreadText(s.max_bound, 3) << std::setw(9) << s.true_contacts << std::setw(8)
+              << s.robot_moving_contacts << std::setw(9) << s.robot_at_rest_contacts << s.succeeded << "/" << s.scenarios
+              << "\n";
   }
   if (summary.empty() || !summary.front().has_reference) return;
   std::cout << "\npaired against none: task time (median of per-scenario ratios [p10, p90]; ratio of medians),\n"
@@ -290,8 +335,9 @@ bool RunScenarios(const InteractionOptions& o, const std::vector<Predictor>& pre
     }
     const auto& row = results->back();
     if (!o.quiet) {
-      std::cerr << "  scenario " << std::setw(3) << s.index + 1 << "/" << specs.size() << " " << s.source << " "
-                << s.sequence.substr(0, 24) << ", " << s.task << " from " << s.start << ":";
+      std::cerr << "  scenario " << std::setw(3) << s.index + 1 << "/" << specs.size() << " "
+                << (s.kind.empty() ? "" : s.kind + " ") << s.source << " " << s.sequence.substr(0, 24) << ", " << s.task
+                << " from " << s.start << ":";
       for (std::size_t p = 0; p < predictors.size(); ++p) {
         std::cerr << " " << cell_sim::ToString(predictors[p]) << " " << Fixed(row[p].task_time, 1) << " s/"
                   << row[p].protective_stops << "st";
@@ -332,7 +378,7 @@ int RunInteraction(const InteractionOptions& o) {
     } catch (const std::exception& e) {
       throw std::runtime_error(std::string("baseline calibration: ") + e.what());
     }
-    specs = cell_sim::MakeScenarios(setup, o.scenarios, o.seed);
+    specs = cell_sim::MakeScenarios(setup, o.scenarios, o.seed, *cell_sim::ParseSuite(o.suite));
   } catch (const std::exception& e) {
     std::cerr << "iplan eval interaction: " << e.what() << "\n";
     return 2;
@@ -350,6 +396,12 @@ int RunInteraction(const InteractionOptions& o) {
   Json doc;
   doc["command"] = "iplan eval interaction";
   doc["seed"] = o.seed;
+  doc["suite"] = o.suite;
+  if (o.suite == cell_sim::ToString(cell_sim::Suite::kSharedSpace)) {
+    doc["shared_space"] = Json{{"max_path_distance_m", setup.shared_space.max_path_distance},
+                               {"window_s", setup.shared_space.window},
+                               {"path_samples", setup.shared_space.path_samples}};
+  }
   doc["num_scenarios"] = specs.size();
   doc["monitor_prediction"] = o.monitor;
   doc["time_limit_s"] = o.time_limit;
@@ -388,13 +440,25 @@ const bool kRegistered = RegisterCommand("eval", [](CLI::App& app) {
       "services' own cores at the cell's rates (skeletons with sensor noise -> prediction -> replanner every\n"
       "planning step -> collision-risk monitor, whose PROTECTIVE_STOP stops the simulated robot, resuming after\n"
       "the supervisor's resume_delay -> robot), once per predictor. The true body decides contacts, separation\n"
-      "and the true bound. Deterministic for a seed. Prints a table (median [p10, p90] over the scenarios and\n"
-      "ratios against 'none'); --json writes every figure and every scenario. Exit code 2 on bad input.\n"
+      "and the true bound; a contact counts as robot-moving when the robot's fastest joint exceeds 0.01 rad/s at its\n"
+      "first moment, else as robot-at-rest. Deterministic for a seed. Prints a table (median [p10, p90] over the\n"
+      "scenarios and ratios against 'none'); --json writes every figure and every scenario. Exit code 2 on bad input.\n"
+      "Suites: default (the above), shared-space (sharing space is the point; scenario i is of kind i % 4:\n"
+      "hand-over: the hand_over task while the person reaches towards the hand-over place; parts-bin: fetch_left\n"
+      "while the person reaches into the bin or their tray beside it; co-assembly: a reach to the near side of the\n"
+      "person's assembly area while they assemble there; crossing: a graph task while the person's hand sweeps\n"
+      "across the robot's path mid-task; the synthetic person in scenarios 0-3 of every 8, recorded motion in 4-7;\n"
+      "every scenario's person comes within 0.35 m of the straight joint path from start to goal within 5 s of the\n"
+      "task command, else it is drawn again).\n"
       "Predictors: none (the planner gets no prediction; only the monitor protects, with the model's), constant-position,\n"
       "constant-velocity (least-squares velocity over 0.25 s), model (the cell's trained intent model, trained\n"
       "or cached as `iplan demo --prepare-only` does), oracle (the true future with the model's covariances).");
   c->add_option("--predictors", o->predictors, "comma-separated predictors to compare")->capture_default_str();
   c->add_option("--scenarios", o->scenarios, "number of scenarios (>= 1)")->capture_default_str();
+  c->add_option("--suite", o->suite,
+                "which scenarios: 'default' (tasks and reaches, the person near or across the path) or 'shared-space' "
+                "(hand-over, parts bin, co-assembly, crossing; the person always within reach of the path)")
+      ->capture_default_str();
   c->add_option("--seed", o->seed, "seed of the scenarios and the sensor noise")->capture_default_str();
   c->add_option("--json", o->json_file, "write the figures and every scenario's run as JSON to this file");
   c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");

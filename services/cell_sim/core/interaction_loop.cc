@@ -205,8 +205,20 @@ class Interaction {
     const int64_t stamp = kEpochNs + t;
     if (control_step_ > 0) robot_.Step(stamp, control_period_ * 1e-9);
     person_.TrueAt(t * 1e-9, &p_WJ_);
+    const int contacts = robot_.contacts();
     const double separation = robot_.UpdateContacts(p_WJ_, body_);
     if (in_task_) result_.min_separation = std::min(result_.min_separation, separation);
+    // A new contact of the task's: was the robot moving into the person, or
+    // standing still while the person moved into it?
+    if (in_task_ && robot_.contacts() > contacts) {
+      const double speed = robot_.qd().cwiseAbs().maxCoeff();
+      result_.contact_speeds.push_back(speed);
+      if (speed > kMovingContactSpeed) {
+        ++result_.robot_moving_contacts;
+      } else {
+        ++result_.robot_at_rest_contacts;
+      }
+    }
     if (control_step_ % state_every_ == 0) {
       const std::vector<double> q = ToStd(robot_.q()), qd = ToStd(robot_.qd());
       if (auto why = replanner_.UpdateRobotState(stamp, robot_joints_, q, qd)) throw std::runtime_error("replanner: " + *why);

@@ -103,6 +103,11 @@ struct TaskSetup {
   trajopt::TaskSpec task;   ///< time_limit is the replanner's (0: none)
 };
 
+/// rad/s: a contact counts as the robot's moving one when the robot's fastest
+/// joint was faster than this at the contact's first moment, else as one
+/// with the robot at rest (InteractionResult::robot_moving_contacts).
+constexpr double kMovingContactSpeed = 0.01;
+
 /// Figures of one run, from the task command to its outcome (or the end).
 struct InteractionResult {
   bool finished = false;       ///< the replanner reported an outcome
@@ -122,6 +127,14 @@ struct InteractionResult {
   /// covariances: what the bound would have been with a perfect prediction.
   double max_bound = 0;
   int true_contacts = 0;       ///< episodes of true contact (RobotSimulator::contacts)
+  /// The contacts split by what the robot was doing at each one's first
+  /// moment (the control step at which the true separation first went below
+  /// the contact margin): moving (max |qd| > kMovingContactSpeed) or at rest
+  /// (a person walking into a robot that stands still). They sum to
+  /// true_contacts.
+  int robot_moving_contacts = 0;
+  int robot_at_rest_contacts = 0;
+  std::vector<double> contact_speeds;  ///< rad/s per contact, in order: max |qd| at its first moment
   std::string first_stop_reason;  ///< the monitor's reason for the first stop ("" without)
   int planning_cycles = 0;
   std::vector<double> planning_times;  ///< s per cycle, wall time (not deterministic)

@@ -16,6 +16,46 @@ namespace {
 constexpr double kShoulderBelowNeck = 0.05;  // m
 constexpr double kNeckToHead = 0.18;         // m
 constexpr double kTorsoToNeck = 0.30;        // m
+constexpr double kUpperArm = 0.30;           // m
+constexpr double kForearm = 0.28;            // m
+constexpr double kMaxReach = 0.97 * (kUpperArm + kForearm);
+
+// Minimum-jerk position profile s(u), u in [0, 1].
+double MinJerk(double u) {
+  u = std::clamp(u, 0.0, 1.0);
+  return u * u * u * (10 - 15 * u + 6 * u * u);
+}
+
+// Elbow of a two-link arm from shoulder to hand, bending down (as the
+// synthetic person's).
+Eigen::Vector3d Elbow(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& hand) {
+  const Eigen::Vector3d d = hand - shoulder;
+  const double dist = std::clamp(d.norm(), 1e-6, kUpperArm + kForearm - 1e-6);
+  const double a = (kUpperArm * kUpperArm - kForearm * kForearm + dist * dist) / (2 * dist);
+  const double h = std::sqrt(std::max(0.0, kUpperArm * kUpperArm - a * a));
+  const Eigen::Vector3d dir = d.norm() > 1e-9 ? Eigen::Vector3d(d / d.norm()) : Eigen::Vector3d::UnitX();
+  Eigen::Vector3d down = Eigen::Vector3d::UnitZ().cross(dir).cross(dir);  // perpendicular, pointing down
+  if (down.norm() < 1e-9) down = Eigen::Vector3d::UnitX();
+  down.normalize();
+  if (down.z() > 0) down = -down;
+  return shoulder + a * dir + h * down;
+}
+
+// Where the sweep puts the hand at t (s), the script having it at `own`;
+// nullopt outside the sweep.
+std::optional<Eigen::Vector3d> SweptHand(const HandSweep& w, double t, const Eigen::Vector3d& own) {
+  const double u = t - w.start;
+  if (u < 0 || u > 2 * w.approach + w.duration) return std::nullopt;
+  if (u < w.approach) return Eigen::Vector3d(own + MinJerk(u / w.approach) * (w.from_W - own));
+  if (u < w.approach + w.duration) return Eigen::Vector3d(w.from_W + MinJerk((u - w.approach) / w.duration) * (w.to_W - w.from_W));
+  return Eigen::Vector3d(w.to_W + MinJerk((u - w.approach - w.duration) / w.approach) * (own - w.to_W));
+}
+
+int BodyJoint(const std::vector<std::string>& body_joints, const std::string& name) {
+  const auto it = std::find(body_joints.begin(), body_joints.end(), name);
+  if (it == body_joints.end()) throw std::invalid_argument("a hand sweep needs the body joint '" + name + "'");
+  return static_cast<int>(it - body_joints.begin());
+}
 
 void CheckArguments(double rate_hz, double duration, double noise_std) {
   if (!(rate_hz > 0) || !std::isfinite(rate_hz)) throw std::invalid_argument("rate_hz must be > 0");
@@ -50,6 +90,13 @@ void AddNoise(double noise_std, uint64_t seed, PersonStream* s) {
 }
 
 }  // namespace
+
+std::string HandSweep::Validate() const {
+  if (!from_W.allFinite() || !to_W.allFinite() || !std::isfinite(start)) return "hand sweep: from, to and start must be finite";
+  if (!(approach > 0) || !std::isfinite(approach)) return "hand sweep: approach must be > 0 s";
+  if (!(duration > 0) || !std::isfinite(duration)) return "hand sweep: duration must be > 0 s";
+  return "";
+}
 
 Eigen::Isometry3d RecordingPose(const intent::SkeletonDataset& data, const std::string& sequence,
                                 const RecordedPlacement& placement) {
@@ -204,6 +251,14 @@ PersonStream SyntheticPersonStream(const perception::SyntheticPersonParams& pers
                                    const std::vector<std::string>& body_joints, double rate_hz, double duration,
                                    double noise_std, uint64_t seed) {
   CheckArguments(rate_hz, duration, noise_std);
+  int hand = -1, elbow = -1, shoulder = -1;
+  if (placement.sweep) {
+    if (const std::string why = placement.sweep->Validate(); !why.empty()) throw std::invalid_argument(why);
+    const std::string side = placement.sweep->right_hand ? "_r" : "_l";
+    hand = BodyJoint(body_joints, "hand" + side);
+    elbow = BodyJoint(body_joints, "elbow" + side);
+    shoulder = BodyJoint(body_joints, "shoulder" + side);
+  }
   perception::SyntheticPersonParams p = person;
   p.torso_W += placement.torso_offset_W;
   p.facing_yaw += placement.yaw;
@@ -230,6 +285,14 @@ PersonStream SyntheticPersonStream(const perception::SyntheticPersonParams& pers
     Eigen::Matrix3Xd q(3, static_cast<Eigen::Index>(body_joints.size()));
     for (std::size_t b = 0; b < body_joints.size(); ++b) {
       q.col(static_cast<Eigen::Index>(b)) = pose[static_cast<std::size_t>(index[b])].position_W;
+    }
+    if (placement.sweep) {
+      if (const auto h = SweptHand(*placement.sweep, i / rate_hz, q.col(hand))) {
+        const Eigen::Vector3d s_W = q.col(shoulder), d = *h - s_W;
+        const Eigen::Vector3d h_W = d.norm() > kMaxReach ? Eigen::Vector3d(s_W + d.normalized() * kMaxReach) : *h;
+        q.col(hand) = h_W;
+        q.col(elbow) = Elbow(s_W, h_W);
+      }
     }
     s.truth.push_back(std::move(q));
   }

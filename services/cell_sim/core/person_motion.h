@@ -7,7 +7,8 @@
 //    transform), placed across the table; body joints the recording lacks
 //    are derived from the shoulders (below); or
 //  - the synthetic person of the cell (perception::SyntheticPerson), moved
-//    and turned, starting their script at a chosen time.
+//    and turned, starting their script at a chosen time, optionally with one
+//    hand sweeping along a line (HandSweep: an arm crossing the robot's path).
 // Observations are the truth plus seeded Gaussian sensor noise.
 //
 // Frames and units: world frame W (robot base, x towards the person, z up
@@ -17,6 +18,7 @@
 
 #include <cstdint>
 #include <map>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -64,19 +66,42 @@ PersonStream RecordedPersonStream(const intent::SkeletonDataset& data, const std
                                   const RecordedPlacement& placement, const std::vector<std::string>& body_joints,
                                   double rate_hz, double duration, double noise_std, uint64_t seed);
 
+/// One hand sweeping along a straight line, over whatever the script has it
+/// do: from `start` the hand moves from where the script has it to from_W
+/// (minimum jerk, `approach` s), along the line to to_W (minimum jerk,
+/// `duration` s), and back to where the script has it then (`approach` s).
+/// The hand is kept within the synthetic person's reach of its shoulder
+/// (0.97 of 0.30 + 0.28 m) and the elbow follows (two-link arm bending down,
+/// as the synthetic person's).
+struct HandSweep {
+  bool right_hand = true;
+  Eigen::Vector3d from_W = Eigen::Vector3d::Zero();  ///< m, W
+  Eigen::Vector3d to_W = Eigen::Vector3d::Zero();    ///< m, W
+  double start = 0;      ///< s, scenario time the hand leaves the script's motion
+  double approach = 0.6; ///< s, to from_W and back from to_W; > 0
+  double duration = 1.0; ///< s, from from_W to to_W; > 0
+  /// s, scenario time the hand is halfway along the line.
+  double middle() const { return start + approach + 0.5 * duration; }
+  /// Empty when valid, else why not.
+  std::string Validate() const;
+};
+
 /// Where and when the synthetic person acts.
 struct SyntheticPlacement {
   Eigen::Vector3d torso_offset_W = Eigen::Vector3d::Zero();  ///< m, added to the configured torso position
   double yaw = 0;           ///< rad, added to the configured facing direction
   double script_start = 0;  ///< s (scenario time) at which the script starts; may be negative (under way)
+  std::optional<HandSweep> sweep;  ///< none: the script alone moves the hands
 };
 
 /// The synthetic person of `person` (its targets stay where the table's
 /// objects are; its seed, variation and script as given; no loop), moved by
-/// the placement, sampled at rate_hz for `duration` s; observed = truth +
-/// N(0, noise_std^2 I), seeded by `seed` (the person's own noise generator is
-/// not used). Throws std::invalid_argument when a body joint is not one of
-/// the person's or on bad arguments.
+/// the placement, its hand swept by placement.sweep if given, sampled at
+/// rate_hz for `duration` s; observed = truth + N(0, noise_std^2 I), seeded
+/// by `seed` (the person's own noise generator is not used). Throws
+/// std::invalid_argument when a body joint is not one of the person's, on an
+/// invalid sweep, a sweep whose hand, elbow or shoulder is not a body joint,
+/// or on bad arguments.
 PersonStream SyntheticPersonStream(const perception::SyntheticPersonParams& person, const SyntheticPlacement& placement,
                                    const std::vector<std::string>& body_joints, double rate_hz, double duration,
                                    double noise_std, uint64_t seed);

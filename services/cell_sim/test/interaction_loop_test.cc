@@ -1,11 +1,14 @@
 // The one-process cell loop: a robot task against a standing person, closed
 // through the replanner, the monitor and the simulated robot. A person far
 // away changes nothing; a person standing in the path is protected by the
-// monitor alone when the planner knows nothing; the run is deterministic.
+// monitor alone when the planner knows nothing; the run is deterministic;
+// a contact is told apart by what the robot was doing when it began (moving
+// into the person, or standing still while the person moved into it).
 #include "core/interaction_loop.h"
 
 #include <gtest/gtest.h>
 
+#include "iplan/collision/robot_model.h"
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::cell_sim {
@@ -95,6 +98,19 @@ class InteractionLoopTest : public ::testing::Test {
     return t;
   }
 
+  // The centre (W) and radius of the robot sphere nearest the person's side
+  // (largest x) at q.
+  std::pair<Eigen::Vector3d, double> FrontSphere(const Eigen::VectorXd& q) const {
+    const collision::RobotModel& robot = planner_->robot();
+    collision::RobotData data(robot);
+    collision::CalcForwardKinematics(robot, q, &data);
+    Eigen::Index front = 0;
+    for (Eigen::Index k = 1; k < data.p_WS.cols(); ++k) {
+      if (data.p_WS(0, k) > data.p_WS(0, front)) front = k;
+    }
+    return {data.p_WS.col(front), robot.spheres[static_cast<std::size_t>(front)].radius};
+  }
+
   collision::HumanBodyModel body_;
   collision_risk::RiskMonitor monitor_;
   std::unique_ptr<planning::Planner> planner_;
@@ -169,6 +185,59 @@ TEST_F(InteractionLoopTest, SameInputsSameRun) {
   EXPECT_EQ(a.max_bound, b.max_bound);
   EXPECT_EQ(a.planner_delay, b.planner_delay);
   EXPECT_EQ(a.planning_cycles, b.planning_cycles);
+}
+
+TEST_F(InteractionLoopTest, AContactWithTheRobotMovingCountsAsMoving) {
+  // The right hand held where the hand-over puts the tool, a planner that
+  // knows nothing of the person, and a monitor whose protective separation
+  // is 0 (every ISO/TS 15066 term 0, no prediction): the robot drives into
+  // the hand and stops only once it touches it.
+  collision_risk::RiskParams blind;
+  blind.ssm.measure_human_speed = false;
+  blind.ssm.default_human_speed = 0;
+  blind.ssm.reaction_time = 0;
+  blind.ssm.stopping_time = 0;
+  blind.ssm.stopping_distance = 0;
+  blind.ssm.intrusion_distance = 0;
+  blind.ssm.sensing_uncertainty = 0;
+  blind.ssm.robot_uncertainty = 0;
+  const collision_risk::RiskMonitor late(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                         body_.params(), blind);
+  models_.monitor = &late;
+  const Eigen::Vector3d goal_tool = FrontSphere(kHandOver).first;
+  const PersonStream person = StandingPerson(goal_tool + Eigen::Vector3d(0.3, 0.15, 0.05), 0.3);
+  const InteractionResult r = RunInteraction(models_, params_, HandOver(), person, nullptr, nullptr, nullptr);
+  ASSERT_GE(r.true_contacts, 1) << "min separation " << r.min_separation;
+  EXPECT_EQ(r.robot_moving_contacts, r.true_contacts);
+  EXPECT_EQ(r.robot_at_rest_contacts, 0);
+  ASSERT_EQ(r.contact_speeds.size(), static_cast<std::size_t>(r.true_contacts));
+  EXPECT_GT(r.contact_speeds.front(), kMovingContactSpeed);
+  EXPECT_LT(r.min_separation, 0.0);
+}
+
+TEST_F(InteractionLoopTest, AHandMovingIntoTheRobotAtRestCountsAsAtRest) {
+  // The hand 8 cm from the robot's front sphere at home keeps the monitor's
+  // stop on from the start (the robot never moves); at 2.5 s it moves into
+  // the sphere.
+  const auto [centre, radius] = FrontSphere(kHome);
+  const double hand_radius = 0.06;  // upper_body.yaml forearm spheres (the hand is one's centre)
+  const Eigen::Vector3d near = centre + Eigen::Vector3d(radius + hand_radius + 0.08, 0, 0);
+  const Eigen::Vector3d offset(0.3, 0.15, 0.05);  // torso from hand in Standing(torso, 0.3)
+  PersonStream person = StandingPerson(near + offset, 0.3);
+  const Eigen::Matrix3Xd touching = Standing(centre + offset, 0.3);
+  for (int i = 75; i < person.num_frames(); ++i) {
+    person.truth[static_cast<std::size_t>(i)] = person.observed[static_cast<std::size_t>(i)] = touching;
+  }
+  int resumes = 0;
+  params_.trace = [&](double, const std::string& e) { resumes += e.rfind("resume", 0) == 0; };
+  const InteractionResult r = RunInteraction(models_, params_, HandOver(), person, nullptr, Holding(person), nullptr);
+  EXPECT_EQ(resumes, 0) << "the robot was meant to stay stopped";
+  EXPECT_EQ(r.first_stop_reason, "stopped when the task was commanded");
+  ASSERT_EQ(r.true_contacts, 1) << "min separation " << r.min_separation;
+  EXPECT_EQ(r.robot_at_rest_contacts, 1);
+  EXPECT_EQ(r.robot_moving_contacts, 0);
+  ASSERT_EQ(r.contact_speeds.size(), 1u);
+  EXPECT_LE(r.contact_speeds.front(), kMovingContactSpeed);
 }
 
 TEST_F(InteractionLoopTest, PersonStreamInterpolatesAndIsChecked) {
