@@ -397,6 +397,35 @@ int Argument(int argc, char** argv, int i, int fallback, int min) {
 
 }  // namespace
 
+// The budgeted replanning cycles with the cell's replanning setting of
+// issue 25: the planner predicts the separation monitor (predict_ssm and its
+// margins as config/planner_replanning.yaml gives them). Not in the
+// fingerprint (which covers the runs without a budget).
+template <class Problems, class Recorded>
+void RunPredictingTheMonitor(const collision::RobotModel& robot, const Problems& problems, int threads,
+                             const PlannerParams& replan_params, const collision::HumanBodyModel& body,
+                             const std::vector<Eigen::Vector3d>& targets, const Recorded& recorded) {
+  const PlannerParams cell = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner_replanning.yaml");
+  PlannerParams ssm_params = replan_params;
+  ssm_params.predict_ssm = true;
+  ssm_params.ssm_margin = cell.ssm_margin;
+  ssm_params.ssm_activation = cell.ssm_activation;
+  ssm_params.ssm_horizon = cell.ssm_horizon;
+  ssm_params.ssm_stop_probability = cell.ssm_stop_probability;
+  ssm_params.weights.ssm = cell.weights.ssm;
+  Planner ssm_replanner(robot, testing::LoadCell(), ssm_params);
+  std::uint64_t ssm_fingerprint = 0;
+  RunReplanning(ssm_replanner, problems, threads, body.num_spheres(), "synthesised reaching person, predicting the monitor",
+                [&](int k) {
+                  const double y = -0.5 + 1.0 * k / 24;
+                  return testing::MakeReachingPrediction(body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
+                },
+                &ssm_fingerprint, kCycleBudget);
+  RunReplanning(ssm_replanner, problems, threads, body.num_spheres(),
+                "recorded person (assembly.csv task1_human1_trial1), predicting the monitor", recorded, &ssm_fingerprint,
+                kCycleBudget);
+}
+
 int main(int argc, char** argv) {
   const int num_problems = Argument(argc, argv, 1, 60, 1);
   const int threads = Argument(argc, argv, 2, 2, 1);
@@ -454,29 +483,7 @@ int main(int argc, char** argv) {
                 &fingerprint, kCycleBudget);
   RunReplanning(replanner, problems, threads, body.num_spheres(), "recorded person (assembly.csv task1_human1_trial1)",
                 recorded, &fingerprint, kCycleBudget);
-  // The same budgeted cycles with the cell's replanning setting of issue 25:
-  // the planner predicts the separation monitor (predict_ssm and its
-  // margins as config/planner_replanning.yaml gives them). Not in the
-  // fingerprint (which covers the runs above).
-  const PlannerParams cell = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner_replanning.yaml");
-  PlannerParams ssm_params = replan_params;
-  ssm_params.predict_ssm = true;
-  ssm_params.ssm_margin = cell.ssm_margin;
-  ssm_params.ssm_activation = cell.ssm_activation;
-  ssm_params.ssm_horizon = cell.ssm_horizon;
-  ssm_params.ssm_stop_probability = cell.ssm_stop_probability;
-  ssm_params.weights.ssm = cell.weights.ssm;
-  Planner ssm_replanner(robot, testing::LoadCell(), ssm_params);
-  std::uint64_t ssm_fingerprint = 0;
-  RunReplanning(ssm_replanner, problems, threads, body.num_spheres(), "synthesised reaching person, predicting the monitor",
-                [&](int k) {
-                  const double y = -0.5 + 1.0 * k / 24;
-                  return testing::MakeReachingPrediction(body, targets, 15, 0.03, 0.06, Eigen::Vector3d(0.0, y, 0.0));
-                },
-                &ssm_fingerprint, kCycleBudget);
-  RunReplanning(ssm_replanner, problems, threads, body.num_spheres(),
-                "recorded person (assembly.csv task1_human1_trial1), predicting the monitor", recorded, &ssm_fingerprint,
-                kCycleBudget);
+  RunPredictingTheMonitor(robot, problems, threads, replan_params, body, targets, recorded);
   std::printf("results fingerprint %016llx (same seeds and results => same value)\n",
               static_cast<unsigned long long>(fingerprint));
   return 0;

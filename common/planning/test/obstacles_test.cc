@@ -15,12 +15,7 @@ namespace iplan::planning {
 namespace {
 
 using testing::DownOrientation;
-
-Eigen::VectorXd Ready() {
-  Eigen::VectorXd q(7);
-  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
-  return q;
-}
+using testing::Ready;
 
 // A box standing on the table top (z = 0), centre (x, y), full edge lengths.
 collision::SceneObject TableBox(double x, double y, const Eigen::Vector3d& size) {

@@ -14,12 +14,7 @@ namespace iplan::planning {
 namespace {
 
 using testing::DownOrientation;
-
-Eigen::VectorXd Ready() {
-  Eigen::VectorXd q(7);
-  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
-  return q;
-}
+using testing::Ready;
 
 class PlannerTest : public ::testing::Test {
  protected:

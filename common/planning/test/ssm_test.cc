@@ -16,12 +16,7 @@ namespace iplan::planning {
 namespace {
 
 using testing::DownOrientation;
-
-Eigen::VectorXd Ready() {
-  Eigen::VectorXd q(7);
-  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
-  return q;
-}
+using testing::Ready;
 
 // One hand sphere (radius 5 cm) of one action, at `at(k)` at step k (0.1 s apart).
 template <class F>

@@ -14,6 +14,12 @@ collision::SceneParams LoadCell() {
   return collision::LoadSceneParams(std::string(IPLAN_SOURCE_DIR) + "/config/scenes/cell.yaml");
 }
 
+Eigen::VectorXd Ready() {
+  Eigen::VectorXd q(7);
+  q << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+  return q;
+}
+
 Eigen::Quaterniond DownOrientation(double yaw) {
   return Eigen::Quaterniond(Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) *
                             Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));

@@ -17,6 +17,9 @@ namespace iplan::planning::testing {
 collision::RobotModel LoadPanda();
 collision::SceneParams LoadCell();
 
+/// The Panda's ready configuration the planning tests start from (rad).
+Eigen::VectorXd Ready();
+
 /// Flange pointing down (z of the flange along -z of W), yaw `yaw` (rad).
 Eigen::Quaterniond DownOrientation(double yaw);
 
