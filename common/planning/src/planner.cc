@@ -185,7 +185,7 @@ void DescribeFailure(const PlannerModel& M, const Problem& at, const Candidate& 
       const cell::SsmPair& v = best.ssm.violation;
       s << "the separation monitor would stop every trajectory after " << result->num_waits
         << " waits; best: separation " << v.separation << " m below S_p " << v.protective_separation << " + "
-        << M.params.ssm_margin << " m (v_h " << v.v_h << ", v_r " << v.v_r << " m/s) at waypoint "
+        << at.ssm_margin << " m (v_h " << v.v_h << ", v_r " << v.v_r << " m/s) at waypoint "
         << best.ssm.first_violation;
     }
   } else {
@@ -256,8 +256,10 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     return result;
   }
   Problem at = M.MakeProblem(req, q_goal);
+  // The optimisers stop early enough that the checks after them fit in the budget.
   if (req.time_budget > 0.0)
-    at.deadline = t0 + std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(req.time_budget));
+    at.deadline = t0 + std::chrono::duration_cast<Clock::duration>(
+                           std::chrono::duration<double>(req.time_budget * (1.0 - P.budget_reserve)));
   // The initial warm start keeps its shape; other first attempts are smoothed.
   const bool warm = req.warm_start.cols() > 1;
   const int wait_steps = std::max(1, static_cast<int>(std::round(P.wait_duration / P.dt)));

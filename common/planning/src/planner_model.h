@@ -47,6 +47,10 @@ constexpr double kSeparationMinProbability = 0.3;
 // within the velocity limits: a motion whose largest joint distance over its
 // velocity limit is t_min gets at least this times t_min.
 constexpr double kRestToRestPeakFactor = 1.5;
+// m: the ssm cost's band above the margin never shrinks below this (or
+// ssm_activation - ssm_margin, if smaller) with PlanningRequest::ssm_scale,
+// so that plans near the margin are still pushed back from it.
+constexpr double kMinSsmBand = 0.02;
 
 std::uint64_t SplitMix(std::uint64_t x);
 double Seconds(Clock::time_point a, Clock::time_point b);
@@ -77,6 +81,9 @@ struct Problem {
   // First waypoint judged by the separation monitor's rule: the request's
   // frozen prefix is executing already; waits inserted after it are judged.
   int ssm_from = 1;
+  // m, the margin above S_p a safe plan keeps and the one below which the
+  // ssm cost starts (PlannerParams, scaled by PlanningRequest::ssm_scale).
+  double ssm_margin = 0.0, ssm_activation = 0.0;
   // Wall time at which the optimisers stop (PlanningRequest::time_budget);
   // time_point::max() without a budget.
   Clock::time_point deadline = Clock::time_point::max();

@@ -32,6 +32,8 @@ std::string PlannerParams::Validate() const {
   if (max_iterations < 1) return "max_iterations must be >= 1, got " + std::to_string(max_iterations);
   if (early_stop_interval < 0)
     return "early_stop_interval must be >= 0, got " + std::to_string(early_stop_interval);
+  if (!(budget_reserve >= 0.0 && budget_reserve < 0.9))
+    return "budget_reserve must be in [0, 0.9), got " + Num(budget_reserve);
   if (!nonneg(convergence_tolerance))
     return "convergence_tolerance must be >= 0, got " + Num(convergence_tolerance);
   if (!(step_size > 0.0 && step_size <= 1.0)) return "step_size must be in (0, 1], got " + Num(step_size);

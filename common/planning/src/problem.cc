@@ -52,6 +52,7 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
   if (!req.obstacles.empty()) {
     if (const std::string why = collision::SceneParams{req.obstacles}.Validate(); !why.empty()) Bad("obstacles: " + why);
   }
+  if (!(req.ssm_scale >= 0.0 && req.ssm_scale <= 1.0)) Bad("ssm_scale must be in [0, 1], got " + std::to_string(req.ssm_scale));
   if (!(req.time_budget >= 0.0) || !std::isfinite(req.time_budget))
     Bad("time_budget must be finite and >= 0, got " + std::to_string(req.time_budget));
   if (req.goal.kind == Goal::Kind::kJoint) {
@@ -92,6 +93,8 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   if (stretched) at.n = std::min(need, 2 * horizon_n);
   at.k = req.num_frozen;
   at.ssm_from = at.k;
+  at.ssm_margin = req.ssm_scale * P.ssm_margin;
+  at.ssm_activation = std::max(req.ssm_scale * P.ssm_activation, std::min(P.ssm_activation, at.ssm_margin + kMinSsmBand));
   if (at.k >= at.n)
     Bad("num_frozen = " + std::to_string(at.k) + " leaves no free waypoint in a horizon of " +
         std::to_string(at.n) + " intervals");

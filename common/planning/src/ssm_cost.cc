@@ -65,7 +65,7 @@ int PlannerModel::SsmLastWaypoint(const Problem& at) const {
 void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
                                  const SsmPairVisitor& visit) const {
   const cell::SsmParams& s = params.ssm;
-  const double reach = params.ssm_activation;
+  const double reach = at.ssm_activation;
   const int S = static_cast<int>(radii.size());
   Eigen::Matrix3Xd v_robot(3, S);
   for (int i = from; i <= to; ++i) {
@@ -125,7 +125,7 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
 void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const {
   const int last = std::min(SsmLastWaypoint(at), at.n - 1);
   if (last < at.k) return;
-  const double w = params.weights.ssm, act = params.ssm_activation;
+  const double w = params.weights.ssm, act = at.ssm_activation;
   const cell::SsmParams& s = params.ssm;
   // The pairs within the activation band (not retreating), and per waypoint
   // and person the actions they belong to: only where those actions are
@@ -186,7 +186,7 @@ SsmJudgement PlannerModel::JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q,
   VisitSsmPairs(at, data, from, last, [&](const SsmVisit& v, const Eigen::Vector3d&, const cell::SsmPair& pair) {
     if (v.retreat) return true;
     if (v.probability >= kSeparationMinProbability) j.min_margin = std::min(j.min_margin, pair.margin);
-    if (pair.margin < params.ssm_margin && v.action < 64) {
+    if (pair.margin < at.ssm_margin && v.action < 64) {
       const std::size_t e = static_cast<std::size_t>(v.waypoint) * P + static_cast<std::size_t>(v.person);
       if (stopped[e] == 0 || pair.margin < tightest[e].margin) tightest[e] = pair;
       stopped[e] |= std::uint64_t{1} << v.action;

@@ -9,6 +9,14 @@
 #include "iplan/core/stats.h"
 
 namespace iplan::trajopt {
+namespace {
+
+// A robot behind the plan's timing counts as slowed down on its path (and the
+// plan is re-timed) only while it moves along the path at this fraction of
+// the plan's speed or more (half the monitor's smallest speed scale).
+constexpr double kMinPathSpeedFraction = 0.05;
+
+}  // namespace
 
 std::string ReplannerParams::Validate() const {
   if (!(planning_step > 0)) return "planning_step must be > 0";
@@ -21,6 +29,7 @@ std::string ReplannerParams::Validate() const {
   if (!(joint_velocity_factor >= 1)) return "joint_velocity_factor must be >= 1";
   if (!(cycle_budget >= 0) || !(cycle_budget < planning_step))
     return "cycle_budget must be in [0, planning_step)";
+  if (!(ssm_patience >= 0) || !std::isfinite(ssm_patience)) return "ssm_patience must be >= 0";
   return "";
 }
 
@@ -310,9 +319,28 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
   planning::PlanningRequest req;
   if (previous_) {
     // Where the executing plan says the robot is at the state's stamp.
-    const auto& [p_start, P] = *previous_;
-    const Eigen::VectorXd expected = cell::JointTrajectory::Uniform(p_start, dt, P).PositionAt(q_->first);
-    if ((expected - q_->second).cwiseAbs().maxCoeff() > params_.max_tracking_error) {
+    auto& [p_start, P] = *previous_;
+    const cell::JointTrajectory plan = cell::JointTrajectory::Uniform(p_start, dt, P);
+    double error = (plan.PositionAt(q_->first) - q_->second).cwiseAbs().maxCoeff();
+    // A robot slowed down by the monitor (its path time-scaled) is behind
+    // the plan's timing, on its path: the plan is re-timed to where the
+    // robot is on it, and the frozen prefix continues from there.
+    if (error > 0.5 * params_.max_tracking_error && !robot_stopped_ && qd_.squaredNorm() > 0) {
+      // A time-scaled robot falls behind by at most (1 - scale) of the time
+      // between two trajectories (it starts each on time): two planning steps
+      // cover that; a robot that stood still longer is off the plan.
+      const auto max_lag = static_cast<int64_t>(2e9 * params_.planning_step);
+      const auto [lag_ns, lag_error] = PathLag(plan, q_->first, q_->second, max_lag);
+      // ... and moving along it (a robot that stands still is off the plan).
+      const int64_t at = q_->first - lag_ns;
+      const Eigen::VectorXd v_plan = (plan.PositionAt(at + 10'000'000) - plan.PositionAt(at)) / 0.01;
+      if (lag_error < error && qd_.dot(v_plan) >= kMinPathSpeedFraction * v_plan.squaredNorm()) {
+        p_start += lag_ns;
+        error = lag_error;
+        r->status += "robot behind the plan by " + std::to_string(lag_ns / 1000000) + " ms (slowed): re-timed; ";
+      }
+    }
+    if (error > params_.max_tracking_error) {
       previous_.reset();  // the robot did not follow (stopped, pushed): start over from it
       r->status += "robot off the plan: replanning from its state; ";
     }
@@ -333,6 +361,11 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
   }
   req.goal = goal;
   req.time_budget = params_.cycle_budget;
+  // Patience: the longer the person has held the task off, the closer the
+  // plan may come to what the monitor allows.
+  if (task_ && params_.ssm_patience > 0) {
+    req.ssm_scale = std::max(0.0, 1.0 - task_->delay / params_.ssm_patience);
+  }
   req.obstacles = obstacles_;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
   predictions_.Expire(now_ns, stale);
@@ -343,6 +376,20 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
   }
   r->num_people = static_cast<int>(req.people.size());
   return req;
+}
+
+// How far (ns, in [0, max_lag_ns]) the robot at `q` (stamp `stamp_ns`) is
+// behind `plan`'s timing along its path: the lag whose plan position is
+// nearest to q (max joint error, rad, returned too), the smallest lag on a tie.
+std::pair<int64_t, double> Replanner::PathLag(const cell::JointTrajectory& plan, int64_t stamp_ns,
+                                              const Eigen::VectorXd& q, int64_t max_lag_ns) {
+  constexpr int64_t kStep = 5'000'000;  // ns
+  std::pair<int64_t, double> best{0, std::numeric_limits<double>::infinity()};
+  for (int64_t lag = 0; lag <= max_lag_ns && stamp_ns - lag >= plan.start_ns; lag += kStep) {
+    const double e = (plan.PositionAt(stamp_ns - lag) - q).cwiseAbs().maxCoeff();
+    if (e < best.second) best = {lag, e};
+  }
+  return best;
 }
 
 // The trajectory to publish from the plan, and what it means for the task:

@@ -53,6 +53,17 @@ struct ReplannerParams {
   /// (or a wait), not late ones; the simulated-time benchmark plans without
   /// one so that it stays deterministic.
   double cycle_budget = 0.0;
+  /// s; patience with a person who holds the robot off (predict_ssm): the
+  /// margin a plan keeps above the separation monitor's S_p and the band in
+  /// which the ssm cost pushes it back (the planner's ssm_margin and
+  /// ssm_activation; PlanningRequest::ssm_scale) shrink linearly with the
+  /// running task's delay (waits, holding off, time in stop), the margin to
+  /// 0 once the delay reaches this, so
+  /// that a person who keeps working near the goal delays the task for a
+  /// while and is then approached as closely as the monitor allows (a plan
+  /// the predicted monitor would stop stays infeasible). 0: off (the margin
+  /// is always the planner's).
+  double ssm_patience = 0.0;
   /// The keys of section trajopt (config/trajopt.yaml); ranges: Validate().
   template <class Archive>
   void Serialize(Archive* a) {
@@ -65,6 +76,7 @@ struct ReplannerParams {
     a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a state further outside the limits is refused, >= 0"));
     a->Visit(IPLAN_NVP(joint_velocity_factor, "a state faster than this x the velocity limit is refused, >= 1"));
     a->Visit(IPLAN_NVP(cycle_budget, "s of wall time one cycle's planning may take, [0, planning_step); 0: none"));
+    a->Visit(IPLAN_NVP(ssm_patience, "s of a task's delay after which its plans keep no margin above S_p, >= 0; 0: off"));
   }
   std::string Validate() const;
 };
@@ -162,6 +174,8 @@ class Replanner {
   CycleResult StandBy(int64_t now_ns);
   std::optional<planning::Goal> AsideGoal(const planning::PlanningRequest& req) const;
   void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
+  static std::pair<int64_t, double> PathLag(const cell::JointTrajectory& plan, int64_t stamp_ns, const Eigen::VectorXd& q,
+                                            int64_t max_lag_ns);
 
   const planning::Planner& planner_;
   const collision::HumanBodyModel& body_;

@@ -308,6 +308,137 @@ TEST_F(ReplannerTest, RobotOffThePlanIsReplannedFromItsState) {
   EXPECT_EQ(c.start_ns, t);
 }
 
+// A robot the separation monitor slows down (its path time-scaled) is behind
+// the plan's timing, on its path, and moving along it: the replanner re-times
+// the plan to where the robot is (the frozen prefix continues from there),
+// rather than planning from the state as for a robot off the plan; a robot
+// that stands at the same place is not re-timed.
+TEST_F(ReplannerTest, ARobotSlowedDownOnItsPathIsReTimedNotReplannedFromRest) {
+  // The cell's replanning settings: a 1.5 s horizon, so the arm is fast.
+  const planning::Planner cell(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                               collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
+                               planning::LoadPlannerParams(kConfig + "planner_replanning.yaml"));
+  Replanner replanner(cell, body_, ReplannerParams{});
+  int64_t t = 100 * kSec;
+  auto set_state = [&](int64_t at, const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {
+    ASSERT_EQ(replanner.UpdateRobotState(at, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7),
+                                         std::vector<double>(qd.data(), qd.data() + 7)),
+              std::nullopt);
+  };
+  set_state(t, Ready(), Eigen::VectorXd::Zero(7));
+  ASSERT_EQ(replanner.StartTask({13, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  CycleResult c;
+  for (int k = 0; k < 4; ++k) {  // under way at full speed
+    c = replanner.Cycle(t);
+    ASSERT_TRUE(c.publish && !c.outcome) << c.status;
+    t += kSec / 10;
+    const Eigen::VectorXd q = At(c, t);
+    set_state(t, q, (At(c, t + kSec / 100) - q) / 0.01);
+  }
+  c = replanner.Cycle(t);
+  ASSERT_TRUE(c.publish) << c.status;
+  // Run at a tenth of the plan's speed from here: 0.1 s later the robot is
+  // where the plan is 0.01 s after it, moving at a tenth of its speed.
+  const int64_t path = t + kSec / 100;
+  t += kSec / 10;
+  const Eigen::VectorXd q = At(c, path);
+  ASSERT_GT((At(c, t) - q).cwiseAbs().maxCoeff(), 0.5 * ReplannerParams{}.max_tracking_error)
+      << "the lag must be large enough to matter";
+  const Eigen::VectorXd v = (At(c, path + kSec / 100) - q) / 0.01 / 10;
+  set_state(t, q, v);
+  const CycleResult slowed = replanner.Cycle(t);
+  EXPECT_NE(slowed.status.find("re-timed"), std::string::npos) << slowed.status;
+  EXPECT_EQ(slowed.status.find("robot off the plan"), std::string::npos) << slowed.status;
+  EXPECT_LT((slowed.positions.col(0) - q).cwiseAbs().maxCoeff(), 0.02) << "the plan continues from the robot";
+  // The same place without motion (a robot stopped there) is not re-timed.
+  Replanner other(cell, body_, ReplannerParams{});
+  int64_t t2 = 100 * kSec;
+  const Eigen::VectorXd ready = Ready();
+  ASSERT_EQ(other.UpdateRobotState(t2, other.joint_names(), std::vector<double>(ready.data(), ready.data() + 7),
+                                   std::vector<double>(7, 0.0)),
+            std::nullopt);
+  ASSERT_EQ(other.StartTask({13, "reach", planning::Goal::Joint(Goal()), 0}, t2), std::nullopt);
+  for (int k = 0; k < 5; ++k) {
+    const CycleResult oc = other.Cycle(t2);
+    t2 += kSec / 10;
+    const Eigen::VectorXd oq = At(oc, k < 4 ? t2 : t2 - kSec * 9 / 100);
+    const Eigen::VectorXd ov = k < 4 ? Eigen::VectorXd((At(oc, t2 + kSec / 100) - oq) / 0.01) : Eigen::VectorXd::Zero(7);
+    ASSERT_EQ(other.UpdateRobotState(t2, other.joint_names(), std::vector<double>(oq.data(), oq.data() + 7),
+                                     std::vector<double>(ov.data(), ov.data() + 7)),
+              std::nullopt);
+  }
+  EXPECT_EQ(other.Cycle(t2).status.find("re-timed"), std::string::npos);
+}
+
+// Patience (ReplannerParams::ssm_patience): a person who stays beside the
+// goal, outside the monitor's S_p there but inside S_p + ssm_margin, holds
+// the task off for ever without it; with it, the margin shrinks with the
+// task's delay, and the robot arrives once the person has delayed it long
+// enough, still outside S_p.
+TEST_F(ReplannerTest, PatienceLetsARobotHeldOffByAStayingPersonArriveOutsideTheProtectiveSeparation) {
+  const planning::PlannerParams pp = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+  ASSERT_TRUE(pp.predict_ssm);
+  ASSERT_NEAR(pp.ssm_margin, 0.08, 1e-12);
+  const planning::Planner predicting(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                     collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), pp);
+  const collision::RobotModel& robot = predicting.robot();
+  collision::RobotData d(robot);
+  collision::CalcForwardKinematics(robot, Goal(), &d);
+  const Eigen::Vector3d tool = d.p_WS.col(static_cast<Eigen::Index>(robot.spheres.size()) - 1);
+  // Smallest surface distance between the robot at the goal and the person
+  // whose hand is `offset` m beyond the tool along x.
+  auto gap = [&](double offset) {
+    const collision::JointMixture m = PersonAt(0, tool + Eigen::Vector3d(offset, 0, 0));
+    Eigen::Matrix3Xd joints(3, static_cast<Eigen::Index>(m.joint_names.size()));
+    for (std::size_t j = 0; j < m.joint_names.size(); ++j) joints.col(static_cast<Eigen::Index>(j)) = m.means[0][j];
+    double best = std::numeric_limits<double>::infinity();
+    for (int h = 0; h < body_.num_spheres(); ++h) {
+      for (std::size_t k = 0; k < robot.spheres.size(); ++k) {
+        best = std::min(best, (d.p_WS.col(static_cast<Eigen::Index>(k)) - body_.SphereCentre(h, joints)).norm() -
+                                  robot.spheres[k].radius - body_.spheres()[static_cast<std::size_t>(h)].radius);
+      }
+    }
+    return best;
+  };
+  // The hand placed so that the gap at the goal is S_p of a still person and
+  // robot (0.17 m) + 0.04 m: half the planner's margin.
+  double lo = 0.0, hi = 0.8;
+  for (int i = 0; i < 60; ++i) (gap(0.5 * (lo + hi)) < 0.21 ? lo : hi) = 0.5 * (lo + hi);
+  const Eigen::Vector3d hand = tool + Eigen::Vector3d(hi, 0, 0);
+  ASSERT_NEAR(gap(hi), 0.21, 1e-6);
+  auto run = [&](double patience, double* closest) {
+    ReplannerParams rp;
+    rp.ssm_patience = patience;
+    Replanner replanner(predicting, body_, rp);
+    int64_t t = 100 * kSec;
+    Eigen::VectorXd q = Ready();
+    std::vector<double> zero(7, 0.0);
+    EXPECT_EQ(replanner.UpdateRobotState(t, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7), zero),
+              std::nullopt);
+    EXPECT_EQ(replanner.StartTask({14, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+    for (int k = 0; k < 80; ++k) {
+      EXPECT_EQ(replanner.UpdatePrediction(PersonAt(t, hand)), std::nullopt);
+      const CycleResult c = replanner.Cycle(t);
+      if (c.outcome) return c.outcome;
+      t += kSec / 10;
+      if (c.publish) q = At(c, t);
+      collision::RobotData r(robot);
+      collision::CalcForwardKinematics(robot, q, &r);
+      *closest = std::min(*closest, (r.p_WS.col(static_cast<Eigen::Index>(robot.spheres.size()) - 1) - hand).norm());
+      EXPECT_EQ(replanner.UpdateRobotState(t, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7), zero),
+                std::nullopt);
+    }
+    return std::optional<TaskOutcome>();
+  };
+  double closest_without = std::numeric_limits<double>::infinity(), closest_with = closest_without;
+  EXPECT_FALSE(run(0.0, &closest_without).has_value()) << "without patience the person holds the task off";
+  const std::optional<TaskOutcome> o = run(1.5, &closest_with);
+  ASSERT_TRUE(o.has_value()) << "with patience the robot arrives within 8 s";
+  EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
+  EXPECT_GT(o->delay, 0.5 * 1.5) << "not before the margin has shrunk to what the gap allows";
+  EXPECT_LT(closest_with, closest_without);
+}
+
 TEST_F(ReplannerTest, RobotStatesOutsideTheJointLimitsAreRefused) {
   const std::vector<std::string> names = replanner_.joint_names();
   auto update = [&](const Eigen::VectorXd& q, const Eigen::VectorXd& qd) {

@@ -105,6 +105,14 @@ struct PlanningRequest {
   /// sphere is kept clear of them like of the scene's objects (obstacle cost,
   /// clearance check, goal check). Each must pass SceneParams::Validate.
   std::vector<collision::SceneObject> obstacles;
+  /// The fraction of PlannerParams::ssm_margin and ssm_activation that this
+  /// request's plans keep above the separation monitor's S_p (predict_ssm),
+  /// in [0, 1]; the cost's band above the margin keeps at least 0.02 m. A
+  /// replanner lowers it while a task is held off (ReplannerParams::
+  /// ssm_patience), so that a person who stays near the goal delays the
+  /// robot for a while, not for ever; at 0 a plan may come as close as the
+  /// predicted monitor allows, never closer.
+  double ssm_scale = 1.0;
 };
 
 enum class PlanStatus {

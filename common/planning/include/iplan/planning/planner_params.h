@@ -66,6 +66,12 @@ struct PlannerParams {
   /// thread count. Meant for replanning (a good warm start is usually feasible
   /// at once); it trades final cost for time.
   int early_stop_interval = 0;
+  /// With a time budget (PlanningRequest::time_budget), the fraction of it
+  /// kept for the work after the optimisers stop (the last feasibility
+  /// checks, exact bounds, the failure report), in [0, 0.9): the optimisers
+  /// stop at (1 - budget_reserve) x the budget, so that Plan returns within
+  /// the budget rather than one iteration and the checks after it.
+  double budget_reserve = 0.15;
   /// Step size of the covariant update x -= step * H^-1 grad, in (0, 1].
   double step_size = 0.5;
   /// Std-dev (rad) of the random via-point offset of optimisers 1..N-1.
@@ -149,6 +155,7 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(max_iterations, "gradient iterations per optimiser and attempt, >= 1"));
   a->Visit(IPLAN_NVP(convergence_tolerance, "stop when feasible and the relative cost decrease is below this, >= 0"));
   a->Visit(IPLAN_NVP(early_stop_interval, "rounds of K iterations, all stop after one is feasible and safe; 0 = off"));
+  a->Visit(IPLAN_NVP(budget_reserve, "fraction of a time budget kept for the checks after the optimisers stop, in [0, 0.9)"));
   a->Visit(IPLAN_NVP(step_size, "step of the covariant update, in (0, 1]"));
   a->Visit(IPLAN_NVP(initial_perturbation, "rad; std-dev of the via-point offset of optimisers 1..N-1, >= 0"));
   a->Visit(IPLAN_NVP(obstacle_margin, "m; hinge margin of the obstacle cost, >= 0"));
