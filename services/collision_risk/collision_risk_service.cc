@@ -131,6 +131,7 @@ class CollisionRiskService : public framework::Service {
     m.human_speed = r.human_speed;
     m.robot_speed = r.robot_speed;
     m.separation_margin = services::ToWire(r.separation_margin);
+    m.speed_scale = r.speed_scale;
     m.verdict = services::ToWire(r.verdict);
     m.reason = r.reason;
     writer_->Write(m);
@@ -141,6 +142,7 @@ class CollisionRiskService : public framework::Service {
     p.validity = permit_validity_;
     p.source = "collision_risk";
     p.reason = r.reason;
+    p.speed_reduction = 1.0 - r.speed_scale;
     permit_writer_->Write(p);
     last_publish_ns_ = now_ns;
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());

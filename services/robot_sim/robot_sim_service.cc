@@ -63,7 +63,7 @@ class RobotSimService : public framework::Service {
                    std::function<void(const msg::SafetyPermit&, SI)>([this, &node](const msg::SafetyPermit& m, SI info) {
                      node.CountRejection("permit", gate_->OnPermit(info.writer_name, info.writer_id, m.state == msg::SafetyPermit::PERMIT,
                                                                    m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
-                                                                   msg::ToNanoseconds(msg::Now())));
+                                                                   msg::ToNanoseconds(msg::Now()), m.speed_reduction));
                    }));
     // A monitor that vanishes (crash, freeze, network) sends no more permits:
     // its last one lapses within its validity, which is shorter than the
@@ -108,6 +108,8 @@ class RobotSimService : public framework::Service {
         if (const auto& sep = sim_->min_separation_seen())
           node.SetDiagnosticValue("min_true_separation_m", std::to_string(*sep));
         node.SetDiagnosticValue("protective_stops", std::to_string(stops_));
+        node.SetDiagnosticValue("speed_scale", std::to_string(sim_->speed_scale()));
+        node.SetDiagnosticValue("slowed_down_s", std::to_string(slowed_s_));
         node.SetDiagnosticValue("stopped", sim_->stopped() ? "true" : "false");
         node.SetDiagnosticValue("permit", permit_reason_);
         node.SetDiagnosticValue("permit_writer_conflicts", std::to_string(writer_conflicts_));
@@ -169,6 +171,9 @@ class RobotSimService : public framework::Service {
       sim_->Resume();
       node.log().info("resume: {}", d.reason);
     }
+    // ISO/TS 15066 speed reduction: the path time-scaled while a monitor asks.
+    if (d.permitted && d.speed_scale < 1.0) slowed_s_ += (now_ns - last_) * 1e-9;
+    sim_->SetSpeedScale(d.permitted ? d.speed_scale : 1.0);
   }
 
   double control_rate_hz_ = 100, publish_rate_hz_ = 50;
@@ -177,6 +182,7 @@ class RobotSimService : public framework::Service {
   std::string writer_conflict_;  // the latest writer conflict ("" when none yet)
   uint64_t writer_conflicts_ = 0;
   bool ever_permitted_ = false;
+  double slowed_s_ = 0.0;  // s the path ran time-scaled (speed reduction)
   std::unique_ptr<RobotSimulator> sim_;
   std::unique_ptr<collision::HumanBodyModel> body_;
   dds::Writer<msg::JointState>* joint_writer_ = nullptr;

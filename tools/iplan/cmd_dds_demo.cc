@@ -108,6 +108,8 @@ class CellMonitor {
     node.Subscribe(topics::CollisionRisk(),
                    std::function<void(const msg::CollisionRisk&, SI)>([this](const msg::CollisionRisk& m, SI) {
                      max_bound_ = std::max(max_bound_, m.max_bound);
+                     const bool slowed = m.verdict == msg::CollisionRisk::SLOW_DOWN && m.speed_scale < 1.0;
+                     if (std::exchange(slowed_, slowed) != slowed && slowed) ++slow_downs_;  // speed reduction
                      separation_ = m.min_separation;
                      min_observed_separation_ = std::min(min_observed_separation_, m.min_separation);
                    }));
@@ -121,7 +123,9 @@ class CellMonitor {
                      if (stopped_ && !was_stopped) {
                        ++stops_;
                        stop_reasons_.push_back(m.source + ": " + m.reason);
+                       stop_since_ = Now();
                      }
+                     if (!stopped_ && was_stopped) stop_time_s_ += Now() - stop_since_;
                    }),
                    any_order);
     node.Subscribe(topics::Diagnostics(),
@@ -178,7 +182,9 @@ class CellMonitor {
   std::vector<double> intent_ms_, queue_ms_, planning_ms_;
   double max_bound_ = 0, max_plan_bound_ = 0;
   double separation_ = 1e18, min_observed_separation_ = 1e18;
-  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0;
+  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0, slow_downs_ = 0;
+  bool slowed_ = false;  // the last verdict slowed the robot
+  double stop_since_ = 0, stop_time_s_ = 0;  // s since the demo started; s stopped (ended stops)
   std::vector<std::string> stop_reasons_;
 
  private:
@@ -233,15 +239,6 @@ class CellMonitor {
   std::map<std::string, std::map<std::string, std::string>> diag_;
   std::vector<std::string> events_;
 };
-
-std::string Tail(const std::string& text, size_t lines) {
-  size_t pos = text.size();
-  for (size_t n = 0; n <= lines && pos > 0; ++n) {
-    pos = text.rfind('\n', pos - 1);
-    if (pos == std::string::npos) return text;
-  }
-  return text.substr(pos + 1);
-}
 
 // One run of the demo: the processes, their vendors and what came of it.
 class DemoRun {
@@ -454,7 +451,9 @@ class DemoRun {
               << "\n"
               << "  maximum collision bound       " << Fixed(mon.max_bound_, 4) << " (executing trajectory), "
               << Fixed(mon.max_plan_bound_, 4) << " (plans)\n"
-              << "  protective stops              " << mon.stops_ << "\n"
+              << "  protective stops              " << mon.stops_ << " (" << Fixed(mon.stop_time_s_, 1) << " s, resume delays "
+              << "included; the first is the safe start); slowed down instead " << mon.slow_downs_ << " times (robot slowed "
+              << Fixed(mon.DiagNumber("robot_sim", "slowed_down_s", 0), 1) << " s, ISO/TS 15066 speed reduction)\n"
               << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
               << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
               << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
@@ -509,6 +508,8 @@ class DemoRun {
     j["max_collision_bound"] = mon.max_bound_;
     j["max_plan_collision_bound"] = mon.max_plan_bound_;
     j["protective_stops"] = mon.stops_;
+    j["protective_stop_time_s"] = mon.stop_time_s_;
+    j["slow_downs"] = {{"count", mon.slow_downs_}, {"robot_slowed_s", mon.DiagNumber("robot_sim", "slowed_down_s", 0)}};
     j["true_contacts"] = contacts;
     j["latency_ms"] = {{"p50", lat.p50}, {"p99", lat.p99}, {"max", lat.max}, {"count", lat.count}};
     j["latency_stages_ms"] = {{"intent", {{"p50", intent_lat.p50}, {"p99", intent_lat.p99}}},

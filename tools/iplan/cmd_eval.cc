@@ -231,6 +231,8 @@ Json ScenarioJson(const cell_sim::ScenarioSpec& s, Predictor predictor, const ce
   j["stops_by_separation"] = r.stops_separation;
   j["stops_by_bound"] = r.stops_bound;
   j["stop_time_s"] = r.stop_time;
+  j["slow_downs"] = r.slow_downs;
+  j["slow_time_s"] = r.slow_time;
   j["min_separation_m"] = r.min_separation;
   j["max_bound"] = r.max_bound;
   j["true_contacts"] = r.true_contacts;
@@ -261,6 +263,8 @@ Json SummaryJson(const cell_sim::PredictorSummary& s) {
   Json stop_time = SpreadJson(s.stop_time);
   stop_time["total"] = s.stop_time_total;
   j["stop_time_s"] = stop_time;
+  j["slow_downs"] = Json{{"total", s.slow_downs_total}};
+  j["slow_time_s"] = Json{{"total", s.slow_time_total}};
   j["min_separation_m"] = SpreadJson(s.min_separation);
   j["max_bound"] = SpreadJson(s.max_bound);
   j["true_contacts"] = s.true_contacts;

@@ -47,4 +47,13 @@ std::optional<framework::TopicDescription> FindCatalogueTopic(const std::string&
   return std::nullopt;
 }
 
+std::string Tail(const std::string& text, size_t lines) {
+  size_t pos = text.size();
+  for (size_t n = 0; n <= lines && pos > 0; ++n) {
+    pos = text.rfind('\n', pos - 1);
+    if (pos == std::string::npos) return text;
+  }
+  return text.substr(pos + 1);
+}
+
 }  // namespace iplan::cli

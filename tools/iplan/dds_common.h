@@ -31,6 +31,10 @@ std::unique_ptr<dds::Participant> MakeParticipant(const DdsOptions& o, const std
 
 /// "rt/iplan/x", "/iplan/x" and "iplan/x" all name DDS topic "rt/iplan/x".
 std::string DdsTopicName(const std::string& name);
+
+/// The last `lines` lines of `text` (all of it when it has fewer), e.g. of a
+/// service's stderr for an error message.
+std::string Tail(const std::string& text, size_t lines);
 /// "rt/iplan/x" -> "/iplan/x" (ROS 2 form); other names unchanged.
 std::string RosTopicName(const std::string& dds_name);
 

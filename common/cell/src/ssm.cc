@@ -13,6 +13,8 @@ std::string SsmParams::Validate() const {
   if (!(speed_window > 0)) return "speed_window must be > 0";
   if (!(stopping_speed > 0)) return "stopping_speed must be > 0";
   if (!std::isfinite(retreat_speed)) return "retreat_speed must be finite";
+  if (!(min_speed_scale > 0 && min_speed_scale <= 1)) return "min_speed_scale must be in (0, 1]";
+  if (!(speed_reduction_time >= 0) || !std::isfinite(speed_reduction_time)) return "speed_reduction_time must be >= 0";
   return "";
 }
 
@@ -27,6 +29,26 @@ double ProtectiveSeparationDistance(const SsmParams& p, double v_h, double v_r) 
   return s_h + s_r + StoppingDistance(p, v_r) + fixed;
 }
 
+double SpeedScaleFor(const SsmParams& p, double d, double v_h, double v_r) {
+  const double at_rest = ProtectiveSeparationDistance(p, v_h, 0.0);
+  if (!(d >= at_rest)) return 0.0;
+  if (!(v_r > 0.0) || d >= ProtectiveSeparationDistance(p, v_h, v_r)) return 1.0;
+  // S_p grows linearly with the robot's speed: directed, with slope
+  // T_r + S_s / stopping_speed up to stopping_speed and T_r above it;
+  // undirected (S_s already in at_rest), with slope T_r. Here S_p(v_r) > d,
+  // so the slope used is positive.
+  const double room = d - at_rest;
+  double v = 0.0;
+  if (p.directed) {
+    const double slope = p.reaction_time + p.stopping_distance / p.stopping_speed;
+    v = room / slope;
+    if (v > p.stopping_speed) v = p.stopping_speed + (room - slope * p.stopping_speed) / p.reaction_time;
+  } else {
+    v = room / p.reaction_time;
+  }
+  return std::clamp(v / v_r, 0.0, 1.0);
+}
+
 SsmPair SsmPairRule(const SsmParams& p, const Eigen::Vector3d& delta, double radii, const Eigen::Vector3d& v_human,
                     const Eigen::Vector3d& v_robot) {
   SsmPair r;
@@ -39,6 +61,10 @@ SsmPair SsmPairRule(const SsmParams& p, const Eigen::Vector3d& delta, double rad
   r.protective_separation = ProtectiveSeparationDistance(p, r.v_h, r.v_r);
   r.margin = r.separation - r.protective_separation;
   r.retreating = r.margin < 0 && p.retreat_speed > 0 && centres > 1e-9 && away >= p.retreat_speed;
+  if (!r.retreating) {
+    r.stop_scale = SpeedScaleFor(p, r.separation, r.v_h, r.v_r);
+    r.slow_scale = SpeedScaleFor(p, r.separation - r.v_r * p.speed_reduction_time, r.v_h, r.v_r);
+  }
   return r;
 }
 

@@ -456,6 +456,7 @@ std::optional<std::string> CheckSemantics(const CollisionRisk& m) {
     if (auto e = CheckUnit(m.waypoint_bounds[i], [i] { return "waypoint_bounds[" + std::to_string(i) + "]"; })) return e;
   }
   if (!m.waypoint_bounds.empty() && m.max_waypoint >= m.waypoint_bounds.size()) return std::string("max_waypoint out of range");
+  if (auto e = CheckUnit(m.speed_scale, "speed_scale")) return e;
   return std::nullopt;
 }
 
@@ -463,6 +464,9 @@ std::optional<std::string> CheckSemantics(const SafetyPermit& m) {
   if (auto e = CheckSemantics(m.header)) return e;
   if (m.state > SafetyPermit::PERMIT) return "state " + std::to_string(m.state) + " unknown";
   if (!(m.validity > 0) || m.validity > 10) return "validity " + Num(m.validity) + " s outside (0, 10]";
+  if (!(m.speed_reduction >= 0 && m.speed_reduction <= 1)) {
+    return "speed_reduction " + Num(m.speed_reduction) + " outside [0, 1]";
+  }
   return std::nullopt;
 }
 

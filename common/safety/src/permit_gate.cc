@@ -55,7 +55,7 @@ PermitGate::PermitGate(PermitGateParams params) : params_(std::move(params)) {
 
 std::optional<std::string> PermitGate::OnPermit(const std::string& monitor, uint64_t writer, bool permit,
                                                 double validity_s, const std::string& reason, int64_t stamp_ns,
-                                                int64_t now_ns) {
+                                                int64_t now_ns, double speed_reduction) {
   if (std::find(params_.monitors.begin(), params_.monitors.end(), monitor) == params_.monitors.end()) {
     return "'" + monitor + "' is not a configured monitor";
   }
@@ -75,6 +75,9 @@ std::optional<std::string> PermitGate::OnPermit(const std::string& monitor, uint
     w->last_ns = std::max(w->last_ns, now_ns);
   }
   if (!(validity_s > 0) || !std::isfinite(validity_s)) return "validity " + std::to_string(validity_s) + " s is not positive";
+  if (!(speed_reduction >= 0 && speed_reduction <= 1)) {
+    return "speed_reduction " + std::to_string(speed_reduction) + " is outside [0, 1]";
+  }
   const int64_t tolerance_ns = Ns(params_.clock_tolerance);
   if (stamp_ns - now_ns > tolerance_ns) {
     return "stamped " + Seconds((stamp_ns - now_ns) * 1e-9) + " ahead of this clock (tolerance " +
@@ -92,13 +95,13 @@ std::optional<std::string> PermitGate::OnPermit(const std::string& monitor, uint
       if (first->expires_ns < expires_ns) m.stops.erase(first);
     }
     if (m.stops.size() < kMaxStopsPerMonitor) m.stops.push_back(Stop{writer, reason, stamp_ns, expires_ns});
-    if (!held.valid || stamp_ns >= held.stamp_ns) held = Held{true, false, reason, stamp_ns, expires_ns};
+    if (!held.valid || stamp_ns >= held.stamp_ns) held = Held{true, false, reason, 0.0, stamp_ns, expires_ns};
     return std::nullopt;
   }
   if (held.valid && stamp_ns < held.stamp_ns) {
     return "older than the permit held (by " + Seconds((held.stamp_ns - stamp_ns) * 1e-9) + ")";
   }
-  held = Held{true, true, reason, stamp_ns, expires_ns};
+  held = Held{true, true, reason, speed_reduction, stamp_ns, expires_ns};
   EraseIf(&m.stops, [&](const Stop& x) { return x.writer == writer && stamp_ns > x.stamp_ns; });
   return std::nullopt;
 }
@@ -122,6 +125,7 @@ std::string PermitGate::ConflictText(const std::string& name, const std::vector<
 PermitDecision PermitGate::Evaluate(int64_t now_ns) const {
   PermitDecision d;
   std::string why;
+  double reduction = 0.0;
   auto add = [&why](const std::string& s) { why += (why.empty() ? "" : "; ") + s; };
   for (const std::string& name : params_.monitors) {
     auto it = monitors_.find(name);
@@ -149,10 +153,13 @@ PermitDecision PermitGate::Evaluate(int64_t now_ns) const {
       add("permit from " + name + " lapsed " + Seconds((now_ns - w->held.expires_ns) * 1e-9) + " ago");
     } else if (!w->held.permit) {
       add(name + " stops: " + w->held.reason);
+    } else {
+      reduction = std::max(reduction, w->held.speed_reduction);
     }
   }
   d.permitted = why.empty();
   d.reason = d.permitted ? permitted_reason_ : why;
+  if (d.permitted) d.speed_scale = 1.0 - reduction;
   return d;
 }
 

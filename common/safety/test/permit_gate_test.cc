@@ -1,5 +1,7 @@
 #include "iplan/safety/permit_gate.h"
 
+#include <cmath>
+
 #include <gtest/gtest.h>
 
 namespace iplan::safety {
@@ -35,6 +37,25 @@ TEST(PermitGate, OneStopIsEnough) {
   const PermitDecision d = g.Evaluate(kT0 + kMs);
   EXPECT_FALSE(d.permitted);
   EXPECT_NE(d.reason.find("iplan-collision_risk stops: separation below S_p"), std::string::npos) << d.reason;
+}
+
+// Speed reduction rides on the permits: the robot runs at 1 minus the
+// largest reduction of the permits it holds; a reduction outside [0, 1] is
+// refused and changes nothing.
+TEST(PermitGate, TheLargestSpeedReductionOfThePermitsHeldApplies) {
+  PermitGate g = TwoMonitors();
+  g.OnPermit("iplan-supervisor", kSup, true, 0.2, "healthy", kT0, kT0);
+  g.OnPermit("iplan-collision_risk", kRisk, true, 0.2, "clear", kT0, kT0);
+  EXPECT_EQ(g.Evaluate(kT0 + kMs).speed_scale, 1.0);
+  ASSERT_FALSE(g.OnPermit("iplan-collision_risk", kRisk, true, 0.2, "speed reduced", kT0 + 10 * kMs, kT0 + 10 * kMs, 0.6));
+  PermitDecision d = g.Evaluate(kT0 + 11 * kMs);
+  EXPECT_TRUE(d.permitted);
+  EXPECT_NEAR(d.speed_scale, 0.4, 1e-12);
+  EXPECT_TRUE(g.OnPermit("iplan-collision_risk", kRisk, true, 0.2, "bad", kT0 + 20 * kMs, kT0 + 20 * kMs, 1.5));
+  EXPECT_TRUE(g.OnPermit("iplan-collision_risk", kRisk, true, 0.2, "bad", kT0 + 20 * kMs, kT0 + 20 * kMs, std::nan("")));
+  EXPECT_NEAR(g.Evaluate(kT0 + 21 * kMs).speed_scale, 0.4, 1e-12);
+  ASSERT_FALSE(g.OnPermit("iplan-collision_risk", kRisk, true, 0.2, "clear", kT0 + 30 * kMs, kT0 + 30 * kMs, 0.0));
+  EXPECT_EQ(g.Evaluate(kT0 + 31 * kMs).speed_scale, 1.0);
 }
 
 TEST(PermitGate, APermitLapsesAfterItsValidity) {

@@ -551,6 +551,8 @@ std::vector<PredictorSummary> Summarize(const std::vector<Predictor>& predictors
       s.stops_bound_total += r.stops_bound;
       stop_time.push_back(r.stop_time);
       s.stop_time_total += r.stop_time;
+      s.slow_downs_total += r.slow_downs;
+      s.slow_time_total += r.slow_time;
       separation.push_back(r.min_separation);
       bound.push_back(r.max_bound);
       s.true_contacts += r.true_contacts;

@@ -271,6 +271,8 @@ struct PredictorSummary {
   int stops_bound_total = 0;       ///< started by the collision bound
   Spread stop_time;             ///< s
   double stop_time_total = 0;   ///< s
+  int slow_downs_total = 0;     ///< times the monitor slowed the robot (speed reduction)
+  double slow_time_total = 0;   ///< s the robot ran slowed down
   Spread min_separation;        ///< m
   Spread max_bound;
   int true_contacts = 0;

@@ -158,6 +158,7 @@ class Interaction {
       }
     }
     if (in_task_ && robot_.stopped()) result_.stop_time += (finish_ - stop_since_) * 1e-9;
+    if (in_task_ && robot_.speed_scale() < 1.0) result_.slow_time += (finish_ - slow_since_) * 1e-9;
     result_.true_contacts = robot_.contacts() - contacts_before_;
     return result_;
   }
@@ -197,6 +198,15 @@ class Interaction {
       if (in_task_) result_.stop_time += (t - stop_since_) * 1e-9;
     }
     replanner_.SetRobotStopped(stop);
+    // Speed reduction: the monitor's scale holds until its next evaluation.
+    const double scale = stop ? 1.0 : report.speed_scale;
+    if (in_task_ && robot_.speed_scale() < 1.0) result_.slow_time += (t - slow_since_) * 1e-9;
+    if (params_.trace && (scale < 1.0) != (robot_.speed_scale() < 1.0)) {
+      params_.trace(t * 1e-9, scale < 1.0 ? "SLOW DOWN: " + report.reason : "full speed: " + report.reason);
+    }
+    if (in_task_ && scale < 1.0 && robot_.speed_scale() == 1.0) ++result_.slow_downs;
+    slow_since_ = t;
+    robot_.SetSpeedScale(scale);
   }
 
   // The robot moves, the true body decides contact, and (at its rate) the
@@ -258,6 +268,7 @@ class Interaction {
     if (t == task_start_) {
       replanner_.StartTask(setup_.task, stamp);
       in_task_ = true;
+      slow_since_ = t;
       contacts_before_ = robot_.contacts();
       if (robot_.stopped()) {
         ++result_.protective_stops;
@@ -328,7 +339,7 @@ class Interaction {
   bool in_task_ = false;
   int contacts_before_ = 0;  // contacts before the command (the robot at rest) are not the task's
   int64_t finish_ = 0;       // scenario time the run ended
-  int64_t last_evaluation_ = INT64_MIN / 2, stop_since_ = 0;
+  int64_t last_evaluation_ = INT64_MIN / 2, stop_since_ = 0, slow_since_ = 0;
   std::vector<Eigen::Vector3d> skeleton_;
   Eigen::Matrix3Xd p_WJ_;
 };

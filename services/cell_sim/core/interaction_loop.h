@@ -120,6 +120,8 @@ struct InteractionResult {
   int stops_separation = 0;    ///< of which the ISO/TS 15066 separation layer started
   int stops_bound = 0;         ///< of which the collision bound along the executing trajectory started
   double stop_time = 0;        ///< s the robot spent stopped
+  int slow_downs = 0;          ///< times the monitor slowed the robot (speed reduction) from full speed
+  double slow_time = 0;        ///< s the robot ran slowed down (its path time-scaled below 1)
   double min_separation = 1e6; ///< m, smallest true robot-human surface distance (control rate)
   /// Highest true bound: at every skeleton frame, the collision bound
   /// (METHOD 4) of the robot's actual configuration against the true body at

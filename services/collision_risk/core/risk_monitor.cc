@@ -140,6 +140,7 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
   if (!state_ || now_ns - state_->first > stale) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = state_ ? "robot state is stale" : "no robot state yet";
+    r.speed_scale = 0.0;
     return r;
   }
   Inputs in;
@@ -173,6 +174,7 @@ RiskReport RiskMonitor::Evaluate(int64_t now_ns) {
 struct RiskMonitor::SeparationSearch {
   double best = std::numeric_limits<double>::infinity(), best_margin = best;
   bool retreating = false;  // the binding pair is a retreat inside S_p
+  double slow_scale = 1.0, stop_scale = 1.0;  // speed reduction: the smallest over the pairs
   std::size_t closest_k = 0, binding_k = 0;
   int closest_h = 0, binding_h = 0;
   cell::BodyId body = 0;  // the person searched now
@@ -209,6 +211,8 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
   r.separation_human_segment = segment(search.closest_h);
   r.separation_margin = search.best_margin;
   r.retreating = search.retreating;
+  r.stop_scale = search.stop_scale;
+  if (s.speed_reduction && search.slow_scale < 1.0) r.speed_scale = std::max(s.min_speed_scale, search.slow_scale);
   r.binding_robot_link = link(search.binding_k);
   r.binding_human_segment = segment(search.binding_h);
 }
@@ -238,6 +242,8 @@ void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure,
       const double d = centres - robot_spheres[k].radius - human_radius;
       double v_h = v_h_max, v_r = v_r_max, sp = sp_undirected, margin = d - sp_undirected;
       bool retreating = false;
+      double slow_scale = cell::SpeedScaleFor(s, d - v_r_max * s.speed_reduction_time, v_h_max, v_r_max);
+      double stop_scale = cell::SpeedScaleFor(s, d, v_h_max, v_r_max);
       if (s.directed) {
         // The pair rule the planner predicts (cell::SsmPairRule). Without a
         // measured speed the person comes at the default speed, straight
@@ -250,10 +256,14 @@ void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure,
         v_r = pair.v_r;
         sp = pair.protective_separation;
         retreating = pair.retreating;
+        slow_scale = pair.slow_scale;
+        stop_scale = pair.stop_scale;
         // A retreat inside S_p is no violation: it binds as a margin of 0
         // (slow down, not stop) unless a pair outside S_p binds tighter.
         margin = retreating ? 0.0 : pair.margin;
       }
+      f.slow_scale = std::min(f.slow_scale, slow_scale);
+      f.stop_scale = std::min(f.stop_scale, stop_scale);
       if (d < f.best) {
         f.best = d;
         f.closest_k = k;
@@ -368,13 +378,17 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                                                           std::to_string(r.num_predicted) + ")"
                                                     : "";
   const bool seen = in.person || in.points;  // fresh points: the depth camera tracks the person
+  // Inside S_p at the trajectory's speed, but not at min_speed_scale of it:
+  // the robot is slowed down, not stopped (ISO/TS 15066 speed reduction).
+  const cell::SsmParams& s = params_.ssm;
+  const bool reducible = s.speed_reduction && r.stop_scale >= s.min_speed_scale;
   if (!seen && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;
     const int64_t last_seen = std::max(last_skeleton_ns_, points_stamp_ns_);
     r.reason = last_seen == 0 ? "no person tracked yet (no skeleton, no depth points): the person could be anywhere"
                               : "person no longer tracked (no skeleton or depth points for " +
                                     Fmt((now_ns - last_seen) * 1e-9) + " s): the person could be anywhere";
-  } else if (seen && margin < 0) {
+  } else if (seen && margin < 0 && !reducible) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "separation " + separation + " m (" + r.binding_robot_link + " / " + r.binding_human_segment +
                (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") +
@@ -398,7 +412,14 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
     r.verdict = Verdict::kSlowDown;
     r.reason = "retreating: separation " + separation + " m (" + r.binding_robot_link + " / " +
                r.binding_human_segment + ") below the protective separation " + Fmt(r.protective_separation) +
-               " m, the robot moving away" + nearest;
+               " m, the robot moving away" + nearest +
+               (r.speed_scale < 1.0 ? "; speed reduced to " + Fmt(r.speed_scale) + " of the trajectory's" : "");
+  } else if (seen && r.speed_scale < 1.0) {
+    r.verdict = Verdict::kSlowDown;
+    r.reason = "speed reduced to " + Fmt(r.speed_scale) + " of the trajectory's: separation " + separation + " m (" +
+               r.binding_robot_link + " / " + r.binding_human_segment + ") against the protective separation " +
+               Fmt(r.protective_separation) + " m at full speed (v_h " + Fmt(r.human_speed) + ", v_r " +
+               Fmt(r.robot_speed) + " m/s)" + nearest;
   } else if (seen && margin < params_.slow_down_margin) {
     r.verdict = Verdict::kSlowDown;
     r.reason = "separation " + separation + " m within " + Fmt(params_.slow_down_margin) +
@@ -412,6 +433,7 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
                               : "clear (separation only: no current prediction)";
   }
+  if (r.verdict == Verdict::kProtectiveStop) r.speed_scale = 0.0;
 }
 
 }  // namespace iplan::collision_risk

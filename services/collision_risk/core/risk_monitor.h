@@ -131,6 +131,14 @@ struct RiskReport {
   cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
   cell::Separation separation_margin;    ///< m, binding_separation - protective_separation (0 for a retreat); < 0 stops
   bool retreating = false;               ///< the binding pair is inside S_p, its robot sphere moving away (cell::SsmPair)
+  /// ISO/TS 15066 speed reduction (SsmParams::speed_reduction): the
+  /// fraction of the executing trajectory's speed the robot may run at, in
+  /// [0, 1]: below 1 with SLOW_DOWN (the path time-scaled), 0 with
+  /// PROTECTIVE_STOP, else 1. `stop_scale` is the smallest fraction at which
+  /// every pair keeps d >= S_p (below min_speed_scale: a stop); 0 where the
+  /// separation does not give one (depth points: no speed reduction).
+  double speed_scale = 1.0;
+  double stop_scale = 0.0;
   std::string binding_robot_link, binding_human_segment;
   cell::BodyId binding_body_id = 0;      ///< person of the binding pair (0: nobody seen)
   Verdict verdict = Verdict::kProtectiveStop;

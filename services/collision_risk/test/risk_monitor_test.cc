@@ -187,11 +187,35 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
                                       {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -0.3, 0, -2.356, 0, 1.571, 0.785}}),
             std::nullopt);
   const RiskReport closer = monitor_.Evaluate(t);
-  EXPECT_EQ(closer.verdict, Verdict::kProtectiveStop) << closer.reason;
   EXPECT_GT(closer.robot_speed, 0.3);
   EXPECT_NEAR(closer.protective_separation,
               closer.robot_speed * 0.1 + 0.15 * std::min(1.0, closer.robot_speed / 1.0) + 0.17 + closer.human_speed * 0.4,
               1e-9);
+  ASSERT_LT(closer.separation_margin.value(), 0.0);
+  // Too close at that speed, not at a lower one: ISO/TS 15066 speed
+  // reduction slows the robot (its path time-scaled) so that the binding
+  // pair keeps S_p with what it travels while slowing to spare, instead of
+  // stopping it.
+  EXPECT_EQ(closer.verdict, Verdict::kSlowDown) << closer.reason;
+  EXPECT_EQ(closer.reason.rfind("speed reduced to ", 0), 0u) << closer.reason;
+  EXPECT_GE(closer.speed_scale, monitor_.params().ssm.min_speed_scale);
+  EXPECT_LT(closer.speed_scale, 1.0);
+  EXPECT_LE(cell::ProtectiveSeparationDistance(monitor_.params().ssm, closer.human_speed,
+                                               closer.speed_scale * closer.robot_speed),
+            closer.binding_separation.value() -
+                closer.robot_speed * monitor_.params().ssm.speed_reduction_time + 1e-9);
+  // Without speed reduction the same approach is stopped.
+  RiskParams strict = monitor_.params();
+  strict.ssm.speed_reduction = false;
+  RiskMonitor m(monitor_.robot(), collision::HumanBodyParams::DefaultUpperBody(), strict);
+  ASSERT_EQ(m.UpdateRobotState(t, kRobotJoints, {0, -0.785, 0, -2.356, 0, 1.571, 0.785}), std::nullopt);
+  ASSERT_EQ(m.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5},
+                               {{0, -0.785, 0, -2.356, 0, 1.571, 0.785}, {0, -0.3, 0, -2.356, 0, 1.571, 0.785}}),
+            std::nullopt);
+  for (int64_t ts : {t - 2 * kSec / 10, t}) ASSERT_EQ(m.UpdateSkeleton(ts, kJoints, Person(torso, 0.3)), std::nullopt);
+  const RiskReport stopped = m.Evaluate(t);
+  EXPECT_EQ(stopped.verdict, Verdict::kProtectiveStop) << stopped.reason;
+  EXPECT_EQ(stopped.speed_scale, 0.0);
 }
 
 // Inside S_p, moving away is a retreat (SsmParams::retreat_speed): the
@@ -243,6 +267,8 @@ TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
   EXPECT_LT(r.separation_margin.value(), 0);
   EXPECT_LT(r.binding_separation.value(), r.protective_separation);
   EXPECT_NE(r.reason.find("below the protective separation"), std::string::npos) << r.reason;
+  EXPECT_EQ(r.speed_scale, 0.0);  // a robot at rest is already inside: no speed helps
+  EXPECT_EQ(r.stop_scale, 0.0);
 }
 
 TEST_F(RiskMonitorTest, PredictionOfContactSoonStopsBeforeSeparationIsViolated) {

@@ -52,6 +52,7 @@ std::optional<std::string> RobotSimulator::SetTrajectory(int64_t start_ns, const
     }
   }
   trajectory_ = std::move(t);
+  lag_ns_ = 0;
   return std::nullopt;
 }
 
@@ -67,8 +68,12 @@ void RobotSimulator::Stop() {
 
 void RobotSimulator::Resume() { stop_requested_ = false; }
 
+void RobotSimulator::SetSpeedScale(double scale) {
+  speed_scale_ = std::isfinite(scale) ? std::clamp(scale, 0.0, 1.0) : 0.0;
+}
+
 Eigen::VectorXd RobotSimulator::Desired(int64_t now_ns) const {
-  return trajectory_.empty() ? q_ : trajectory_.PositionAt(now_ns);
+  return trajectory_.empty() ? q_ : trajectory_.PositionAt(now_ns - lag_ns_);
 }
 
 void RobotSimulator::Step(int64_t now_ns, double dt) {
@@ -83,6 +88,9 @@ void RobotSimulator::Step(int64_t now_ns, double dt) {
     last_stopping_distance_ = std::max(last_stopping_distance_, (data_.X_WL.back().translation() - stop_start_ee_).norm());
     return;
   }
+  // Speed reduction: the trajectory's time falls behind by what the scale
+  // takes off this step.
+  lag_ns_ += static_cast<int64_t>(std::llround((1.0 - speed_scale_) * dt * 1e9));
   // Track the desired position: the velocity that would reach it in one
   // step, limited in velocity and in acceleration, and so that the joint can
   // still stop before overshooting.

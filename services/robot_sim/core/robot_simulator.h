@@ -1,7 +1,8 @@
 // A simulated robot arm: follows a time-stamped joint trajectory at the
 // control rate within the joint position, velocity and acceleration limits,
-// obeys protective stop / resume with a configured stopping time, and counts
-// true contacts between its collision spheres and a person's true body.
+// obeys protective stop / resume with a configured stopping time and speed
+// reduction (its path time-scaled), and counts true contacts between its
+// collision spheres and a person's true body.
 // No DDS types. Units: rad, rad/s, rad/s^2, s, m; times in ns since the epoch.
 // Not thread-safe (one owner).
 #pragma once
@@ -52,6 +53,15 @@ class RobotSimulator {
   /// Resume following the trajectory (from where its timing says it is now).
   void Resume();
   bool stopped() const { return stop_requested_; }
+  /// ISO/TS 15066 speed reduction: follow the trajectory's path at `scale`
+  /// (clamped to [0, 1]) of its timing from now on, i.e. its time runs
+  /// `scale` s per s and falls behind the clock (the tracking within the
+  /// limits brings the joints to the slower path speed). A new trajectory
+  /// starts on time again (the replanner plans from where the robot is).
+  void SetSpeedScale(double scale);
+  double speed_scale() const { return speed_scale_; }
+  /// s the trajectory's time is behind the clock (speed reduction).
+  double path_lag() const { return lag_ns_ * 1e-9; }
 
   /// Advances the simulation to `now_ns` by one control step of `dt` s:
   /// tracks the trajectory's position at now_ns within velocity and
@@ -86,6 +96,8 @@ class RobotSimulator {
   std::vector<std::string> robot_joints_;  // robot_.JointNames()
   cell::JointTrajectory trajectory_;      // empty: hold the current position
   bool stop_requested_ = false;
+  double speed_scale_ = 1.0;
+  int64_t lag_ns_ = 0;  // trajectory time = clock - lag (speed reduction)
   Eigen::VectorXd stop_decel_;  // per joint deceleration of the current stop
   Eigen::Vector3d stop_start_ee_ = Eigen::Vector3d::Zero();
   double last_stopping_distance_ = 0;

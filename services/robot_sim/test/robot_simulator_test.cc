@@ -69,6 +69,38 @@ TEST_F(RobotSimulatorTest, ProtectiveStopComesToRestWithinTheStoppingTime) {
   EXPECT_LT((sim_.q() - goal).norm(), 1e-3);
 }
 
+// Speed reduction: at half scale the path's time runs half as fast, so the
+// robot is where the trajectory is at half the elapsed time, moving at half
+// its speed; back at full scale it keeps that lag; a new trajectory starts on
+// time again.
+TEST_F(RobotSimulatorTest, SpeedReductionTimeScalesThePath) {
+  Eigen::VectorXd goal = Ready();
+  goal[0] = 1.0;  // 0.5 rad/s for 2 s
+  ASSERT_EQ(sim_.SetTrajectory(0, sim_.joint_names(), {0.0, 2.0}, Points(Ready(), goal)), std::nullopt);
+  const double dt = 0.01;
+  int k = 1;
+  for (; k <= 20; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);  // 0.2 s at full speed
+  sim_.SetSpeedScale(0.5);
+  for (; k <= 120; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);  // 1 s at half speed
+  EXPECT_NEAR(sim_.path_lag(), 0.5, 1e-9);
+  EXPECT_NEAR(sim_.qd()[0], 0.25, 1e-6);
+  EXPECT_NEAR(sim_.q()[0], 0.5 * (1.2 - 0.5), 0.01);  // where the trajectory is at 0.7 s
+  sim_.SetSpeedScale(1.0);
+  for (; k <= 150; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  EXPECT_NEAR(sim_.path_lag(), 0.5, 1e-9);
+  EXPECT_NEAR(sim_.qd()[0], 0.5, 1e-4);
+  sim_.SetSpeedScale(0.0);  // a pause along the path
+  for (; k <= 200; ++k) sim_.Step(static_cast<int64_t>(k * dt * kSec), dt);
+  EXPECT_NEAR(sim_.qd()[0], 0.0, 1e-9);
+  const Eigen::VectorXd held = sim_.q();
+  ASSERT_EQ(sim_.SetTrajectory(static_cast<int64_t>(k * dt * kSec), sim_.joint_names(), {0.0, 1.0}, Points(held, goal)),
+            std::nullopt);
+  EXPECT_EQ(sim_.path_lag(), 0.0);
+  EXPECT_EQ(sim_.speed_scale(), 0.0) << "the scale is the monitor's, not the trajectory's";
+  sim_.SetSpeedScale(std::nan(""));
+  EXPECT_EQ(sim_.speed_scale(), 0.0) << "a non-finite scale holds the robot";
+}
+
 TEST_F(RobotSimulatorTest, RefusesBadTrajectories) {
   Eigen::VectorXd far = Ready();
   far[0] = 5.0;

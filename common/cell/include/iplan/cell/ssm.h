@@ -45,6 +45,16 @@ struct SsmParams {
   /// the robot where the person is heading; its retreat only widens the gap.
   /// <= 0: off (every pair inside S_p stops the robot).
   double retreat_speed = 0.05;        ///< m/s
+  /// Speed reduction (directed or not): a robot whose separation would be
+  /// below S_p at its trajectory's speed, but not at a lower one, is slowed
+  /// down (the executing path time-scaled: SLOW_DOWN with a speed scale)
+  /// instead of stopped. The scale keeps d - v_r speed_reduction_time >=
+  /// S_p(v_h, scale x v_r) for every pair (what the robot travels while it
+  /// slows down); a stop only when even min_speed_scale x v_r leaves d < S_p.
+  /// false: every pair inside S_p stops the robot (no speed reduction).
+  bool speed_reduction = true;
+  double min_speed_scale = 0.1;       ///< below this fraction of its speed the robot is stopped instead, in (0, 1]
+  double speed_reduction_time = 0.1;  ///< s, >= 0
 
   /// Empty when valid, else the reason naming the field.
   std::string Validate() const;
@@ -65,6 +75,9 @@ struct SsmParams {
     a->Visit(IPLAN_NVP(sensing_uncertainty, "m; Z_d, >= 0"));
     a->Visit(IPLAN_NVP(robot_uncertainty, "m; Z_r, >= 0"));
     a->Visit(IPLAN_NVP(retreat_speed, "m/s; a pair inside S_p whose robot sphere moves away this fast is a retreat, not a stop (<= 0: off; directed only)"));
+    a->Visit(IPLAN_NVP(speed_reduction, "slow the robot (time-scale its path) where a lower speed keeps the separation above S_p, instead of stopping it"));
+    a->Visit(IPLAN_NVP(min_speed_scale, "below this fraction of its trajectory's speed the robot is stopped instead of slowed, in (0, 1]"));
+    a->Visit(IPLAN_NVP(speed_reduction_time, "s; slowing starts v_r x this before S_p is reached (the robot's travel while it slows), >= 0"));
   }
 };
 
@@ -78,6 +91,13 @@ double StoppingDistance(const SsmParams& p, double v_r);
 /// S_p above for the person's speed v_h and the robot's speed v_r (m/s, >= 0).
 double ProtectiveSeparationDistance(const SsmParams& p, double v_h, double v_r);
 
+/// ISO/TS 15066's speed-reduction side: the largest fraction s in [0, 1] of
+/// the robot's speed v_r (towards the person, m/s, >= 0) at which a
+/// separation d (m) keeps d >= S_p(v_h, s v_r): 1 when d >= S_p(v_h, v_r)
+/// already, 0 when even a robot at rest is inside (d < S_p(v_h, 0): only a
+/// stop, or moving away, helps).
+double SpeedScaleFor(const SsmParams& p, double d, double v_h, double v_r);
+
 /// One robot / human sphere pair as the monitor judges it and the planner
 /// predicts it (the same rule for both, so that a plan the planner accepts
 /// is one the monitor lets run).
@@ -88,7 +108,13 @@ struct SsmPair {
   double protective_separation = 0;  ///< m, S_p(v_h, v_r)
   double margin = 0;      ///< m, d - S_p; < 0 is inside S_p
   bool retreating = false;  ///< inside S_p, but the robot sphere moves away at retreat_speed or faster
-  /// Inside S_p and not retreating: the monitor stops the robot.
+  /// Speed reduction (SsmParams::speed_reduction): the fraction of the
+  /// robot sphere's speed at which d - v_r speed_reduction_time >= S_p, and
+  /// at which d >= S_p (SpeedScaleFor); 1 for a retreat.
+  double slow_scale = 1.0;
+  double stop_scale = 1.0;
+  /// Inside S_p and not retreating: the robot must not go on at its speed
+  /// (it is slowed down, or stopped when even min_speed_scale is too fast).
   bool violates() const { return margin < 0 && !retreating; }
 };
 

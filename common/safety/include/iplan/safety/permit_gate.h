@@ -77,6 +77,10 @@ struct PermitDecision {
   /// Why not (every missing, lapsed or refusing monitor, "; "-separated), or
   /// what the permission rests on.
   std::string reason;
+  /// While permitted: the fraction of its trajectory's speed the robot may
+  /// run at, 1 minus the largest speed_reduction of the permits held (ISO/TS
+  /// 15066 speed reduction); 1 when no monitor asks to slow down.
+  double speed_scale = 1.0;
 };
 
 /// Two writers claiming one monitor: raised when the second one is heard,
@@ -105,10 +109,13 @@ class PermitGate {
   /// positive), else nullopt. A refused sample changes nothing except that
   /// its writer counts as claiming `monitor` (a configured one). A stop is
   /// never refused for being older: it can only stop, and lapses by its stamp.
+  /// `speed_reduction` (a permit's, in [0, 1]; refused outside): by how
+  /// much the robot must slow down while this permit holds.
   /// Allocates only when a writer or stop is new; keeps at most 16 writers
   /// and 16 stops per monitor.
   std::optional<std::string> OnPermit(const std::string& monitor, uint64_t writer, bool permit, double validity_s,
-                                      const std::string& reason, int64_t stamp_ns, int64_t now_ns);
+                                      const std::string& reason, int64_t stamp_ns, int64_t now_ns,
+                                      double speed_reduction = 0.0);
   /// The decision at `now_ns`.
   PermitDecision Evaluate(int64_t now_ns) const;
   /// Writer conflicts that began or ended since the last call, judged at
@@ -123,6 +130,7 @@ class PermitGate {
     bool valid = false;  // a sample was accepted from this writer
     bool permit = false;
     std::string reason;
+    double speed_reduction = 0.0;
     int64_t stamp_ns = 0;
     int64_t expires_ns = 0;
   };
