@@ -64,4 +64,9 @@ echo "setup: installing the web part's npm packages (web/package-lock.json)"
 jobs="${IPLAN_JOBS:-$(nproc)}"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
 cmake --build build -j "$jobs"
+# The cell's DDS Security keystore (CA, governance, one enclave per service):
+# made once per user, never overwritten; `iplan demo` runs secured with it.
+# Built beside its folder and renamed into place, so an interrupted setup
+# never leaves a half keystore (docs/deployment.md, "DDS Security").
+./build/bin/iplan security ensure-keystore
 echo "setup: done; executables in build/bin/"

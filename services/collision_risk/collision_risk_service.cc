@@ -1,7 +1,7 @@
 // iplan-collision-risk: the independent watchdog on the executing trajectory.
 // Evaluates the collision bound against every human prediction and ISO/TS
 // 15066 separation monitoring, publishes /iplan/collision_risk, and with
-// every evaluation its own permit to move (/iplan/safety/permit): the robot
+// every evaluation its own permit to move (/iplan/safety/permit/collision_risk): the robot
 // obeys it independently of the supervisor, so the robot stops when this
 // service stops evaluating, whatever happens to the supervisor.
 #include <chrono>
@@ -38,7 +38,7 @@ class CollisionRiskService : public framework::Service {
       return Result::Fail(e.what());
     }
     writer_ = &node.Advertise(framework::topics::CollisionRisk());
-    permit_writer_ = &node.Advertise(framework::topics::SafetyPermit());
+    permit_writer_ = &node.Advertise(framework::topics::CollisionRiskPermit());
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
                    std::function<void(const msg::JointState&, SI)>([this, &node](const msg::JointState& m, SI) {

@@ -1,7 +1,7 @@
 // iplan-robot-sim: a simulated robot for the demo cell and the tests.
 // Follows /iplan/robot/trajectory, publishes /joint_states, moves only while
 // it holds a fresh permit from every configured monitor
-// (/iplan/safety/permit, iplan/safety/permit_gate.h), and counts true
+// (/iplan/safety/permit/<monitor>, iplan/safety/permit_gate.h), and counts true
 // contacts with the simulated person's true body (/iplan/sim/human_truth).
 // Publishes world -> robot base on /tf_static for RViz and Foxglove.
 #include <chrono>
@@ -54,17 +54,24 @@ class RobotSimService : public framework::Service {
                      node.CountRejection("trajectory", sim_->SetTrajectory(services::TrajectoryStartNs(m, info.reception_ns),
                                                                            m.joint_names, times, pos));
                    }));
-    // Permits count only from the configured monitors' writers; the writer's
+    // Each monitor's permits come on its own topic, from its own writer
+    // only (with DDS Security: its enclave alone may publish there), so the
+    // topic names the monitor, whatever the sample claims. The writer's
     // identity (info.writer_id) lets the gate hold a stop against another
     // writer's permits and catch two writers claiming one monitor.
-    auto permit_topic = framework::topics::SafetyPermit();
-    permit_topic.writers = permits.monitors;
-    node.Subscribe(permit_topic,
-                   std::function<void(const msg::SafetyPermit&, SI)>([this, &node](const msg::SafetyPermit& m, SI info) {
-                     node.CountRejection("permit", gate_->OnPermit(info.writer_name, info.writer_id, m.state == msg::SafetyPermit::PERMIT,
-                                                                   m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
-                                                                   msg::ToNanoseconds(msg::Now()), m.speed_reduction));
-                   }));
+    for (const std::string& monitor : permits.monitors) {
+      framework::Topic<msg::SafetyPermit> topic;
+      try {
+        topic = framework::topics::SafetyPermit(monitor);
+      } catch (const std::exception& e) {
+        return Result::Fail(std::string("permits.monitors: ") + e.what());
+      }
+      node.Subscribe(topic, std::function<void(const msg::SafetyPermit&, SI)>([this, &node, monitor](const msg::SafetyPermit& m, SI info) {
+                       node.CountRejection("permit", gate_->OnPermit(monitor, info.writer_id, m.state == msg::SafetyPermit::PERMIT,
+                                                                     m.validity, m.reason, msg::ToNanoseconds(m.header.stamp),
+                                                                     msg::ToNanoseconds(msg::Now()), m.speed_reduction));
+                     }));
+    }
     // A monitor that vanishes (crash, freeze, network) sends no more permits:
     // its last one lapses within its validity, which is shorter than the
     // liveliness lease. Liveliness events are not used: they do not say

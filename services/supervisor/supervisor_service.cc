@@ -1,7 +1,7 @@
 // iplan-supervisor: the task planner (MDP + Q-learning, METHOD 6) and the
 // cell's deadline / liveliness monitor. It issues task commands to the
 // trajectory optimiser, learns from their outcomes and the predicted human
-// action, and withholds its permit to move (/iplan/safety/permit, asserted
+// action, and withholds its permit to move (/iplan/safety/permit/supervisor, asserted
 // every permit period, not only on change) whenever an input is late, gone
 // or unusable or the collision-risk verdict says stop, granting it again
 // when all is healthy. While a task runs its command is re-sent every
@@ -34,6 +34,7 @@ class SupervisorService : public framework::Service {
     }
     QLearningParams q = settings.learning;
     q.learning = settings.mode == "learning";
+    deployment_ = settings.mode == "deployment";
     const std::vector<std::string>& watched = settings.watch;
     const std::string graph_file = settings.task_graph;
     const double resume_delay = settings.resume_delay;
@@ -57,7 +58,7 @@ class SupervisorService : public framework::Service {
     // reuses the id of a task the optimiser already finished.
     task_id_ = static_cast<uint32_t>((msg::ToNanoseconds(msg::Now()) / 1000000) % 2000000000);
     command_writer_ = &node.Advertise(framework::topics::TaskCommand());
-    permit_writer_ = &node.Advertise(framework::topics::SafetyPermit());
+    permit_writer_ = &node.Advertise(framework::topics::SupervisorPermit());
     using SI = const dds::SampleInfo&;
     // Watched topics: any accepted sample is a sign of life; deadline and
     // liveliness events come through OnReaderEvent.
@@ -100,6 +101,10 @@ class SupervisorService : public framework::Service {
     node.CancelTimer(timer_);
     return Result::Ok();
   }
+
+  // A deployed cell's safety authority never runs unauthenticated by
+  // accident: its permit must be its own (docs/safety.md, "Threat model").
+  std::string SecurityRequiredBy() const override { return deployment_ ? "supervisor.mode is deployment" : ""; }
 
  private:
   template <class T>
@@ -228,6 +233,7 @@ class SupervisorService : public framework::Service {
   double pause_ = 0.5;
   int max_episodes_ = 0;
   dds::Writer<msg::TaskCommand>* command_writer_ = nullptr;
+  bool deployment_ = false;  // supervisor.mode deployment: needs DDS Security
   dds::Writer<msg::SafetyPermit>* permit_writer_ = nullptr;
   double permit_period_ = 0.05, permit_validity_ = 0.2, resend_period_ = 1.0;  // s
   std::vector<std::pair<std::string, double>> deadlines_;  // watched topic, s

@@ -63,9 +63,7 @@ class TrajoptService : public framework::Service {
                    }));
     // The supervisor's permit tells whether the cell is stopped (its stop
     // covers the collision-risk verdict too): stop time counts as delay.
-    auto permits = framework::topics::SafetyPermit();
-    permits.writers = {"iplan-supervisor"};
-    node.Subscribe(permits, std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
+    node.Subscribe(framework::topics::SupervisorPermit(), std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
                      replanner_->SetRobotStopped(m.state == msg::SafetyPermit::STOP);
                    }));
     node.Subscribe(framework::topics::TaskCommand(),

@@ -27,6 +27,26 @@ for svc in perception collision_risk trajopt robot_sim supervisor; do
     echo "FAIL $svc refuses its installed configuration: $out"; failures=$((failures+1))
   fi
 done
+# Secure by default: every unit starts its service with --require-security,
+# which refuses to run without a keystore (exit 2, the reason said) unless
+# IPLAN_INSECURE=1 says it is meant.
+for unit in "$units"/iplan-*.service; do
+  grep -q '^ExecStart=.* --require-security ' "$unit" || { echo "FAIL $(basename "$unit") does not require DDS Security"; failures=$((failures+1)); }
+done
+set +e
+out="$("$prefix/bin/iplan-trajopt" --require-security --config "$IPLAN_CONFIG_DIR/trajopt.yaml" --check-config 2>&1)"; rc=$?
+set -e
+if [ "$rc" -eq 2 ] && grep -q "refusing to start without DDS Security" <<<"$out"; then
+  echo "ok   a unit's service without a keystore refuses to start (exit 2, says why)"
+else
+  echo "FAIL unsecured unit: exit $rc: $out"; failures=$((failures+1))
+fi
+if out="$(IPLAN_INSECURE=1 "$prefix/bin/iplan-trajopt" --require-security --config "$IPLAN_CONFIG_DIR/trajopt.yaml" --check-config 2>&1)" \
+    && grep -q "DDS Security is off on purpose" <<<"$out"; then
+  echo "ok   IPLAN_INSECURE=1 runs it unsecured on purpose, and says so"
+else
+  echo "FAIL IPLAN_INSECURE=1: $out"; failures=$((failures+1))
+fi
 set +e
 out="$("$prefix/bin/iplan-intent" --config "$IPLAN_CONFIG_DIR/intent.yaml" --check-config 2>&1)"; rc=$?
 set -e

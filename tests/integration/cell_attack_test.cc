@@ -60,7 +60,7 @@ class AttackRun {
       : vendor_(v.vendor),
         cell("cell-attack-" + v.name, v.vendor, 91),
         rogue_("rogue", v.vendor, cell.domain()),
-        permit_w(rogue_.node->Advertise(framework::topics::SafetyPermit())),
+        permit_w(rogue_.node->Advertise(framework::topics::SupervisorPermit())),
         traj_w(rogue_.node->Advertise(framework::topics::RobotTrajectory())),
         risk_w(rogue_.node->Advertise(framework::topics::CollisionRisk())),
         cmd_w(rogue_.node->Advertise(framework::topics::TaskCommand())),
@@ -168,7 +168,7 @@ class AttackRun {
   }
   cell.SpinFor(1500ms);
   EXPECT_LT(cell.MaxSpeedSince(attack), 1e-3) << "the stranger moved the robot";
-  EXPECT_GT(cell.DiagNumber("robot_sim", "ignored_writers/rt/iplan/safety/permit"), 100);
+  EXPECT_GT(cell.DiagNumber("robot_sim", "ignored_writers/rt/iplan/safety/permit/supervisor"), 100);
   EXPECT_GT(cell.DiagNumber("robot_sim", "ignored_writers/rt/iplan/robot/trajectory"), 10);
   EXPECT_GT(cell.DiagNumber("supervisor", "ignored_writers/rt/iplan/collision_risk"), 500);
   EXPECT_FALSE(cell.Permits("supervisor")) << "the supervisor resumed on the stranger's verdicts";

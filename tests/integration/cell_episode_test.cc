@@ -1,11 +1,14 @@
 // The whole cell, as users start it: `iplan demo` runs every service as a
 // separate process on loopback DDS (the synthetic person, intent, collision
 // risk, trajectory optimisation, the robot simulator and the supervisor) for
-// one collaborative episode, on Cyclone DDS, on Fast DDS, and mixed (half the
-// services on each vendor). Every robot task completes, the robot never
-// touches the person's true body, and trajectories come with an end-to-end
-// latency. The intent model is trained from the synthetic person on the first
-// run (cached in config/models).
+// one collaborative episode: with no flags (Cyclone DDS, secured with DDS
+// Security, the user's keystore made on this first use), on Fast DDS
+// (secured), and mixed (half the services on each vendor, --insecure: a
+// secured --mixed is refused with its reason). Every robot task completes,
+// the robot never touches the person's true body, and trajectories come
+// with an end-to-end latency. The intent model is trained from the
+// synthetic person on the first run (cached in config/models). Each demo
+// gets an XDG_DATA_HOME of its own, so the user's keystore is the test's.
 //
 // However `iplan demo` ends (SIGINT, SIGKILL), it leaves no service of its
 // cell running behind it.
@@ -43,7 +46,7 @@ TEST_P(CellEpisode, TasksCompleteWithoutContact) {
                                    "--state-dir",     dir.string(),  "--domain",   std::to_string(UniqueDomain(31)),
                                    "--config-dir",    std::string(IPLAN_SOURCE_DIR) + "/config"};
   argv.insert(argv.end(), GetParam().args.begin(), GetParam().args.end());
-  Process demo(argv);
+  Process demo(argv, {{"XDG_DATA_HOME", dir.string()}, {"IPLAN_SECURITY", ""}});
   const auto rc = demo.Wait(200s);
   ASSERT_TRUE(rc.has_value()) << "demo did not finish\n" << demo.Stdout();
   EXPECT_EQ(*rc, 0) << demo.Stdout() << demo.Stderr();
@@ -63,7 +66,35 @@ TEST_P(CellEpisode, TasksCompleteWithoutContact) {
   if (GetParam().name == "mixed") {
     EXPECT_NE(j["vendors"]["intent"], j["vendors"]["perception"]);
     EXPECT_NE(j["vendors"]["trajopt"], j["vendors"]["supervisor"]);
+    EXPECT_EQ(j["security"]["secured"], false);
+    EXPECT_NE(demo.Stdout().find("no DDS Security (--insecure)"), std::string::npos) << demo.Stdout();
+  } else {
+    // Secured by default, with the keystore made on this first use.
+    const std::string keystore = (dir / "iplan/keystore").string();
+    EXPECT_EQ(j["security"]["secured"], true);
+    EXPECT_EQ(j["security"]["keystore"], keystore);
+    EXPECT_NE(demo.Stdout().find("keystore " + keystore + ", this user's, created now"), std::string::npos)
+        << demo.Stdout();
+    EXPECT_TRUE(std::filesystem::is_regular_file(keystore + "/enclaves/iplan-supervisor/key.pem"));
   }
+  std::filesystem::remove_all(dir);
+}
+
+// A secured cell over both vendors cannot authenticate (Debian's Fast DDS 2.9
+// and Cyclone DDS 0.10): `iplan demo --mixed` says so and starts nothing.
+TEST(CellEpisodeMixed, SecuredIsRefusedWithItsReason) {
+  const auto dir = std::filesystem::temp_directory_path() / ("iplan-mixed-refused-" + std::to_string(getpid()));
+  Process demo({BinPath("iplan"), "demo", "--mixed", "--state-dir", dir.string(), "--config-dir",
+                std::string(IPLAN_SOURCE_DIR) + "/config"},
+               {{"XDG_DATA_HOME", dir.string()}, {"IPLAN_SECURITY", ""}});
+  EXPECT_EQ(demo.Wait(30s), 2);
+  EXPECT_NE(demo.Stderr().find("iplan demo: refused: --mixed runs secured only where both DDS vendors can "
+                               "authenticate each other"),
+            std::string::npos)
+      << demo.Stderr();
+  EXPECT_NE(demo.Stderr().find("Failed to convert octet sequence to ASN1 integer"), std::string::npos);
+  EXPECT_NE(demo.Stderr().find("iplan demo --mixed --insecure"), std::string::npos);
+  EXPECT_EQ(demo.Stdout().find("services:"), std::string::npos) << "services were started:\n" << demo.Stdout();
   std::filesystem::remove_all(dir);
 }
 
@@ -100,7 +131,8 @@ TEST_P(DemoEnds, NoServiceOutlivesTheDemo) {
   const auto dir = std::filesystem::temp_directory_path() / ("iplan-demo-ends-" + std::to_string(getpid()));
   std::filesystem::remove_all(dir);
   Process demo({BinPath("iplan"), "demo", "--episodes", "20", "--timeout", "300", "--state-dir", dir.string(),
-                "--domain", std::to_string(domain), "--config-dir", std::string(IPLAN_SOURCE_DIR) + "/config"});
+                "--domain", std::to_string(domain), "--config-dir", std::string(IPLAN_SOURCE_DIR) + "/config"},
+               {{"XDG_DATA_HOME", dir.string()}, {"IPLAN_SECURITY", ""}});
   ASSERT_TRUE(demo.WaitForOutput("episodes: 20", 120s)) << demo.Stdout() << demo.Stderr();
   // Every service is up (each announces itself by its diagnostics soon after).
   std::this_thread::sleep_for(2s);
@@ -120,9 +152,8 @@ INSTANTIATE_TEST_SUITE_P(Signals, DemoEnds, ::testing::Values(SIGINT, SIGKILL),
                          [](const auto& info) { return info.param == SIGKILL ? "sigkill" : "sigint"; });
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellEpisode,
-                         ::testing::Values(Variant{"cyclonedds", {"--dds", "cyclonedds"}},
-                                           Variant{"fastdds", {"--dds", "fastdds"}},
-                                           Variant{"mixed", {"--dds", "cyclonedds", "--mixed"}}),
+                         ::testing::Values(Variant{"default", {}}, Variant{"fastdds", {"--dds", "fastdds"}},
+                                           Variant{"mixed", {"--dds", "cyclonedds", "--mixed", "--insecure"}}),
                          [](const auto& info) { return info.param.name; });
 
 }  // namespace

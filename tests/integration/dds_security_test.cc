@@ -6,7 +6,8 @@
 //    they read no skeleton, and robot-sim accepts none of their trajectories
 //    and permits (its counters stay at zero: nothing even matches);
 //  - a credentialed participant whose permissions do not grant the topic
-//    (perception's enclave publishing a trajectory): its writer is refused;
+//    (perception's enclave publishing a trajectory, the supervisor's
+//    publishing collision risk's permit): its writer is refused;
 //  - entitled, credentialed participants: the observer reads skeletons and
 //    diagnostics, iplan-trajopt's enclave publishes a trajectory and
 //    iplan-supervisor's a permit, and robot-sim accepts both.
@@ -19,6 +20,7 @@
 #include <sys/stat.h>
 
 #include <filesystem>
+#include <map>
 #include <fstream>
 #include <thread>
 
@@ -157,6 +159,63 @@ TEST(SecurityKeystore, EveryServiceConfiguresWithItsEnclaveOnBothVendors) {
   EXPECT_NE(p.Stderr().find("is for CN=iplan-perception, not CN=iplan-trajopt"), std::string::npos) << p.Stderr();
 }
 
+// Secure by default: a service without a keystore says so; with
+// --require-security (what the units pass) or as a supervisor in deployment
+// mode it refuses to start (exit code 2, the reason said) unless --insecure
+// or IPLAN_INSECURE=1 says it is meant; --insecure with a keystore is a
+// contradiction.
+TEST(SecurityMode, ServicesRefuseToRunUnsecuredUnlessToldSo) {
+  const std::string domain = std::to_string(UniqueDomain(122));
+  const std::map<std::string, std::string> no_env = {{"IPLAN_SECURITY", ""}, {"IPLAN_INSECURE", ""}};
+  Process unit({BinPath("iplan-robot-sim"), "--require-security", "--check-config", "--domain", domain}, no_env);
+  EXPECT_EQ(unit.Wait(30s), 2);
+  EXPECT_NE(unit.Stderr().find("refusing to start without DDS Security (--require-security"), std::string::npos)
+      << unit.Stderr();
+  const std::string q_table = "supervisor.q_table=" + (Keystores::Dir() / "q.bin").string();
+  Process deployed({BinPath("iplan-supervisor"), "--set", "supervisor.mode=deployment", "--set", q_table,
+                    "--check-config", "--domain", domain},
+                   no_env);
+  EXPECT_EQ(deployed.Wait(30s), 2);
+  EXPECT_NE(deployed.Stderr().find("refusing to start without DDS Security (supervisor.mode is deployment)"),
+            std::string::npos)
+      << deployed.Stderr();
+  auto env = no_env;
+  env["IPLAN_INSECURE"] = "1";
+  Process meant({BinPath("iplan-supervisor"), "--set", "supervisor.mode=deployment", "--set", q_table,
+                 "--require-security", "--check-config", "--domain", domain},
+                env);
+  EXPECT_EQ(meant.Wait(30s), 0) << meant.Stderr();
+  EXPECT_NE(meant.Stderr().find("DDS Security is off on purpose (--insecure)"), std::string::npos) << meant.Stderr();
+  Process secured({BinPath("iplan-supervisor"), "--set", "supervisor.mode=deployment", "--set", q_table,
+                   "--require-security", "--check-config", "--domain", domain, "--security", Keystores::Cell()},
+                  no_env);
+  EXPECT_EQ(secured.Wait(60s), 0) << secured.Stderr();
+  Process both({BinPath("iplan-robot-sim"), "--insecure", "--security", Keystores::Cell(), "--check-config"}, no_env);
+  EXPECT_EQ(both.Wait(30s), 2);
+  EXPECT_NE(both.Stderr().find("contradicts the DDS Security keystore"), std::string::npos) << both.Stderr();
+}
+
+// A Cyclone DDS service and a Fast DDS client of one secured cell cannot
+// authenticate (Debian's builds): the service says so, with the reason, once.
+TEST(MixedVendors, ACycloneServiceExplainsTheFailedFastDdsHandshake) {
+  const std::string domain = std::to_string(UniqueDomain(123));
+  Process svc({BinPath("iplan-perception"), "--dds", "cyclonedds", "--domain", domain, "--security", Keystores::Cell()});
+  Process client({BinPath("iplan"), "topic", "echo", "/iplan/human/skeleton", "-n", "1", "--timeout", "20", "--dds",
+                  "fastdds", "--domain", domain, "--security", Keystores::Cell()});
+  const std::string expected = "iplan: the DDS Security handshake above failed the way Debian's Fast DDS 2.9 and "
+                               "Cyclone DDS 0.10 fail with each other";
+  const auto end = Clock::now() + 20s;
+  while (svc.Stderr().find(expected) == std::string::npos && Clock::now() < end) std::this_thread::sleep_for(100ms);
+  client.Signal(SIGTERM);
+  svc.Signal(SIGTERM);
+  EXPECT_EQ(svc.Wait(15s), 0);
+  const std::string log = svc.Stderr();
+  EXPECT_NE(log.find("ASN1 integer"), std::string::npos) << log;
+  const auto first = log.find(expected);
+  EXPECT_NE(first, std::string::npos) << log;
+  EXPECT_EQ(log.find(expected, first + 1), std::string::npos) << "explained more than once:\n" << log;
+}
+
 struct Variant {
   std::string name;
   std::string services;  ///< vendor of the services
@@ -275,7 +334,7 @@ TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
       << "skeletons " << obs.skeletons << ", robot-sim diagnostics " << obs.robot_diagnostics << "\n"
       << services_[0]->Stderr() << services_[1]->Stderr();
   const std::string traj_topic = framework::topics::RobotTrajectory().name;
-  const std::string permit_topic = framework::topics::SafetyPermit().name;
+  const std::string permit_topic = framework::topics::SupervisorPermit().name;
   EXPECT_EQ(obs.Robot("received/" + traj_topic), 0);
   EXPECT_EQ(obs.Robot("received/" + permit_topic), 0);
 
@@ -289,8 +348,12 @@ TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
   auto bare_permit = Publish(permit_topic, PermitJson(), "", "");
   auto other_traj = Publish(traj_topic, TrajectoryJson(), Keystores::Other(), "iplan-trajopt");
   auto other_permit = Publish(permit_topic, PermitJson(), Keystores::Other(), "iplan-supervisor");
-  // Credentialed but not granted: perception may not publish trajectories.
+  // Credentialed but not granted: perception may not publish trajectories,
+  // nor the supervisor collision risk's permits (a permit's topic is its
+  // monitor's authenticated identity).
   auto ungranted = Publish(traj_topic, TrajectoryJson(), Keystores::Cell(), "iplan-perception");
+  const std::string risk_permit = framework::topics::CollisionRiskPermit().name;
+  auto other_monitor = Publish(risk_permit, PermitJson(), Keystores::Cell(), "iplan-supervisor");
   EXPECT_EQ(bare_echo->Wait(30s), 1) << bare_echo->Stdout().substr(0, 300);
   EXPECT_EQ(bare_echo->Stdout(), "");
   EXPECT_EQ(other_echo->Wait(30s), 1) << other_echo->Stdout().substr(0, 300);
@@ -300,6 +363,8 @@ TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
   }
   EXPECT_NE(ungranted->Wait(30s), 0);
   EXPECT_NE(ungranted->Stderr().find(traj_topic), std::string::npos) << ungranted->Stderr();
+  EXPECT_NE(other_monitor->Wait(30s), 0);
+  EXPECT_NE(other_monitor->Stderr().find(risk_permit), std::string::npos) << other_monitor->Stderr();
   // Two more diagnostics periods: robot-sim received nothing and ignored
   // nobody (no stranger's writer ever matched its readers).
   const int seen = obs.robot_diagnostics;

@@ -336,7 +336,7 @@ BoxRun RunBox(const collision::SceneObject& box) {
   TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain);
   framework::Node& node = *tc.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
-  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit("test_cell"));
   BoxRun run;
   const auto t_start = Clock::now();
   auto since = [t_start] { return std::chrono::duration<double>(Clock::now() - t_start).count(); };

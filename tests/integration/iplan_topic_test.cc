@@ -84,9 +84,9 @@ TEST_F(IplanTopic, UnknownTopicWithoutTypeIsAClearError) {
 }
 
 TEST_F(IplanTopic, PubDeliversAMessageToEcho) {
-  auto echo = Tool({"topic", "echo", "/iplan/safety/permit", "-n", "1", "--timeout", "20"});
+  auto echo = Tool({"topic", "echo", "/iplan/safety/permit/supervisor", "-n", "1", "--timeout", "20"});
   std::this_thread::sleep_for(1s);
-  auto pub = Tool({"topic", "pub", "/iplan/safety/permit",
+  auto pub = Tool({"topic", "pub", "/iplan/safety/permit/supervisor",
                    R"({"state": 0, "validity": 0.2, "source": "test", "reason": "operator", "seq": 7})", "--stamp-now"});
   ASSERT_EQ(pub->Wait(30s), 0) << pub->Stderr();
   ASSERT_EQ(echo->Wait(30s), 0) << echo->Stderr();
@@ -94,7 +94,7 @@ TEST_F(IplanTopic, PubDeliversAMessageToEcho) {
   EXPECT_EQ(j["seq"], 7);
   EXPECT_EQ(j["reason"], "operator");
   EXPECT_GT(j["header"]["stamp"]["sec"].get<int>(), 1700000000);
-  auto bad = Tool({"topic", "pub", "/iplan/safety/permit", R"({"stat": 0})"});
+  auto bad = Tool({"topic", "pub", "/iplan/safety/permit/supervisor", R"({"stat": 0})"});
   ASSERT_EQ(bad->Wait(30s), 1);
   EXPECT_NE(bad->Stderr().find("unknown field 'stat'"), std::string::npos) << bad->Stderr();
 }

@@ -189,7 +189,7 @@ constexpr double kPermitValidity = 0.2;  // s, a permit's validity at the robot 
 constexpr double kStoppingTime = 0.3;    // s, robot_sim.stopping_time
 constexpr double kJointDeadline = 0.1;   // s, /joint_states deadline at the supervisor
 constexpr double kSlack = 0.25;          // s, scheduling on a loaded 2-core machine, 20 ms joint-state period
-constexpr auto kCut = 12s;               // well past Cyclone's 3 s participant lease: peers expire and are rediscovered
+constexpr auto kCut = 12s;               // long against every deadline and liveliness lease; within the 20 s participant lease
 
 // Cable out while the arm moves; returns the robot's rest latency, s.
 double CutTheRobotHost(MultiHostCell& mh, const Process& echo) {

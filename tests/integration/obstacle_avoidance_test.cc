@@ -58,7 +58,7 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   TestNode cloud("iplan-cloud", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
-  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit("test_cell"));
   auto& obstacles = cloud.node->Advertise(framework::topics::Obstacles());
   Episode e;
   bool started = false;

@@ -144,7 +144,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool
   framework::Node& node = *cell.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
   auto& rogue_cmd = stranger.node->Advertise(framework::topics::TaskCommand());
-  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit("test_cell"));
   auto& pred = node.Advertise(framework::topics::HumanPrediction());
   auto& truth = node.Advertise(framework::topics::HumanTruth());
   Result r;

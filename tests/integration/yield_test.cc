@@ -167,7 +167,7 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
   TestNode perception("iplan-perception", dds::Vendor::kCyclone, domain);
   TestNode intent("iplan-intent", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
-  auto& permit = node.Advertise(framework::topics::SafetyPermit());
+  auto& permit = node.Advertise(framework::topics::SafetyPermit("test_cell"));
   auto& skeleton = perception.node->Advertise(framework::topics::HumanSkeleton());
   auto& prediction = intent.node->Advertise(framework::topics::HumanPrediction());
   Observed seen(node);

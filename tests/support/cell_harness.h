@@ -50,7 +50,10 @@ class CellHarness {
   };
 
   /// With a DDS Security keystore `security_dir` every service starts with
-  /// --security and the observer uses enclave iplan-observer.
+  /// --security and the observer uses enclave iplan-observer; without one
+  /// every service starts with --insecure (unsecured on purpose). Either
+  /// way the processes get IPLAN_SECURITY set to it (or emptied), so the
+  /// environment the test runs in cannot change the cell.
   CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset, const std::string& security_dir = "")
       : vendor_(vendor), domain_(UniqueDomain(domain_offset)), security_(security_dir) {
     dir_ = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
@@ -80,11 +83,12 @@ class CellHarness {
                      positions_ = m.position;
                    }),
                    any_order);
-    node.Subscribe(framework::topics::SafetyPermit(),
-                   std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI info) {
-                     permits_.push_back({Clock::now(), m, info.writer_name});
-                   }),
-                   any_order);
+    for (const auto& topic : {framework::topics::SupervisorPermit(), framework::topics::CollisionRiskPermit()}) {
+      node.Subscribe(topic, std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI info) {
+                       permits_.push_back({Clock::now(), m, info.writer_name});
+                     }),
+                     any_order);
+    }
     node.Subscribe(framework::topics::TaskOutcome(),
                    std::function<void(const msg::TaskOutcome&, SI)>([this](const msg::TaskOutcome& m, SI) {
                      outcomes_.push_back(m);
@@ -119,6 +123,9 @@ class CellHarness {
   }
 
   bool ready() const { return observer_ != nullptr; }
+  dds::Vendor vendor() const { return vendor_; }
+  /// The keystore the cell runs with ("" when unsecured).
+  const std::string& security() const { return security_; }
   framework::Node& node() { return *observer_->node; }
   int domain() const { return domain_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
@@ -142,6 +149,7 @@ class CellHarness {
     std::vector<std::string> argv = launchers_[svc];
     argv.insert(argv.end(), {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml", "--dds",
                              dds::ToString(vendor), "--domain", std::to_string(domain_)});
+    if (security_.empty()) argv.push_back("--insecure");
     if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
     if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
     if (svc == "perception") {
@@ -151,8 +159,8 @@ class CellHarness {
       argv.insert(argv.end(), {"--set", "supervisor.q_table=" + q_table(), "--set", "supervisor.pause_between_tasks=0.2"});
     }
     argv.insert(argv.end(), extra.begin(), extra.end());
-    procs_[svc] = std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false,
-                                            (dir_ / (svc + "-" + std::to_string(++starts_))).string());
+    procs_[svc] = std::make_unique<Process>(argv, std::map<std::string, std::string>{{"IPLAN_SECURITY", security_}},
+                                            false, (dir_ / (svc + "-" + std::to_string(++starts_))).string());
   }
   void StartAll() {
     for (const auto& s : Services()) Start(s);

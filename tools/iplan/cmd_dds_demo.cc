@@ -25,7 +25,9 @@
 #include "supervisor/core/task_planner.h"
 #include "dds_cell_model.h"
 #include "dds_common.h"
+#include "dds_demo_security.h"
 #include "dds_viewer_common.h"
+#include "demo_monitor.h"
 #include "iplan/core/process.h"
 #include "iplan/core/stats.h"
 #include "iplan/framework/config.h"
@@ -49,7 +51,8 @@ struct DemoOptions {
   double timeout = 170;
   std::string summary_file, config_dir, state_dir;
   std::string record_file;  ///< MCAP recording of the run (iplan record); empty: none
-  bool keep_learning = false, retrain = false, prepare_only = false;
+  bool keep_learning = false, retrain = false, prepare_only = false, insecure = false;
+  std::string security;  ///< --security DIR (dds_demo_security.h)
   /// What the planner and monitor are given as the prediction: model,
   /// constant-position, constant-velocity (intent.predictor), or none (the
   /// planner ignores the person, trajopt.use_prediction false; collision
@@ -67,179 +70,6 @@ const std::vector<std::pair<std::string, std::string>> kServices = {
 // --sensor depth adds the cloud service (after perception, its source).
 const std::pair<std::string, std::string> kCloudService = {"cloud", "cloud"};
 
-struct Episode {
-  int number = 0;
-  double start = -1, end = -1;  // s since the demo started
-  int succeeded = 0, failed = 0;
-  double waiting = 0;            // s, sum of the tasks' delays
-  std::vector<std::string> order;
-  bool done = false;
-  double completion() const { return end - start; }
-};
-
-std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-class CellMonitor {
- public:
-  CellMonitor(framework::Node& node, int num_tasks, Clock::time_point t0) : num_tasks_(num_tasks), t0_(t0) {
-    using SI = const dds::SampleInfo&;
-    namespace topics = framework::topics;
-    const framework::SubscribeOptions any_order{false};
-    node.Subscribe(topics::TaskCommand(), std::function<void(const msg::TaskCommand&, SI)>(
-                                              [this](const msg::TaskCommand& m, SI) { OnCommand(m); }),
-                   any_order);
-    node.Subscribe(topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>(
-                                              [this](const msg::TaskOutcome& m, SI) { OnOutcome(m); }),
-                   any_order);
-    node.Subscribe(topics::PlanStatus(), std::function<void(const msg::PlanStatus&, SI)>([this](const msg::PlanStatus& m, SI) {
-                     if (m.latency > 0) {
-                       latency_ms_.push_back(1e3 * m.latency);
-                       intent_ms_.push_back(1e3 * m.intent_latency);
-                       queue_ms_.push_back(1e3 * m.queue_latency);
-                       planning_ms_.push_back(1e3 * m.planning_time);
-                     }
-                     waiting_ = m.waiting;
-                     max_plan_bound_ = std::max(max_plan_bound_, m.max_bound);
-                   }));
-    node.Subscribe(topics::CollisionRisk(),
-                   std::function<void(const msg::CollisionRisk&, SI)>([this](const msg::CollisionRisk& m, SI) {
-                     max_bound_ = std::max(max_bound_, m.max_bound);
-                     const bool slowed = m.verdict == msg::CollisionRisk::SLOW_DOWN && m.speed_scale < 1.0;
-                     if (std::exchange(slowed_, slowed) != slowed && slowed) ++slow_downs_;  // speed reduction
-                     separation_ = m.min_separation;
-                     min_observed_separation_ = std::min(min_observed_separation_, m.min_separation);
-                   }));
-    // The robot is stopped while any monitor withholds its permit; a stop
-    // is counted when the first one does.
-    node.Subscribe(topics::SafetyPermit(),
-                   std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
-                     const bool was_stopped = stopped_;
-                     permit_stops_[m.source] = m.state == msg::SafetyPermit::STOP;
-                     stopped_ = std::any_of(permit_stops_.begin(), permit_stops_.end(), [](const auto& p) { return p.second; });
-                     if (stopped_ && !was_stopped) {
-                       ++stops_;
-                       stop_reasons_.push_back(m.source + ": " + m.reason);
-                       stop_since_ = Now();
-                     }
-                     if (!stopped_ && was_stopped) stop_time_s_ += Now() - stop_since_;
-                   }),
-                   any_order);
-    node.Subscribe(topics::Diagnostics(),
-                   std::function<void(const msg::DiagnosticArray& a, SI)>([this](const msg::DiagnosticArray& a, SI) {
-                     for (const auto& st : a.status) {
-                       for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
-                     }
-                   }),
-                   any_order);
-  }
-
-  double Now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
-  const std::map<int, Episode>& episodes() const { return episodes_; }
-  int completed_episodes() const {
-    return static_cast<int>(std::count_if(episodes_.begin(), episodes_.end(), [](const auto& e) { return e.second.done; }));
-  }
-  std::string Diag(const std::string& service, const std::string& key, const std::string& otherwise = "") const {
-    auto s = diag_.find(service);
-    if (s == diag_.end()) return otherwise;
-    auto k = s->second.find(key);
-    return k == s->second.end() ? otherwise : k->second;
-  }
-  double DiagNumber(const std::string& service, const std::string& key, double otherwise) const {
-    const std::string v = Diag(service, key);
-    try {
-      return v.empty() ? otherwise : std::stod(v);
-    } catch (...) {
-      return otherwise;
-    }
-  }
-
-  // The progress line.
-  std::string Progress(int total_episodes) const {
-    std::ostringstream s;
-    const int e = current_episode_;
-    s << "  [" << std::setw(4) << Fixed(Now(), 0) << " s] ";
-    if (e == 0) {
-      s << "waiting for the cell (supervisor: " << Diag("supervisor", "safety", "starting") << ")";
-    } else {
-      s << "episode " << e << "/" << total_episodes << ": " << (current_task_.empty() ? "-" : current_task_)
-        << (waiting_ ? " (waiting)" : "");
-    }
-    s << " | person: " << Diag("perception", "action", "?") << " | separation "
-      << (separation_ < 1e9 ? Fixed(separation_, 2) + " m" : "-") << " | bound " << Fixed(max_bound_, 3)
-      << " | stops " << stops_ << " | contacts " << Diag("robot_sim", "true_contacts", "0");
-    return s.str();
-  }
-
-  std::vector<std::string> TakeEvents() { return std::exchange(events_, {}); }
-
-  std::vector<double> latency_ms_;
-  // Its stages, per trajectory: skeleton to prediction (intent), prediction
-  // to the planning cycle's start (DDS and waiting), the cycle's planning.
-  std::vector<double> intent_ms_, queue_ms_, planning_ms_;
-  double max_bound_ = 0, max_plan_bound_ = 0;
-  double separation_ = 1e18, min_observed_separation_ = 1e18;
-  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0, slow_downs_ = 0;
-  bool slowed_ = false;  // the last verdict slowed the robot
-  double stop_since_ = 0, stop_time_s_ = 0;  // s since the demo started; s stopped (ended stops)
-  std::vector<std::string> stop_reasons_;
-
- private:
-  void OnCommand(const msg::TaskCommand& m) {
-    if (m.command != msg::TaskCommand::START || m.episode == 0) return;
-    const int e = static_cast<int>(m.episode);
-    if (task_episode_.count(m.task_id)) return;  // a re-sent command
-    task_episode_[m.task_id] = e;
-    Episode& ep = episodes_[e];
-    if (ep.start < 0) {
-      ep.number = e;
-      ep.start = Now();
-    }
-    current_episode_ = e;
-    current_task_ = m.task_name;
-  }
-  void OnOutcome(const msg::TaskOutcome& m) {
-    auto it = task_episode_.find(m.task_id);
-    if (it == task_episode_.end()) return;
-    Episode& ep = episodes_[it->second];
-    ep.waiting += m.delay;
-    if (m.status == msg::TaskOutcome::SUCCEEDED) {
-      ++ep.succeeded;
-      ++succeeded_tasks_;
-      ep.order.push_back(m.task_name);
-    } else {
-      ++ep.failed;
-      ++failed_tasks_;
-      events_.push_back("task '" + m.task_name + "' " + (m.status == msg::TaskOutcome::FAILED ? "failed" : "cancelled") +
-                        (m.reason.empty() ? "" : ": " + m.reason));
-    }
-    current_task_.clear();
-    if (!ep.done && ep.succeeded == num_tasks_) {
-      ep.done = true;
-      ep.end = Now();
-      std::ostringstream s;
-      s << "episode " << ep.number << " done in " << Fixed(ep.completion(), 1) << " s, robot waiting "
-        << Fixed(ep.waiting, 1) << " s:";
-      for (const auto& t : ep.order) s << " " << t;
-      events_.push_back(s.str());
-    }
-  }
-
-  int num_tasks_;
-  Clock::time_point t0_;
-  std::map<uint32_t, int> task_episode_;
-  std::map<int, Episode> episodes_;
-  int current_episode_ = 0;
-  std::string current_task_;
-  bool waiting_ = false, stopped_ = false;
-  std::map<std::string, bool> permit_stops_;  // per monitor: its last permit is a STOP
-  std::map<std::string, std::map<std::string, std::string>> diag_;
-  std::vector<std::string> events_;
-};
-
 // One run of the demo: the processes, their vendors and what came of it.
 class DemoRun {
  public:
@@ -254,11 +84,7 @@ class DemoRun {
   int Run() {
     if (const std::optional<int> rc = Prepare()) return *rc;
     if (const std::optional<int> rc = StartServices()) return *rc;
-    dds::ParticipantOptions popts;
-    popts.vendor = vendor_a_;
-    popts.domain_id = domain_;
-    popts.name = "iplan-demo";
-    auto participant = dds::Participant::Create(popts);
+    auto participant = dds::Participant::Create(security_->Participant(vendor_a_, domain_, "iplan-demo"));
     spdlog::set_level(spdlog::level::warn);  // the progress lines say what matters
     framework::NodeOptions nopts;
     nopts.diagnostics_period = 0;
@@ -309,6 +135,7 @@ class DemoRun {
     std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain_ << "\n"
               << "  configuration " << config_dir_ << "\n  state and service logs (<service>.err) " << state_dir_ << "\n";
     if (o_.predictor != "model") std::cout << "  predictor: " << o_.predictor << " (ablation)\n";
+    if (!o_.prepare_only && !(security_ = SecureDemoOrExplain(o_.insecure, o_.security, o_.mixed, domain_))) return 2;
     try {
       if (!fs::exists(fs::path(config_dir_) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir_);
       std::cout << "  intent model: checking ..." << std::flush;
@@ -332,6 +159,7 @@ class DemoRun {
   std::vector<std::string> ServiceArguments(const std::string& exe, const std::string& name) const {
     std::vector<std::string> argv = {core::ExecutableDir() + "/iplan-" + exe, "--config", Cfg(name), "--dds",
                                      dds::ToString(VendorOf(name)), "--domain", std::to_string(domain_)};
+    argv.insert(argv.end(), security_->service_args.begin(), security_->service_args.end());
     if (name == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_.path});
     if (name == "intent" && o_.predictor != "model" && o_.predictor != "none") {
       argv.insert(argv.end(), {"--set", "intent.predictor=" + o_.predictor});
@@ -354,7 +182,7 @@ class DemoRun {
   std::optional<int> StartServices() {
     if (!o_.record_file.empty()) {
       try {
-        recorder_ = StartRecorder(dds::ToString(vendor_a_), domain_, o_.record_file, config_dir_, state_dir_ + "/record");
+        recorder_ = StartRecorder(dds::ToString(vendor_a_), domain_, o_.record_file, config_dir_, state_dir_ + "/record", security_->env);
         std::cout << "  recording to " << o_.record_file << "\n";
       } catch (const std::exception& e) {
         std::cerr << "iplan demo: " << e.what() << "\n";
@@ -367,8 +195,8 @@ class DemoRun {
     if (o_.sensor == "depth") services_.insert(services_.begin() + 2, kCloudService);
     for (const auto& [exe, name] : services_) {
       try {
-        procs_.push_back(std::make_unique<core::Process>(ServiceArguments(exe, name), std::map<std::string, std::string>{},
-                                                         false, state_dir_ + "/" + name));
+        procs_.push_back(std::make_unique<core::Process>(ServiceArguments(exe, name), security_->env, false,
+                                                         state_dir_ + "/" + name));
       } catch (const std::exception& e) {
         std::cerr << "\niplan demo: cannot start iplan-" << exe << ": " << e.what() << "\n";
         return 1;
@@ -454,6 +282,7 @@ class DemoRun {
               << "  protective stops              " << mon.stops_ << " (" << Fixed(mon.stop_time_s_, 1) << " s, resume delays "
               << "included; the first is the safe start); slowed down instead " << mon.slow_downs_ << " times (robot slowed "
               << Fixed(mon.DiagNumber("robot_sim", "slowed_down_s", 0), 1) << " s, ISO/TS 15066 speed reduction)\n"
+              << "  security                      " << security_->summary << "\n"
               << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
               << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
               << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
@@ -510,6 +339,7 @@ class DemoRun {
     j["protective_stops"] = mon.stops_;
     j["protective_stop_time_s"] = mon.stop_time_s_;
     j["slow_downs"] = {{"count", mon.slow_downs_}, {"robot_slowed_s", mon.DiagNumber("robot_sim", "slowed_down_s", 0)}};
+    j["security"] = {{"secured", security_->secured}, {"keystore", security_->keystore}, {"summary", security_->summary}};
     j["true_contacts"] = contacts;
     j["latency_ms"] = {{"p50", lat.p50}, {"p99", lat.p99}, {"max", lat.max}, {"count", lat.count}};
     j["latency_stages_ms"] = {{"intent", {{"p50", intent_lat.p50}, {"p99", intent_lat.p99}}},
@@ -540,6 +370,7 @@ class DemoRun {
   const std::string config_dir_;
   std::string state_dir_;
   CellModelResult model_;
+  std::optional<DemoSecurity> security_;  // decided in Prepare (not for --prepare-only)
   supervisor::TaskGraph graph_;
   std::unique_ptr<core::Process> recorder_;
   Clock::time_point t0_;
@@ -557,11 +388,12 @@ void Register(CLI::App& app) {
   static DemoOptions o;
   auto* d = app.add_subcommand(
       "demo",
-      "Run the collaborative cell: every service as a separate process on loopback DDS, the synthetic person "
-      "across the table, the robot learning its task order; live progress and a summary");
+      "Run the collaborative cell: every service as a separate process on loopback DDS (secured with DDS Security "
+      "unless --insecure), the synthetic person across the table, the robot learning its task order; live "
+      "progress and a summary");
   d->add_option("--dds", o.vendor, "DDS vendor of the services: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
-  d->add_flag("--mixed", o.mixed,
-              "run half the services on each vendor (intent, trajopt and robot_sim on the other one)");
+  d->add_flag("--mixed", o.mixed, "run half the services on each vendor (intent, trajopt and robot_sim on the other "
+                                 "one); only with --insecure: secured, Debian's two vendors fail to authenticate");
   d->add_option("--episodes", o.episodes, "collaborative episodes to run")->capture_default_str()->check(CLI::Range(1, 1000));
   d->add_option("--timeout", o.timeout, "give up after this many seconds")->capture_default_str()->check(CLI::PositiveNumber);
   d->add_option("--domain", o.domain, "DDS domain (default: 100 + pid % 100, to stay apart from a running cell)")
@@ -573,6 +405,7 @@ void Register(CLI::App& app) {
   d->add_flag("--keep-learning", o.keep_learning,
               "use the Q-table of supervisor.yaml (learning carries over between runs) instead of a fresh one");
   d->add_flag("--retrain", o.retrain, "train the intent model again even if a cached one fits");
+  AddDemoSecurityOptions(d, &o.insecure, &o.security);
   d->add_option("--sensor", o.sensor,
                  "skeleton: the skeleton stream; depth: also the simulated depth camera and the cloud service "
                  "(obstacles and human points, docs/perception-clouds.md)")

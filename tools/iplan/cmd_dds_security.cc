@@ -37,6 +37,21 @@ void CreateKeystore(const Options& o) {
   std::cout << "\nstart the services with --security " << o.dir << " (or IPLAN_SECURITY=" << o.dir << ")\n";
 }
 
+// The keystore a cell of this version runs with, made or brought up to date.
+void EnsureKeystore(const Options& o) {
+  const std::string dir = o.dir.empty() ? iplan::framework::UserKeystoreDir() : o.dir;
+  const iplan::framework::KeystoreReport r = iplan::framework::EnsureCellKeystore(dir);
+  if (r.created) {
+    std::cout << "keystore " << dir << ": created (CA, governance, " << iplan::framework::CellEnclaves().size()
+              << " enclaves)\n";
+  } else if (r.reissued.empty()) {
+    std::cout << "keystore " << dir << ": present; every enclave of the cell valid and current\n";
+  } else {
+    std::cout << "keystore " << dir << ": re-issued " << r.reissued.size() << " enclaves (signed by its CA):\n";
+    for (const auto& why : r.reissued) std::cout << "  " << why << "\n";
+  }
+}
+
 void CreateEnclave(const Options& o) {
   iplan::dds::EnclaveGrant g{o.name, {}, {}};
   for (const auto& t : o.publish) g.publish.push_back(iplan::cli::DdsTopicName(t));
@@ -94,13 +109,24 @@ const bool kRegistered = iplan::cli::RegisterCommand("security", [](CLI::App& ap
       ->capture_default_str();
   ks->callback([] { Run([] { CreateKeystore(o); }); });
 
+  auto* ek = sec->add_subcommand(
+      "ensure-keystore",
+      "Make DIR a keystore this version of the cell runs with: create it when missing (built beside it and "
+      "renamed into place: never half made), re-issue any cell enclave that is invalid or grants other topics "
+      "than the cell now uses (signed by its own CA), leave all else alone. `iplan demo` does this on first use "
+      "and scripts/setup.sh runs it.");
+  ek->add_option("dir", o.dir,
+                 "keystore folder (default: this user's, $XDG_DATA_HOME/iplan/keystore or "
+                 "~/.local/share/iplan/keystore)");
+  ek->callback([] { Run([] { EnsureKeystore(o); }); });
+
   auto* en = sec->add_subcommand(
       "create-enclave",
       "Add or replace an enclave of an existing keystore (e.g. a robot bridge of your own), signed by its CA");
   en->add_option("dir", o.dir, "keystore folder")->required();
   en->add_option("name", o.name, "enclave name = participant name, e.g. iplan-robot-bridge")->required();
   en->add_option("--publish", o.publish, "topic it may publish, e.g. /joint_states (repeatable)");
-  en->add_option("--subscribe", o.subscribe, "topic it may subscribe to, e.g. /iplan/safety/permit (repeatable)");
+  en->add_option("--subscribe", o.subscribe, "topic it may subscribe to, e.g. /iplan/safety/permit/supervisor (repeatable)");
   en->add_option("--domain", o.domain, "the one DDS domain it covers (default: all, 0-230)")
       ->check(CLI::Range(0, 230));
   en->add_option("--days", o.days, "validity in days")->check(CLI::Range(1, 36500))->capture_default_str();

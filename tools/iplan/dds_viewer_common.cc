@@ -23,12 +23,13 @@ viewer::CellModel LoadViewerCellModel(const std::string& config_dir, const std::
 }
 
 std::unique_ptr<core::Process> StartRecorder(const std::string& vendor, int domain, const std::string& out,
-                                             const std::string& config_dir, const std::string& log_base) {
+                                             const std::string& config_dir, const std::string& log_base,
+                                             const std::map<std::string, std::string>& env) {
   auto p = std::make_unique<core::Process>(
       std::vector<std::string>{core::ExecutableDir() + "/iplan", "record", "--dds", vendor, "--domain",
                                std::to_string(domain), "--out", out, "--stats", out + ".stats.json", "--config-dir",
                                config_dir},
-      std::map<std::string, std::string>{}, false, log_base);
+      env, false, log_base);
   if (!p->WaitForOutput("recording", std::chrono::seconds(20))) {
     throw std::runtime_error("iplan record did not start:\n" + p->Stdout() + p->Stderr());
   }

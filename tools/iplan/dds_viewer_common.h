@@ -3,6 +3,7 @@
 // configuration names), and starting/stopping a recorder next to a cell.
 #pragma once
 
+#include <map>
 #include <memory>
 #include <optional>
 #include <string>
@@ -19,10 +20,12 @@ viewer::CellModel LoadViewerCellModel(const std::string& config_dir, const std::
                                       const std::string& scene = "", const std::string& body = "");
 
 /// Starts `iplan record` (this executable) on `domain` writing `out` and
-/// its per-topic counts to `out`.stats.json; waits until it listens.
+/// its per-topic counts to `out`.stats.json, with `env` added to its
+/// environment (e.g. IPLAN_SECURITY); waits until it listens.
 /// @throws std::runtime_error when it does not start.
 std::unique_ptr<core::Process> StartRecorder(const std::string& vendor, int domain, const std::string& out,
-                                             const std::string& config_dir, const std::string& log_base);
+                                             const std::string& config_dir, const std::string& log_base,
+                                             const std::map<std::string, std::string>& env = {});
 
 /// Stops a recorder (SIGTERM) and waits until the file is complete. Returns
 /// an error text, or nullopt.

@@ -4,7 +4,8 @@
 const VERDICTS = ["OK", "SLOW_DOWN", "PROTECTIVE_STOP"];
 
 export const STRIP_TOPICS = ["/iplan/task/command", "/iplan/task/outcome", "/iplan/human/action_belief",
-  "/iplan/collision_risk", "/iplan/safety/permit", "/iplan/robot/plan_status"];
+  "/iplan/collision_risk", "/iplan/safety/permit/supervisor", "/iplan/safety/permit/collision_risk",
+  "/iplan/robot/plan_status"];
 
 export function emptyStrip() {
   return { task: null, action: null, actionProbability: 0, verdict: null, separation: null, protectiveSeparation: null,
@@ -35,7 +36,8 @@ export function applyStrip(s, topic, m) {
       s.protectiveSeparation = typeof m.protective_separation === "number" ? m.protective_separation : null;
       s.riskReason = m.reason;
       break;
-    case "/iplan/safety/permit": {
+    case "/iplan/safety/permit/supervisor":
+    case "/iplan/safety/permit/collision_risk": {
       // The robot stands while any monitor withholds its permit; a stop is
       // counted when the first one does (as iplan demo counts them).
       const was = s.stopped;

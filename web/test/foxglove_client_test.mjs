@@ -49,7 +49,8 @@ check(serverInfo?.name === "iplan", `serverInfo names the server (${serverInfo?.
 const topics = channels.map((c) => c.topic).sort();
 console.log("advertised:", topics.join(" "));
 for (const t of ["/iplan/human/skeleton", "/joint_states", "/iplan/human/prediction", "/iplan/collision_risk",
-  "/iplan/safety/permit", "/diagnostics", "/iplan/viewer/scene", "/iplan/viewer/cell"]) {
+  "/iplan/safety/permit/supervisor", "/iplan/safety/permit/collision_risk", "/diagnostics", "/iplan/viewer/scene",
+  "/iplan/viewer/cell"]) {
   check(topics.includes(t), `channel ${t} is advertised`);
 }
 for (const c of channels) {

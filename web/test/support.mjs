@@ -88,6 +88,15 @@ export function tempDir(tag) {
   return d;
 }
 
+/** A DDS Security keystore of this test's own (`iplan security create-keystore`): the
+ * demo cell runs secured by default, and a viewer must hold the cell's observer enclave. */
+export async function cellKeystore(bin, tag) {
+  const dir = join(tempDir(tag), "keystore");
+  const p = new Proc([join(bin, "iplan"), "security", "create-keystore", dir], "iplan security");
+  if (await p.exited !== 0) fail(`cannot create a keystore:\n${p.out}`);
+  return dir;
+}
+
 /** A DDS domain of this test's own (as tests/support/test_paths.h does). */
 export function uniqueDomain(offset = 0) {
   return 1 + ((process.pid * 7 + offset) % 200);

@@ -3,7 +3,7 @@
 // the data inlined; no network) with the plots of a demo run, from its
 // summary JSON (iplan demo --summary) and its MCAP recording (iplan record):
 //   learning curve, waiting time per episode           (summary)
-//   separation and S_p over time with stops marked     (recording: /iplan/collision_risk, /iplan/safety/permit)
+//   separation and S_p over time with stops marked     (recording: /iplan/collision_risk, /iplan/safety/permit/*)
 //   end-to-end latency histogram                       (recording: /iplan/robot/plan_status)
 //   per-service cycle times and deadline misses        (recording: /diagnostics)
 // A plot whose data the run lacks is listed under "Not in this run".
@@ -45,7 +45,7 @@ function separationPlot(msgs, t0) {
   }
   const stops = [], sources = {};
   let stopped = false;
-  for (const m of msgs.filter((m) => m.topic === "/iplan/safety/permit")) {
+  for (const m of msgs.filter((m) => m.topic.startsWith("/iplan/safety/permit/"))) {
     sources[m.data.source] = m.data.state === 0;
     const now = Object.values(sources).some((v) => v);
     if (now && !stopped) stops.push({ t: Number(m.logTime - t0) * 1e-9, reason: `${m.data.source}: ${m.data.reason}` });

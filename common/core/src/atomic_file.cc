@@ -84,7 +84,12 @@ std::vector<std::string> RemoveStaleTempFiles(const std::string& path) {
     const pid_t pid = PidOf(name.substr(prefix.size()));
     if (pid == 0 || pid == ::getpid() || Running(pid)) continue;
     const std::string stale = target.has_parent_path() ? (dir / name).string() : name;
-    if (::unlink(stale.c_str()) == 0) removed.push_back(stale);
+    std::error_code rm;
+    if (it->is_directory(rm) && !it->is_symlink(rm)) {
+      if (fs::remove_all(stale, rm) != static_cast<std::uintmax_t>(-1) && !rm) removed.push_back(stale);
+    } else if (::unlink(stale.c_str()) == 0) {
+      removed.push_back(stale);
+    }
   }
   return removed;
 }

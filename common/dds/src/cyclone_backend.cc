@@ -1,5 +1,7 @@
 // Cyclone DDS 0.10 backend: idlc C structs through the C API, one wait set
 // per participant.
+#include <atomic>
+#include <cstdio>
 #include <cstring>
 #include <mutex>
 #include <string>
@@ -23,6 +25,30 @@ const cyclone_gen::CycloneTypeOps& FindOps(const std::string& dds_type) {
     if (dds_type == ops.dds_name) return ops;
   }
   throw std::runtime_error("Cyclone DDS: no type support for '" + dds_type + "'");
+}
+
+// Cyclone's log on stderr, as its default sink writes it, one line per
+// message, with one addition: the first handshake of the process that fails
+// the Fast DDS way is explained. On Debian's builds a Cyclone participant
+// cannot answer a Fast DDS one's handshake request (it cannot read the
+// Diffie-Hellman key in it) and says only "Begin handshake reply failed:
+// Failed to convert octet sequence to ASN1 integer", once a second, while
+// the two never match (docs/dds.md, "Mixed vendors: what fails").
+void LogSink(void*, const dds_log_data_t* d) {
+  std::fwrite(d->message - d->hdrsize, 1, d->hdrsize + d->size, stderr);
+  if (d->size == 0 || d->message[d->size - 1] != '\n') std::fputc('\n', stderr);
+  static std::atomic<bool> explained{false};
+  const std::string text(d->message, d->size);
+  if (text.find("andshake") != std::string::npos && text.find("ASN1 integer") != std::string::npos &&
+      !explained.exchange(true)) {
+    std::fprintf(stderr,
+                 "iplan: the DDS Security handshake above failed the way Debian's Fast DDS 2.9 and Cyclone DDS 0.10 "
+                 "fail with each other (Cyclone cannot read the Diffie-Hellman key of a Fast DDS handshake "
+                 "request): that participant runs Fast DDS and the two will never match. Run one DDS vendor on "
+                 "every computer of a secured cell (IPLAN_DDS), or both unsecured on purpose (--insecure); "
+                 "docs/dds.md, \"Mixed vendors: what fails\"\n");
+  }
+  std::fflush(stderr);
 }
 
 dds_duration_t ToDuration(std::chrono::nanoseconds ns) {
@@ -211,6 +237,10 @@ class CycloneParticipant final : public BackendParticipant {
                                      " with " + config_file, dom));
       }
       if (dom >= 0) domain_ = dom;
+    }
+    if (!security.empty()) {
+      static std::once_flag sink;
+      std::call_once(sink, [] { dds_set_log_sink(&LogSink, nullptr); });
     }
     dds_qos_t* pq = dds_create_qos();
     dds_qset_entity_name(pq, options.name.c_str());

@@ -1,5 +1,6 @@
 // Creating DDS Security keystores (iplan/dds/security.h): the CA, the signed
 // governance and, per enclave, an identity and signed permissions.
+#include <fcntl.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -31,6 +32,14 @@ void MakeDir(const std::string& path, unsigned mode) {
     throw std::runtime_error("cannot create folder " + path + ": " + std::strerror(errno));
   }
   ::chmod(path.c_str(), static_cast<mode_t>(mode));  // exactly `mode`, whatever the umask
+}
+
+// The rename of a folder into `parent` survives a power loss.
+void SyncFolder(const std::string& parent) {
+  const int fd = ::open(parent.c_str(), O_RDONLY | O_DIRECTORY);
+  if (fd < 0) return;
+  ::fsync(fd);
+  ::close(fd);
 }
 
 void CheckOptions(const std::string& dir, const KeystoreOptions& o) {
@@ -164,7 +173,11 @@ void WriteEnclave(const KeystorePaths& ks, const std::string& enclave_dir, const
 
 }  // namespace
 
-void CreateKeystore(const std::string& dir, const std::vector<EnclaveGrant>& grants, const KeystoreOptions& options) {
+void CreateKeystore(const std::string& dir_text, const std::vector<EnclaveGrant>& grants,
+                    const KeystoreOptions& options) {
+  // "a/ks/" and "a/ks" are one keystore; its temporary goes beside it.
+  std::string dir = dir_text;
+  while (dir.size() > 1 && dir.back() == '/') dir.pop_back();
   CheckOptions(dir, options);
   for (const auto& g : grants) CheckName(dir, g.name);
   std::error_code ec;
@@ -174,8 +187,12 @@ void CreateKeystore(const std::string& dir, const std::vector<EnclaveGrant>& gra
     Fail(dir, "exists and is not empty (an existing keystore is never overwritten; add an enclave with "
               "`iplan security create-enclave`, or remove the folder first)");
   }
+  const fs::path parent = fs::absolute(dir, ec).parent_path();
+  fs::create_directories(parent, ec);
   // Built beside the target and renamed into place: the keystore appears
-  // whole or not at all.
+  // whole or not at all. A creation killed before its rename left only its
+  // temporary folder: removed here, never used.
+  core::RemoveStaleTempFiles(dir);
   const std::string tmp = dir + ".tmp." + std::to_string(::getpid());
   fs::remove_all(tmp, ec);
   try {
@@ -191,8 +208,10 @@ void CreateKeystore(const std::string& dir, const std::vector<EnclaveGrant>& gra
     core::WriteFileAtomically(ks.governance_xml, governance);
     core::WriteFileAtomically(ks.governance_p7s, pki::SignSmime(governance, ca));
     for (const auto& g : grants) WriteEnclave(ks, ks.enclaves_dir + "/" + g.name, g, ca, options);
-    if (existed) fs::remove(dir);
+    // rename(2) replaces an empty folder and refuses a non-empty one (a
+    // keystore another process made meanwhile): never a mix of two.
     fs::rename(tmp, dir);
+    SyncFolder(parent.string());
   } catch (const std::exception& e) {
     fs::remove_all(tmp, ec);
     Fail(dir, e.what());

@@ -96,6 +96,37 @@ EnclaveFiles LoadEnclave(const std::string& dir, const std::string& name) {
   return f;
 }
 
+namespace {
+
+// The <topic> entries inside every <`rule`> ... </`rule`> of a permissions document.
+std::vector<std::string> GrantedTopics(const std::string& doc, const std::string& rule) {
+  std::vector<std::string> topics;
+  const std::string open = "<" + rule + ">", close = "</" + rule + ">";
+  for (auto at = doc.find(open); at != std::string::npos; at = doc.find(open, at + 1)) {
+    const auto end = doc.find(close, at);
+    if (end == std::string::npos) break;
+    const std::string block = doc.substr(at, end - at);
+    for (auto t = block.find("<topic>"); t != std::string::npos; t = block.find("<topic>", t + 1)) {
+      const auto e = block.find("</topic>", t);
+      if (e == std::string::npos) break;
+      topics.push_back(block.substr(t + 7, e - t - 7));
+    }
+  }
+  return topics;
+}
+
+}  // namespace
+
+EnclaveGrant ReadGrant(const std::string& dir, const std::string& name) {
+  const EnclaveFiles f = LoadEnclave(dir, name);
+  std::string content;
+  if (std::string why = pki::VerifySmime(core::ReadFile(f.permissions), core::ReadFile(f.permissions_ca), &content);
+      !why.empty()) {
+    throw std::runtime_error("security: enclave " + name + " in " + dir + ": permissions: " + why);
+  }
+  return {name, GrantedTopics(content, "publish"), GrantedTopics(content, "subscribe")};
+}
+
 std::string DefaultSecurityDir() {
   const char* v = std::getenv("IPLAN_SECURITY");
   return v && *v ? v : "";

@@ -5,6 +5,7 @@
 #include <map>
 
 #include <CLI/CLI.hpp>
+#include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
 #include "iplan/dds/security.h"
@@ -136,6 +137,78 @@ void AddSecurityOption(CLI::App* app, const std::string& name, std::string* dir)
                   "$IPLAN_SECURITY, else no security)");
 }
 
+// The service's command line.
+struct CommandLine {
+  std::string config_file;
+  std::string vendor_text;
+  int domain = -1;
+  std::string security_dir;
+  bool insecure = false;          ///< run without DDS Security on purpose
+  bool require_security = false;  ///< refuse to start without it, unless insecure
+  std::string log_level = "info";
+  bool check_only = false;
+  std::vector<std::string> overrides;
+  std::vector<std::string> remaps;
+};
+
+// Without a keystore, say what that means, once, at start. True when the
+// service may run so; false (said why) when it must not: --require-security
+// (the systemd units) or the configured service's own need (`required_by`,
+// e.g. a supervisor in deployment mode), unless --insecure said it is meant.
+bool AcceptSecurityMode(const std::string& name, const dds::ParticipantOptions& popts, bool insecure,
+                        const std::string& required_by) {
+  if (!popts.security_dir.empty()) return true;
+  // The service's own logger (the Node takes it over), on stderr.
+  auto log = spdlog::get(name);
+  if (!log) log = spdlog::stderr_color_mt(name);
+  const std::string exposure =
+      "any process on the network can read this service's topics and write to it under any participant name "
+      "(docs/safety.md, \"Threat model\")";
+  if (insecure) {
+    log->warn("DDS Security is off on purpose (--insecure): {}", exposure);
+    return true;
+  }
+  if (!required_by.empty()) {
+    log->error("refusing to start without DDS Security ({}): give the cell's keystore (--security DIR or "
+               "IPLAN_SECURITY=DIR, docs/deployment.md), or --insecure (IPLAN_INSECURE=1) to run unsecured on "
+               "purpose",
+               required_by);
+    return false;
+  }
+  log->warn("no DDS Security (no --security, no IPLAN_SECURITY): {}; pass --insecure to run so on purpose",
+            exposure);
+  return true;
+}
+
+// IPLAN_INSECURE from the environment: true for 1/true/yes, false when unset,
+// empty or 0/false/no; anything else is an error (thrown).
+bool InsecureFromEnvironment() {
+  const char* v = std::getenv("IPLAN_INSECURE");
+  const std::string s = v ? v : "";
+  if (s.empty() || s == "0" || s == "false" || s == "no") return false;
+  if (s == "1" || s == "true" || s == "yes") return true;
+  throw std::invalid_argument("IPLAN_INSECURE='" + s + "' is not 1/true/yes or 0/false/no");
+}
+
+// --insecure / IPLAN_INSECURE against the keystore and --require-security,
+// before the participant exists. False (said why) when the service must not
+// start.
+bool DecideSecurity(const std::string& name, const dds::ParticipantOptions& popts, CommandLine* cl) {
+  try {
+    cl->insecure = cl->insecure || InsecureFromEnvironment();
+  } catch (const std::exception& e) {
+    std::cerr << "iplan-" << name << ": " << e.what() << "\n";
+    return false;
+  }
+  if (cl->insecure && !popts.security_dir.empty()) {
+    std::cerr << "iplan-" << name << ": --insecure (or IPLAN_INSECURE) contradicts the DDS Security keystore "
+              << popts.security_dir << " (--security or IPLAN_SECURITY): give one of them\n";
+    return false;
+  }
+  return AcceptSecurityMode(name, popts, cl->insecure,
+                            cl->require_security ? "--require-security, as the systemd units pass it" : "");
+}
+
 void LogConfiguring(Node& node, const std::string& config_file, const dds::ParticipantOptions& popts) {
   node.log().info("configuring from {} on {} domain {}{}", config_file.empty() ? "(defaults)" : config_file,
                   dds::ToString(popts.vendor), popts.domain_id,
@@ -168,18 +241,6 @@ bool RunActive(Service* service, Node* node) {
   return true;
 }
 
-// The service's command line.
-struct CommandLine {
-  std::string config_file;
-  std::string vendor_text;
-  int domain = -1;
-  std::string security_dir;
-  std::string log_level = "info";
-  bool check_only = false;
-  std::vector<std::string> overrides;
-  std::vector<std::string> remaps;
-};
-
 void AddOptions(const ServiceInfo& info, CLI::App* app, CommandLine* cl) {
   app->add_option("-c,--config", cl->config_file, "YAML configuration file")
       ->capture_default_str();
@@ -187,6 +248,12 @@ void AddOptions(const ServiceInfo& info, CLI::App* app, CommandLine* cl) {
                   "DDS vendor: cyclonedds or fastdds (default: $IPLAN_DDS, else cyclonedds)");
   app->add_option("--domain", cl->domain, "DDS domain id 0-232 (default: $IPLAN_DOMAIN, else 0)");
   AddSecurityOption(app, info.name, &cl->security_dir);
+  app->add_flag("--insecure", cl->insecure,
+                "run without DDS Security on purpose (also IPLAN_INSECURE=1): anyone on the network can then "
+                "read the cell and claim any participant's name (docs/safety.md); contradicts --security");
+  app->add_flag("--require-security", cl->require_security,
+                "refuse to start (exit code 2) without a DDS Security keystore unless --insecure (the systemd "
+                "units pass it)");
   app->add_option("--log-level", cl->log_level, "trace, debug, info, warn, error")
       ->check(CLI::IsMember({"trace", "debug", "info", "warn", "error"}))
       ->capture_default_str();
@@ -245,6 +312,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
 
   dds::ParticipantOptions popts;
   if (!ParticipantOptionsFrom(info.name, cl.vendor_text, cl.domain, cl.security_dir, &popts)) return kExitConfigError;
+  if (!DecideSecurity(info.name, popts, &cl)) return kExitConfigError;
 
   std::unique_ptr<ConfigSection> config;
   NodeOptions nopts;
@@ -266,6 +334,11 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
     service = make();
     LogConfiguring(*node, cl.config_file, popts);
     if (!Configure(info.name, config.get(), service.get(), node.get())) return kExitConfigError;
+    if (const std::string why = service->SecurityRequiredBy(); !why.empty() && popts.security_dir.empty() &&
+        !cl.insecure) {
+      AcceptSecurityMode(info.name, popts, false, why);
+      return kExitConfigError;
+    }
     node->SetState("configured");
     if (cl.check_only) {
       std::cout << cl.config_file << ": configuration is valid\n";

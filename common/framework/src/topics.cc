@@ -4,6 +4,7 @@
 #include <cctype>
 #include <mutex>
 #include <set>
+#include <stdexcept>
 
 namespace iplan::framework::topics {
 namespace {
@@ -16,7 +17,8 @@ const std::vector<std::string>& CatalogueNames() {
       "rt/iplan/human/skeleton", "rt/iplan/sim/human_truth", "rt/iplan/depth/points", "rt/iplan/obstacles",
       "rt/iplan/human/points", "rt/iplan/human/action_belief", "rt/iplan/human/prediction", "rt/joint_states",
       "rt/iplan/robot/trajectory", "rt/iplan/task/command", "rt/iplan/task/outcome", "rt/iplan/robot/plan_status",
-      "rt/iplan/collision_risk", "rt/iplan/safety/permit", "rt/diagnostics", "rt/tf_static"};
+      "rt/iplan/collision_risk", "rt/iplan/safety/permit/supervisor", "rt/iplan/safety/permit/collision_risk",
+      "rt/diagnostics", "rt/tf_static"};
   return kNames;
 }
 
@@ -152,12 +154,20 @@ Topic<msg::PlanStatus> PlanStatus() {
 Topic<msg::CollisionRisk> CollisionRisk() {
   return {Named("rt/iplan/collision_risk"), Q::SensorStream(milliseconds(200), milliseconds(300)), {"iplan-collision_risk"}};
 }
-Topic<msg::SafetyPermit> SafetyPermit() {
+Topic<msg::SafetyPermit> SafetyPermit(const std::string& monitor) {
+  const std::string prefix = "iplan-";
+  std::string token = monitor.rfind(prefix, 0) == 0 ? monitor.substr(prefix.size()) : monitor;
+  std::replace_if(token.begin(), token.end(), [](char c) { return c == '-' || c == '.'; }, '_');
+  if (const std::string why = InvalidRosName("/iplan/safety/permit/" + token); !why.empty() || monitor.empty()) {
+    throw std::invalid_argument("monitor '" + monitor + "' gives no permit topic: " +
+                                (why.empty() ? std::string("empty name") : why));
+  }
   // Deadline and lease well above the permit period (50 ms); the robot side
   // judges freshness itself, from each permit's validity.
-  return {Named("rt/iplan/safety/permit"), Q::SensorStream(milliseconds(200), milliseconds(300)),
-          {"iplan-supervisor", "iplan-collision_risk"}};
+  return {Named("rt/iplan/safety/permit/" + token), Q::SensorStream(milliseconds(200), milliseconds(300)), {monitor}};
 }
+Topic<msg::SafetyPermit> SupervisorPermit() { return SafetyPermit("iplan-supervisor"); }
+Topic<msg::SafetyPermit> CollisionRiskPermit() { return SafetyPermit("iplan-collision_risk"); }
 Topic<msg::DiagnosticArray> Diagnostics() {
   Q q = Q::Command(milliseconds(3000));
   q.name = "status";
@@ -194,7 +204,8 @@ std::vector<TopicDescription> All() {
       Describe(TaskOutcome(), "robot task outcomes (trajectory optimisation)"),
       Describe(PlanStatus(), "one status per replanning cycle, with end-to-end latency (trajectory optimisation)"),
       Describe(CollisionRisk(), "collision bound and separation monitoring (collision risk)"),
-      Describe(SafetyPermit(), "permission to move, re-published every period (supervisor, collision risk)"),
+      Describe(SupervisorPermit(), "the supervisor's permission to move, re-published every period"),
+      Describe(CollisionRiskPermit(), "collision risk's permission to move, re-published every period"),
       Describe(Diagnostics(), "per-service diagnostics (every service)"),
       Describe(TfStatic(), "static transforms: world -> robot base (robot simulator)"),
   };

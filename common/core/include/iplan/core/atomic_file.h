@@ -17,7 +17,8 @@ void WriteFileAtomically(const std::string& path, const std::string& content, un
 
 /// Removes the temporaries `path.tmp.<pid>` that WriteFileAtomically left
 /// behind when its process died between creating and renaming them (kill -9,
-/// power loss): those whose <pid> is no running process. Kept: this
+/// power loss): those whose <pid> is no running process (a folder built the
+/// same way, e.g. a keystore, with all it holds). Kept: this
 /// process's own (its next write of `path` truncates and renames it), those
 /// of running processes (a write in progress) and names that are not ours
 /// (a suffix that is not a pid). A pid reused by an unrelated process keeps

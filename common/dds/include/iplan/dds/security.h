@@ -39,9 +39,10 @@ struct KeystoreOptions {
 /// folder) with a CA, the governance document and one enclave per grant.
 /// Every file is written atomically; keys with mode 0600 in folders the
 /// owner alone can enter. Throws std::runtime_error naming the path and the
-/// reason (existing keystore, not a folder, cannot write, OpenSSL failure);
-/// a failed creation leaves no half-written keystore behind only when `dir`
-/// did not exist before. Allocates.
+/// reason (existing keystore, not a folder, cannot write, OpenSSL failure).
+/// The keystore is built in `dir`.tmp.<pid> and renamed into place, so `dir`
+/// appears whole or not at all, also when the process is killed; such a
+/// killed creation's folder is removed by the next creation. Allocates.
 void CreateKeystore(const std::string& dir, const std::vector<EnclaveGrant>& grants,
                     const KeystoreOptions& options = {});
 
@@ -64,6 +65,12 @@ struct EnclaveFiles {
 /// permissions naming the certificate's subject. Throws std::runtime_error
 /// ("security: enclave iplan-trajopt in /etc/iplan/keystore: ...").
 EnclaveFiles LoadEnclave(const std::string& dir, const std::string& name);
+
+/// What the enclave `name` of keystore `dir` is granted: the topics of the
+/// publish and subscribe rules of its signed permissions (after LoadEnclave's
+/// checks), in document order. Throws std::runtime_error like LoadEnclave.
+/// Allocates.
+EnclaveGrant ReadGrant(const std::string& dir, const std::string& name);
 
 /// IPLAN_SECURITY from the environment (a keystore folder), else "".
 std::string DefaultSecurityDir();

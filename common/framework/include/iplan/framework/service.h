@@ -39,6 +39,11 @@ class Service {
   virtual Result OnDeactivate(Node& node) { return Result::Ok(); }
   /// Releases what OnConfigure acquired.
   virtual Result OnCleanup(Node& node) { return Result::Ok(); }
+  /// Why this service, as configured, must not run without DDS Security
+  /// (e.g. "supervisor.mode is deployment"), or "" when it may. Asked after
+  /// OnConfigure: without a keystore and without --insecure the service then
+  /// stops with exit code 2 before activating.
+  virtual std::string SecurityRequiredBy() const { return ""; }
 };
 
 struct ServiceInfo {
@@ -51,7 +56,11 @@ enum ExitCode { kExitOk = 0, kExitRuntimeError = 1, kExitConfigError = 2 };
 
 /// Runs a service to completion; returns the process exit code.
 /// Command line: --config FILE, --dds VENDOR, --domain N, --log-level LEVEL,
-/// --check-config (load and validate, then exit).
+/// --check-config (load and validate, then exit), --security DIR /
+/// --insecure / --require-security (DDS Security: without a keystore the
+/// service says so at start, and refuses to start, exit code 2, when
+/// --require-security or Service::SecurityRequiredBy asks for one, unless
+/// --insecure or IPLAN_INSECURE=1 says running unsecured is meant).
 int RunService(int argc, char** argv, const ServiceInfo& info,
                const std::function<std::unique_ptr<Service>()>& make);
 

@@ -66,10 +66,20 @@ Topic<msg::TaskOutcome> TaskOutcome();
 Topic<msg::PlanStatus> PlanStatus();
 /// Collision risk of the executing trajectory.
 Topic<msg::CollisionRisk> CollisionRisk();
-/// Permission to move from each safety monitor, re-published every period
-/// (supervisor, collision risk). Volatile: a late joiner must wait for a
-/// fresh permit, never replay an old one.
-Topic<msg::SafetyPermit> SafetyPermit();
+/// Permission to move from one safety monitor, re-published every period.
+/// Each monitor has a topic of its own: "rt/iplan/safety/permit/<service>"
+/// for the monitor whose participant is "iplan-<service>" (any other name:
+/// the whole name, with '-' and '.' as '_'), entitled to that participant
+/// alone. With DDS Security only that monitor's enclave is granted to
+/// publish it (enclaves.h), so the topic a permit arrives on is its
+/// authenticated origin. Volatile: a late joiner must wait for a fresh
+/// permit, never replay an old one. Throws std::invalid_argument when
+/// `monitor` gives no valid topic name.
+Topic<msg::SafetyPermit> SafetyPermit(const std::string& monitor);
+/// The shipped monitors' permit topics: SafetyPermit("iplan-supervisor"),
+/// SafetyPermit("iplan-collision_risk").
+Topic<msg::SafetyPermit> SupervisorPermit();
+Topic<msg::SafetyPermit> CollisionRiskPermit();
 /// Per-service diagnostics (ROS 2 /diagnostics).
 Topic<msg::DiagnosticArray> Diagnostics();
 

@@ -1,0 +1,200 @@
+// iplan demo's view of the running cell: a monitoring participant that
+// follows task commands and outcomes, plan statuses, collision-risk verdicts,
+// both monitors' permits and every service's diagnostics, and keeps what the
+// demo's progress line and summary show (episodes, stops and slow-downs,
+// separation, bound, latency). Single-threaded: its callbacks run on the
+// node's thread (Node::SpinOnce).
+#pragma once
+
+#include <algorithm>
+#include <chrono>
+#include <iomanip>
+#include <map>
+#include <sstream>
+#include <string>
+#include <utility>
+#include <vector>
+
+#include "iplan/framework/node.h"
+#include "iplan/framework/topics.h"
+
+namespace iplan::cli {
+
+// One episode of the task graph, as the demo saw it.
+struct Episode {
+  int number = 0;
+  double start = -1, end = -1;  // s since the demo started
+  int succeeded = 0, failed = 0;
+  double waiting = 0;            // s, sum of the tasks' delays
+  std::vector<std::string> order;
+  bool done = false;
+  double completion() const { return end - start; }
+};
+
+// `v` with `digits` decimals.
+inline std::string Fixed(double v, int digits) {
+  std::ostringstream s;
+  s << std::fixed << std::setprecision(digits) << v;
+  return s.str();
+}
+
+class CellMonitor {
+ public:
+  using Clock = std::chrono::steady_clock;
+  CellMonitor(framework::Node& node, int num_tasks, Clock::time_point t0) : num_tasks_(num_tasks), t0_(t0) {
+    using SI = const dds::SampleInfo&;
+    namespace topics = framework::topics;
+    const framework::SubscribeOptions any_order{false};
+    node.Subscribe(topics::TaskCommand(), std::function<void(const msg::TaskCommand&, SI)>(
+                                              [this](const msg::TaskCommand& m, SI) { OnCommand(m); }),
+                   any_order);
+    node.Subscribe(topics::TaskOutcome(), std::function<void(const msg::TaskOutcome&, SI)>(
+                                              [this](const msg::TaskOutcome& m, SI) { OnOutcome(m); }),
+                   any_order);
+    node.Subscribe(topics::PlanStatus(), std::function<void(const msg::PlanStatus&, SI)>([this](const msg::PlanStatus& m, SI) {
+                     if (m.latency > 0) {
+                       latency_ms_.push_back(1e3 * m.latency);
+                       intent_ms_.push_back(1e3 * m.intent_latency);
+                       queue_ms_.push_back(1e3 * m.queue_latency);
+                       planning_ms_.push_back(1e3 * m.planning_time);
+                     }
+                     waiting_ = m.waiting;
+                     max_plan_bound_ = std::max(max_plan_bound_, m.max_bound);
+                   }));
+    node.Subscribe(topics::CollisionRisk(),
+                   std::function<void(const msg::CollisionRisk&, SI)>([this](const msg::CollisionRisk& m, SI) {
+                     max_bound_ = std::max(max_bound_, m.max_bound);
+                     const bool slowed = m.verdict == msg::CollisionRisk::SLOW_DOWN && m.speed_scale < 1.0;
+                     if (std::exchange(slowed_, slowed) != slowed && slowed) ++slow_downs_;  // speed reduction
+                     separation_ = m.min_separation;
+                     min_observed_separation_ = std::min(min_observed_separation_, m.min_separation);
+                   }));
+    // The robot is stopped while any monitor withholds its permit; a stop
+    // is counted when the first one does.
+    for (const auto& topic : {topics::SupervisorPermit(), topics::CollisionRiskPermit()}) {
+      node.Subscribe(topic, std::function<void(const msg::SafetyPermit&, SI)>([this](const msg::SafetyPermit& m, SI) {
+                       const bool was_stopped = stopped_;
+                       permit_stops_[m.source] = m.state == msg::SafetyPermit::STOP;
+                       stopped_ = std::any_of(permit_stops_.begin(), permit_stops_.end(), [](const auto& p) { return p.second; });
+                       if (stopped_ && !was_stopped) {
+                         ++stops_;
+                         stop_reasons_.push_back(m.source + ": " + m.reason);
+                         stop_since_ = Now();
+                       }
+                       if (!stopped_ && was_stopped) stop_time_s_ += Now() - stop_since_;
+                     }),
+                     any_order);
+    }
+    node.Subscribe(topics::Diagnostics(),
+                   std::function<void(const msg::DiagnosticArray& a, SI)>([this](const msg::DiagnosticArray& a, SI) {
+                     for (const auto& st : a.status) {
+                       for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
+                     }
+                   }),
+                   any_order);
+  }
+
+  double Now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
+  const std::map<int, Episode>& episodes() const { return episodes_; }
+  int completed_episodes() const {
+    return static_cast<int>(std::count_if(episodes_.begin(), episodes_.end(), [](const auto& e) { return e.second.done; }));
+  }
+  std::string Diag(const std::string& service, const std::string& key, const std::string& otherwise = "") const {
+    auto s = diag_.find(service);
+    if (s == diag_.end()) return otherwise;
+    auto k = s->second.find(key);
+    return k == s->second.end() ? otherwise : k->second;
+  }
+  double DiagNumber(const std::string& service, const std::string& key, double otherwise) const {
+    const std::string v = Diag(service, key);
+    try {
+      return v.empty() ? otherwise : std::stod(v);
+    } catch (...) {
+      return otherwise;
+    }
+  }
+
+  // The progress line.
+  std::string Progress(int total_episodes) const {
+    std::ostringstream s;
+    const int e = current_episode_;
+    s << "  [" << std::setw(4) << Fixed(Now(), 0) << " s] ";
+    if (e == 0) {
+      s << "waiting for the cell (supervisor: " << Diag("supervisor", "safety", "starting") << ")";
+    } else {
+      s << "episode " << e << "/" << total_episodes << ": " << (current_task_.empty() ? "-" : current_task_)
+        << (waiting_ ? " (waiting)" : "");
+    }
+    s << " | person: " << Diag("perception", "action", "?") << " | separation "
+      << (separation_ < 1e9 ? Fixed(separation_, 2) + " m" : "-") << " | bound " << Fixed(max_bound_, 3)
+      << " | stops " << stops_ << " | contacts " << Diag("robot_sim", "true_contacts", "0");
+    return s.str();
+  }
+
+  std::vector<std::string> TakeEvents() { return std::exchange(events_, {}); }
+
+  std::vector<double> latency_ms_;
+  // Its stages, per trajectory: skeleton to prediction (intent), prediction
+  // to the planning cycle's start (DDS and waiting), the cycle's planning.
+  std::vector<double> intent_ms_, queue_ms_, planning_ms_;
+  double max_bound_ = 0, max_plan_bound_ = 0;
+  double separation_ = 1e18, min_observed_separation_ = 1e18;
+  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0, slow_downs_ = 0;
+  bool slowed_ = false;  // the last verdict slowed the robot
+  double stop_since_ = 0, stop_time_s_ = 0;  // s since the demo started; s stopped (ended stops)
+  std::vector<std::string> stop_reasons_;
+
+ private:
+  void OnCommand(const msg::TaskCommand& m) {
+    if (m.command != msg::TaskCommand::START || m.episode == 0) return;
+    const int e = static_cast<int>(m.episode);
+    if (task_episode_.count(m.task_id)) return;  // a re-sent command
+    task_episode_[m.task_id] = e;
+    Episode& ep = episodes_[e];
+    if (ep.start < 0) {
+      ep.number = e;
+      ep.start = Now();
+    }
+    current_episode_ = e;
+    current_task_ = m.task_name;
+  }
+  void OnOutcome(const msg::TaskOutcome& m) {
+    auto it = task_episode_.find(m.task_id);
+    if (it == task_episode_.end()) return;
+    Episode& ep = episodes_[it->second];
+    ep.waiting += m.delay;
+    if (m.status == msg::TaskOutcome::SUCCEEDED) {
+      ++ep.succeeded;
+      ++succeeded_tasks_;
+      ep.order.push_back(m.task_name);
+    } else {
+      ++ep.failed;
+      ++failed_tasks_;
+      events_.push_back("task '" + m.task_name + "' " + (m.status == msg::TaskOutcome::FAILED ? "failed" : "cancelled") +
+                        (m.reason.empty() ? "" : ": " + m.reason));
+    }
+    current_task_.clear();
+    if (!ep.done && ep.succeeded == num_tasks_) {
+      ep.done = true;
+      ep.end = Now();
+      std::ostringstream s;
+      s << "episode " << ep.number << " done in " << Fixed(ep.completion(), 1) << " s, robot waiting "
+        << Fixed(ep.waiting, 1) << " s:";
+      for (const auto& t : ep.order) s << " " << t;
+      events_.push_back(s.str());
+    }
+  }
+
+  int num_tasks_;
+  Clock::time_point t0_;
+  std::map<uint32_t, int> task_episode_;
+  std::map<int, Episode> episodes_;
+  int current_episode_ = 0;
+  std::string current_task_;
+  bool waiting_ = false, stopped_ = false;
+  std::map<std::string, bool> permit_stops_;  // per monitor: its last permit is a STOP
+  std::map<std::string, std::map<std::string, std::string>> diag_;
+  std::vector<std::string> events_;
+};
+
+}  // namespace iplan::cli
