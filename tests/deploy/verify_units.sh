@@ -33,27 +33,29 @@ done
 for unit in "$units"/iplan-*.service; do
   grep -q '^ExecStart=.* --require-security ' "$unit" || { echo "FAIL $(basename "$unit") does not require DDS Security"; failures=$((failures+1)); }
 done
-set +e
-out="$("$prefix/bin/iplan-trajopt" --require-security --config "$IPLAN_CONFIG_DIR/trajopt.yaml" --check-config 2>&1)"; rc=$?
-set -e
-if [ "$rc" -eq 2 ] && grep -q "refusing to start without DDS Security" <<<"$out"; then
-  echo "ok   a unit's service without a keystore refuses to start (exit 2, says why)"
-else
-  echo "FAIL unsecured unit: exit $rc: $out"; failures=$((failures+1))
-fi
+# expect_refusal WHAT PATTERN CMD...: CMD exits 2 and its output matches PATTERN.
+expect_refusal() {
+  local what="$1" pattern="$2" out rc
+  shift 2
+  set +e
+  out="$("$@" 2>&1)"; rc=$?
+  set -e
+  if [ "$rc" -eq 2 ] && grep -q "$pattern" <<<"$out"; then
+    echo "ok   $what"
+  else
+    echo "FAIL $what: exit $rc: $out"; failures=$((failures+1))
+  fi
+}
+expect_refusal "a unit's service without a keystore refuses to start (exit 2, says why)" \
+  "refusing to start without DDS Security" \
+  "$prefix/bin/iplan-trajopt" --require-security --config "$IPLAN_CONFIG_DIR/trajopt.yaml" --check-config
 if out="$(IPLAN_INSECURE=1 "$prefix/bin/iplan-trajopt" --require-security --config "$IPLAN_CONFIG_DIR/trajopt.yaml" --check-config 2>&1)" \
     && grep -q "DDS Security is off on purpose" <<<"$out"; then
   echo "ok   IPLAN_INSECURE=1 runs it unsecured on purpose, and says so"
 else
   echo "FAIL IPLAN_INSECURE=1: $out"; failures=$((failures+1))
 fi
-set +e
-out="$("$prefix/bin/iplan-intent" --config "$IPLAN_CONFIG_DIR/intent.yaml" --check-config 2>&1)"; rc=$?
-set -e
-if [ "$rc" -eq 2 ] && grep -q "model" <<<"$out"; then
-  echo "ok   intent refuses to start without a trained model (exit 2, names the model)"
-else
-  echo "FAIL intent without a model: exit $rc: $out"; failures=$((failures+1))
-fi
+expect_refusal "intent refuses to start without a trained model (exit 2, names the model)" "model" \
+  "$prefix/bin/iplan-intent" --config "$IPLAN_CONFIG_DIR/intent.yaml" --check-config
 echo "$failures failures"
 [ "$failures" -eq 0 ]
