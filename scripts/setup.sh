@@ -1,10 +1,12 @@
 #!/usr/bin/env bash
 # Sets up iplan on a Debian 12 machine: installs every dependency from
-# Debian's packages (only what is missing), then configures and builds a
-# Release build in build/. Executables end up in build/bin/.
+# Debian's packages (only what is missing), then configures a Release build
+# in build/ and builds what the demo runs (executables in build/bin/);
+# scripts/test.sh builds the tests and benchmarks.
 #
 #   ./scripts/setup.sh            # install + build
 #   IPLAN_JOBS=1 ./scripts/setup.sh   # build with fewer parallel jobs
+#   IPLAN_BUILD_ALL=1 ./scripts/setup.sh   # build the tests and benchmarks too
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -63,7 +65,13 @@ echo "setup: installing the web part's npm packages (web/package-lock.json)"
 
 jobs="${IPLAN_JOBS:-$(nproc)}"
 cmake -S . -B build -G Ninja -DCMAKE_BUILD_TYPE=Release
-cmake --build build -j "$jobs"
+# Only what the demo runs (the iplan tool, the services, the viewer's page);
+# scripts/test.sh builds the tests and benchmarks, IPLAN_BUILD_ALL=1 here too.
+if [ "${IPLAN_BUILD_ALL:-0}" = 1 ]; then
+  cmake --build build -j "$jobs"
+else
+  cmake --build build -j "$jobs" --target demo_cell
+fi
 # The cell's DDS Security keystore (CA, governance, one enclave per service):
 # made once per user, never overwritten; `iplan demo` runs secured with it.
 # Built beside its folder and renamed into place, so an interrupted setup
