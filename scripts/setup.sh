@@ -16,6 +16,8 @@ PACKAGES=(
   libfastrtps-dev libfastcdr-dev fastddsgen fastdds-tools cyclonedds-dev cyclonedds-tools
   # algorithms
   libeigen3-dev libfcl-dev libccd-dev libceres-dev liburdfdom-dev
+  # collision meshes of URDFs (STL, DAE, OBJ; common/collision/src/mesh_io.cc)
+  libassimp-dev
   # point clouds (found through its pkg-config files, see common/cloud/CMakeLists.txt)
   libpcl-dev
   # infrastructure

@@ -15,6 +15,7 @@
 #include "iplan/core/params.h"
 
 #include "check.h"
+#include "robot_model_mesh.h"
 
 namespace iplan::collision {
 namespace {
@@ -283,11 +284,11 @@ std::vector<Sphere> CoverShape(const std::string& path, const std::string& link,
         cover = CoverBox(0.5 * Eigen::Vector3d(b.dim.x, b.dim.y, b.dim.z), X_LG, options.cover, &entry->cover);
         break;
       }
-      case urdf::Geometry::MESH:
+      case urdf::Geometry::MESH: {
         if (options.ignore_mesh_collisions) return {};
-        Fail(path, "link '" + link +
-                       "' has a mesh collision shape; meshes are not supported "
-                       "(replace by primitives or set ignore_mesh_collisions)");
+        const auto& m = static_cast<const urdf::Mesh&>(*col.geometry);
+        return CoverUrdfMesh(path, link, m.filename, {m.scale.x, m.scale.y, m.scale.z}, X_LG, options, entry);
+      }
     }
   } catch (const std::invalid_argument& e) {
     Fail(path, "link '" + link + "': " + e.what());
@@ -532,7 +533,7 @@ std::vector<std::vector<Sphere>> CoverLinks(const RobotFile& f, const RobotModel
   };
   auto add = [&](int link, std::vector<Sphere> cover, const CoverReport& report) {
     per_link[link].insert(per_link[link].end(), cover.begin(), cover.end());
-    model->cover_report.push_back({model->link_names[link], report});
+    model->cover_report.push_back({model->link_names[link], report, {}, std::nullopt});
   };
   for (std::size_t i = 0; i < f.spheres.size(); ++i) {
     const SphereEntry& s = f.spheres[i];

@@ -320,7 +320,9 @@ joints:
   const std::string mesh = WriteTemp("mesh.urdf", R"(<robot name="m">
   <link name="a"><collision><geometry><mesh filename="x.stl"/></geometry></collision></link>
 </robot>)");
-  ExpectThrowsWith([&] { LoadRobotModelFromUrdf(mesh); }, "link 'a' has a mesh collision shape");
+  // A mesh that is not there: the URDF, the link and the file it looked for.
+  ExpectThrowsWith([&] { LoadRobotModelFromUrdf(mesh); }, mesh + ": link 'a': ");
+  ExpectThrowsWith([&] { LoadRobotModelFromUrdf(mesh); }, "x.stl: cannot read the mesh");
   RobotModelOptions opt;
   opt.ignore_mesh_collisions = true;
   EXPECT_EQ(LoadRobotModelFromUrdf(mesh, opt).spheres.size(), 0u);

@@ -16,6 +16,7 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "iplan/collision/mesh_cover.h"
 #include "iplan/collision/sphere_cover.h"
 #include "iplan/core/name_value.h"
 
@@ -63,6 +64,9 @@ struct CollisionSphere {
 struct ShapeCoverEntry {
   std::string link;
   CoverReport cover;
+  /// Mesh shapes: the mesh file (resolved path) and its cover's report.
+  std::string mesh_file;
+  std::optional<MeshCoverReport> mesh;
 };
 
 /// Immutable robot description. Links are ordered parents first (link 0 is
@@ -142,7 +146,12 @@ struct RobotModelOptions {
   /// collaborative arms (Franka's smallest published values are 7.5 and 3750).
   double default_acceleration = 7.5;
   double default_jerk = 3750.0;
-  /// Skip <mesh> collision shapes instead of throwing (they are then not
+  /// Covers of <mesh> collision shapes (mesh_cover.h).
+  MeshCoverParams mesh_cover;
+  /// Where mesh covers are cached; nullopt: DefaultMeshCoverCacheDir(); an
+  /// empty string: no cache.
+  std::optional<std::string> mesh_cache_dir;
+  /// Skip <mesh> collision shapes instead of covering them (they are then not
   /// covered by any sphere: unsafe unless other shapes cover them).
   bool ignore_mesh_collisions = false;
   /// Drop spheres contained in another sphere of the same link.
@@ -152,10 +161,13 @@ struct RobotModelOptions {
 /// Loads a robot from a URDF file: the kinematic tree (revolute, continuous,
 /// prismatic, fixed joints; mimic joints follow their master), limits, and
 /// collision spheres covering each <collision> shape (sphere kept as is,
-/// cylinder and box covered, see sphere_cover.h). Visual elements are ignored.
+/// cylinder and box covered, see sphere_cover.h; meshes read and covered as
+/// in mesh_cover.h, their files relative to the URDF, file:// or
+/// package://NAME/... found on $ROS_PACKAGE_PATH or as a folder NAME above
+/// the URDF). Visual elements are ignored.
 /// @throws std::runtime_error naming the file and the problem (unreadable or
-///         invalid URDF, unsupported joint type, mesh collision shape, unknown
-///         locked joint, invalid options).
+///         invalid URDF, unsupported joint type, a mesh that cannot be found
+///         or read, unknown locked joint, invalid options).
 /// Thread-safe (no shared state); allocates. urdfdom may print parser
 /// warnings to stderr (console_bridge) before the exception.
 RobotModel LoadRobotModelFromUrdf(const std::string& path, const RobotModelOptions& options = {});
