@@ -19,13 +19,16 @@ const bool kRegistered = iplan::cli::RegisterCommand("plan", [](CLI::App& app) {
   cmd->add_option("--robot", opts->robot, "robot: a DH YAML, a URDF or a URDF overlay (docs/robots.md)")
       ->capture_default_str();
   cmd->add_option("--config", opts->config, "planner params YAML (config/planner.yaml)");
-  cmd->add_option("--start", opts->start, "start joint positions q1,...,q7 (rad)")
+  cmd->add_option("--start", opts->start, "start joint positions, one per joint of the robot (rad or m)")
       ->delimiter(',')->required();
-  auto* g = cmd->add_option("--goal", opts->goal, "goal joint positions q1,...,q7 (rad)")->delimiter(',');
+  auto* g = cmd->add_option("--goal", opts->goal, "goal joint positions, one per joint (rad or m)")->delimiter(',');
   auto* gp = cmd->add_option("--goal-pose", opts->goal_pose,
                              "goal end-effector pose x,y,z,qx,qy,qz,qw (m, unit quaternion)")
                  ->delimiter(',');
   g->excludes(gp);
+  cmd->add_option("--tool-link", opts->tool_link,
+                  "link whose pose --goal-pose gives (default: the config's end_effector_link; without a config, "
+                  "panda_link8, or the robot's last link when it has no such link)");
   cmd->add_option("--prediction", opts->prediction, "human prediction JSON (docs/planning.md)");
   cmd->add_option("--human", opts->human, "human body YAML (default: built-in upper body)");
   cmd->add_option("--threads", *threads, "worker threads (default: params)");

@@ -12,6 +12,22 @@
 #include "iplan/planning/prediction_io.h"
 
 namespace iplan::planning {
+namespace {
+
+// The planner's parameters: the config's (or the defaults, adapted to the
+// robot) with the command line's overrides.
+PlannerParams Params(const PlanCliOptions& o, const collision::RobotModel& robot) {
+  PlannerParams params = o.config.empty() ? PlannerParams{} : LoadPlannerParams(o.config);
+  if (o.threads) params.num_threads = *o.threads;
+  if (o.seed) params.seed = *o.seed;
+  // The defaults are the Panda's; for another arm, its own links.
+  if (o.config.empty()) params = AdaptLinksToRobot(params, robot);
+  if (o.tool_link) params.end_effector_link = *o.tool_link;
+  if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument("planner params: " + why);
+  return params;
+}
+
+}  // namespace
 
 int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err) {
   try {
@@ -20,11 +36,7 @@ int RunPlanCommand(const PlanCliOptions& o, std::ostream& out, std::ostream& err
       throw std::invalid_argument("give exactly one of --goal and --goal-pose");
     collision::RobotModel robot = collision::LoadRobotModel(o.robot);
     collision::SceneParams scene = collision::LoadSceneParams(o.scene);
-    PlannerParams params = o.config.empty() ? PlannerParams{} : LoadPlannerParams(o.config);
-    if (o.threads) params.num_threads = *o.threads;
-    if (o.seed) params.seed = *o.seed;
-    if (const std::string why = params.Validate(); !why.empty())
-      throw std::invalid_argument("planner params: " + why);
+    const PlannerParams params = Params(o, robot);
     Planner planner(std::move(robot), std::move(scene), params);
     const int nq = planner.robot().nq;
     auto vec = [&](const std::vector<double>& v, const char* what) {

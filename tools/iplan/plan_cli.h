@@ -20,6 +20,12 @@ struct PlanCliOptions {
   std::vector<double> goal_pose;                       ///< x,y,z,qx,qy,qz,qw (m, unit quaternion), or empty
   std::optional<int> threads;                          ///< overrides num_threads
   std::optional<std::uint64_t> seed;                   ///< overrides seed
+  /// Overrides end_effector_link (the link of --goal-pose). Without it and
+  /// without a config, a robot without the default Panda link uses its last
+  /// link (the URDF's last in tree order, e.g. the UR5e's tool0), offset 0;
+  /// likewise the default allowed_collisions (the Panda's base and first
+  /// link on the table) become the robot's first two links with spheres.
+  std::optional<std::string> tool_link;
   bool json = false;
 };
 

@@ -18,6 +18,7 @@
 #include <stdexcept>
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdint>
 #include <cstdio>
 #include <cstdlib>
@@ -158,9 +159,9 @@ collision::HumanPrediction RecordedPrediction(const collision::HumanBodyModel& b
 
 // Seeded table-top problems: start and goal from the named poses, +-3 cm
 // and +-0.3 rad yaw jitter; every other goal a pose, the others joints.
-std::vector<Problem> MakeProblems(const Planner& planner, int num_problems, int* ik_rejected) {
-  Eigen::VectorXd ready(7);
-  ready << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+// `ready` seeds the first IK of each problem.
+std::vector<Problem> MakeProblems(const Planner& planner, const Eigen::VectorXd& ready, int num_problems,
+                                  int* ik_rejected) {
   const auto poses = testing::TableTopPoses();
   std::mt19937_64 rng(2026);
   std::uniform_int_distribution<int> pick(0, static_cast<int>(poses.size()) - 1);
@@ -168,6 +169,12 @@ std::vector<Problem> MakeProblems(const Planner& planner, int num_problems, int*
   std::vector<Problem> problems;
   *ik_rejected = 0;
   while (static_cast<int>(problems.size()) < num_problems) {
+    if (*ik_rejected > 100 * num_problems) {
+      std::fprintf(stderr, "planning_bench: %d candidate poses rejected (no IK or start in collision) for %zu "
+                           "problems; this robot does not reach the cell's table-top poses\n",
+                   *ik_rejected, problems.size());
+      std::exit(1);
+    }
     const int a = pick(rng), b = pick(rng);
     if (a == b) continue;
     const Eigen::Vector3d pa = poses[a].p + Eigen::Vector3d(jit(rng), jit(rng), jit(rng));
@@ -389,7 +396,8 @@ int Argument(int argc, char** argv, int i, int fallback, int min) {
   char* end = nullptr;
   const long v = std::strtol(argv[i], &end, 10);
   if (end == argv[i] || *end != '\0' || v < min || v > 100000) {
-    std::fprintf(stderr, "usage: planning_bench [problems=60 (>= 1)] [threads=2 (>= 1)]\n");
+    std::fprintf(stderr, "usage: planning_bench [problems=60 (>= 1)] [threads=2 (>= 1)] [robot file (default: the "
+                         "Panda, config/robots/panda.yaml)]\n");
     std::exit(2);
   }
   return static_cast<int>(v);
@@ -429,14 +437,26 @@ void RunPredictingTheMonitor(const collision::RobotModel& robot, const Problems&
 int main(int argc, char** argv) {
   const int num_problems = Argument(argc, argv, 1, 60, 1);
   const int threads = Argument(argc, argv, 2, 2, 1);
-  const collision::RobotModel robot = testing::LoadPanda();
-  PlannerParams params = LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml");
+  // Another arm (a URDF, an overlay or a DH file) in the Panda's place: the
+  // planner's config with that robot's links, IK seeded at the middle of
+  // its limits (0 for unbounded joints). Not the fingerprinted Panda run.
+  const std::string robot_file = argc > 3 ? argv[3] : "";
+  const collision::RobotModel robot = robot_file.empty() ? testing::LoadPanda() : collision::LoadRobotModel(robot_file);
+  const PlannerParams params =
+      AdaptLinksToRobot(LoadPlannerParams(std::string(IPLAN_SOURCE_DIR) + "/config/planner.yaml"), robot);
   Planner planner(robot, testing::LoadCell(), params);
+  Eigen::VectorXd ready(robot.nq);
+  if (robot_file.empty()) {
+    ready << 0.0, -0.3, 0.0, -2.2, 0.0, 2.0, 0.8;
+  } else {
+    ready = (0.5 * (robot.LowerLimits() + robot.UpperLimits())).unaryExpr([](double v) { return std::isfinite(v) ? v : 0.0; });
+  }
   int ik_rejected = 0;
-  const std::vector<Problem> problems = MakeProblems(planner, num_problems, &ik_rejected);
-  std::printf("planning_bench: %d problems (%d candidate poses rejected: no IK / start in collision), "
-              "%d worker threads, dt %.2f s, horizon %.1f s\n",
-              num_problems, ik_rejected, threads, params.dt, params.horizon);
+  const std::vector<Problem> problems = MakeProblems(planner, ready, num_problems, &ik_rejected);
+  std::printf("planning_bench: %s (%d joints, %zu spheres), %d problems (%d candidate poses rejected: no IK / start "
+              "in collision), %d worker threads, dt %.2f s, horizon %.1f s\n",
+              robot.name.c_str(), robot.nq, robot.spheres.size(), num_problems, ik_rejected, threads, params.dt,
+              params.horizon);
   std::uint64_t fingerprint = 14695981039346656037ULL;
   for (int nopt : {8, 1}) RunOneShot(planner, problems, nopt, threads, &fingerprint);
   CompareClearance(planner, robot);

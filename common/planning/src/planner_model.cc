@@ -118,3 +118,27 @@ double PlannerModel::Clearance(const collision::RobotData& data, const std::vect
 }
 
 }  // namespace iplan::planning::internal
+
+namespace iplan::planning {
+
+PlannerParams AdaptLinksToRobot(PlannerParams params, const collision::RobotModel& robot) {
+  if (robot.link_names.empty()) return params;
+  if (robot.FindLink(params.end_effector_link) < 0) {
+    params.end_effector_link = robot.link_names.back();
+    params.end_effector_offset = {0.0, 0.0, 0.0};
+  }
+  bool all_known = true;
+  for (const auto& [link, object] : params.allowed_collisions) all_known = all_known && robot.FindLink(link) >= 0;
+  if (all_known) return params;
+  std::vector<int> with_spheres;
+  for (const auto& s : robot.spheres) with_spheres.push_back(s.link);
+  std::sort(with_spheres.begin(), with_spheres.end());
+  with_spheres.erase(std::unique(with_spheres.begin(), with_spheres.end()), with_spheres.end());
+  params.allowed_collisions.clear();
+  for (std::size_t i = 0; i < with_spheres.size() && i < 2; ++i) {
+    params.allowed_collisions.push_back({robot.link_names[with_spheres[i]], "table"});
+  }
+  return params;
+}
+
+}  // namespace iplan::planning

@@ -212,6 +212,16 @@ class Planner {
   std::unique_ptr<Impl> impl_;
 };
 
+/// PlannerParams' defaults name the Panda's links (end_effector_link
+/// panda_link8 and its base pairs allowed on the table). For a robot that
+/// lacks them: end_effector_link becomes the robot's last link (the URDF's
+/// last in tree order, e.g. the UR5e's tool0) with offset 0, and
+/// allowed_collisions its first two links with spheres against "table".
+/// Parameters whose links the robot has are returned unchanged. For tools
+/// and benchmarks that plan without a robot-specific config; a config that
+/// names links stays checked by the Planner. Allocates.
+PlannerParams AdaptLinksToRobot(PlannerParams params, const collision::RobotModel& robot);
+
 /// Checks a trajectory against the limits of `robot` with the discrete
 /// derivatives above (start velocity qdot0, size nq or empty = 0), relative
 /// tolerance `tol`. Returns an empty string when it respects them, else the
