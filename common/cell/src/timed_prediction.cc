@@ -16,4 +16,14 @@ std::optional<std::string> TimedPrediction::Build(const collision::HumanBodyMode
   return std::nullopt;
 }
 
+std::optional<std::string> KeepNewestPrediction(const collision::HumanBodyModel& body, BodyId body_id,
+                                                const collision::JointMixture& in, double stale_after_s,
+                                                PerBody<TimedPrediction>* store) {
+  TimedPrediction p;
+  if (auto why = TimedPrediction::Build(body, in, &p)) return why;
+  store->Expire(in.t0_ns, static_cast<int64_t>(stale_after_s * 1e9));
+  if (auto why = store->Update(body_id, p.t0_ns(), std::move(p))) return "prediction: " + *why;
+  return std::nullopt;
+}
+
 }  // namespace iplan::cell

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/cell/people.h"
+#include "iplan/cell/timed_prediction.h"
 
 namespace iplan::cell {
 namespace {
@@ -73,6 +74,46 @@ TEST(UnionBound, IsTheSumOfThePersonsBoundsCappedAtOne) {
   EXPECT_DOUBLE_EQ(UnionBound({0.6, 0.7}), 1.0);         // capped
   EXPECT_DOUBLE_EQ(UnionBound({0.25, 0.25, 0.25, 0.25}), 1.0);
   EXPECT_DOUBLE_EQ(UnionBound({0.1, 0.0, 0.2, 0.05}), 0.35);
+}
+
+// One action, two steps, every joint of the default upper body at the
+// origin with 1 cm standard deviation.
+collision::JointMixture StillPerson(const collision::HumanBodyModel& body, int64_t t0_ns) {
+  collision::JointMixture m;
+  m.t0_ns = t0_ns;
+  m.time_step = 0.1;
+  m.num_steps = 2;
+  m.joint_names = body.params().joints;
+  m.actions = {"still"};
+  m.probabilities = {1.0};
+  m.means = {std::vector<Eigen::Vector3d>(2 * body.num_joints(), Eigen::Vector3d::Zero())};
+  m.covariances = {std::vector<Eigen::Matrix3d>(2 * body.num_joints(), 1e-4 * Eigen::Matrix3d::Identity())};
+  return m;
+}
+
+TEST(KeepNewestPrediction, BuildsExpiresAndRefusesLikeTheStore) {
+  const collision::HumanBodyModel body(collision::HumanBodyParams::DefaultUpperBody());
+  PerBody<TimedPrediction> store;
+  EXPECT_FALSE(KeepNewestPrediction(body, 1, StillPerson(body, 10 * kSecond), 1.0, &store));
+  ASSERT_NE(store.Find(1), nullptr);
+  EXPECT_EQ(store.Find(1)->value.t0_ns(), 10 * kSecond);
+  EXPECT_EQ(store.Find(1)->value.num_steps(), 2);
+  // Out of order: refused with the store's reason, the newest kept.
+  const auto late = KeepNewestPrediction(body, 1, StillPerson(body, 9 * kSecond), 1.0, &store);
+  ASSERT_TRUE(late);
+  EXPECT_EQ(late->rfind("prediction: ", 0), 0u) << *late;
+  EXPECT_NE(late->find("out of order"), std::string::npos) << *late;
+  EXPECT_EQ(store.Find(1)->value.t0_ns(), 10 * kSecond);
+  // A mixture that cannot be built: refused before anything expires.
+  collision::JointMixture bad = StillPerson(body, 30 * kSecond);
+  bad.actions.clear();
+  EXPECT_TRUE(KeepNewestPrediction(body, 2, bad, 1.0, &store));
+  EXPECT_EQ(store.size(), 1);
+  // Another person 1.5 s later: the first, older than 1 s, is dropped.
+  EXPECT_FALSE(KeepNewestPrediction(body, 2, StillPerson(body, 11 * kSecond + kSecond / 2), 1.0, &store));
+  EXPECT_EQ(store.Find(1), nullptr);
+  ASSERT_NE(store.Find(2), nullptr);
+  EXPECT_EQ(store.size(), 1);
 }
 
 }  // namespace

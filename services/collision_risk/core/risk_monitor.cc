@@ -87,11 +87,7 @@ std::optional<std::string> RiskMonitor::UpdateSkeleton(cell::BodyId body_id, int
 }
 
 std::optional<std::string> RiskMonitor::UpdatePrediction(cell::BodyId body_id, const PredictionInput& in) {
-  cell::TimedPrediction p;
-  if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
-  predictions_.Expire(in.t0_ns, static_cast<int64_t>(params_.stale_after * 1e9));
-  if (auto why = predictions_.Update(body_id, p.t0_ns(), std::move(p))) return "prediction: " + *why;
-  return std::nullopt;
+  return cell::KeepNewestPrediction(body_, body_id, in, params_.stale_after, &predictions_);
 }
 
 Eigen::VectorXd RiskMonitor::RobotConfigurationAt(int64_t t_ns) const {

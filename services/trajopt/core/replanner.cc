@@ -62,11 +62,7 @@ std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const s
 }
 
 std::optional<std::string> Replanner::UpdatePrediction(cell::BodyId body_id, const collision::JointMixture& in) {
-  cell::TimedPrediction p;
-  if (auto why = cell::TimedPrediction::Build(body_, in, &p)) return why;
-  predictions_.Expire(in.t0_ns, static_cast<int64_t>(params_.stale_after * 1e9));
-  if (auto why = predictions_.Update(body_id, p.t0_ns(), std::move(p))) return "prediction: " + *why;
-  return std::nullopt;
+  return cell::KeepNewestPrediction(body_, body_id, in, params_.stale_after, &predictions_);
 }
 
 TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int64_t now_ns) {

@@ -21,6 +21,7 @@
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/joint_mixture.h"
 #include "iplan/collision/trajectory_bound.h"
+#include "iplan/cell/people.h"
 
 namespace iplan::cell {
 
@@ -55,5 +56,15 @@ class TimedPrediction {
   std::vector<std::string> actions_;
   collision::HumanPrediction spheres_;
 };
+
+/// What the collision-risk monitor and the replanner both do with a
+/// received prediction: drop the people whose newest prediction is older
+/// than `stale_after_s` (s) at its observation time, build it for `body`, and
+/// keep it as `body_id`'s newest in `store`. Returns why it was refused (the
+/// build's reason, or "prediction: " and the store's: out of order, too many
+/// people); the store then keeps what it had, less the expired. Allocates.
+std::optional<std::string> KeepNewestPrediction(const collision::HumanBodyModel& body, BodyId body_id,
+                                                const collision::JointMixture& in, double stale_after_s,
+                                                PerBody<TimedPrediction>* store);
 
 }  // namespace iplan::cell
