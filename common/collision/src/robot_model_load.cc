@@ -40,11 +40,17 @@ RobotModel LoadRobotModel(const std::string& path, const RobotModelOptions& opti
   with.default_jerk = o.jerk;
   for (const auto& l : o.locked_joints) with.locked_joints[l.name] = l.value;
   const std::string urdf = top.ResolvePath(o.urdf);
+  RobotModel model;
   try {
-    return LoadRobotModelFromUrdf(urdf, with);
+    model = LoadRobotModelFromUrdf(urdf, with);
   } catch (const std::runtime_error& e) {
     throw std::runtime_error(std::string(e.what()) + " (named by " + path + ")");
   }
+  if (!o.tool_link.empty() && model.FindLink(o.tool_link) < 0) {
+    throw std::runtime_error(path + ": key 'tool_link': " + urdf + " has no link '" + o.tool_link + "'");
+  }
+  model.tool_link = o.tool_link;
+  return model;
 }
 
 }  // namespace iplan::collision

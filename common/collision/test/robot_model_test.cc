@@ -495,6 +495,14 @@ TEST(RobotModelTest, LoadRobotModelTakesYamlUrdfAndOverlay) {
   EXPECT_LT((dy.X_WL[static_cast<std::size_t>(yaml.FindLink("panda_link8"))].translation() -
              du.X_WL[static_cast<std::size_t>(over.FindLink("panda_link8"))].translation()).norm(), 1e-6);
 
+  EXPECT_EQ(over.tool_link, "");
+  // The tool link the overlay names, checked against the URDF.
+  std::ofstream(overlay) << "urdf: " << kUrdf << "\ntool_link: panda_hand\n";
+  EXPECT_EQ(LoadRobotModel(overlay).tool_link, "panda_hand");
+  std::ofstream(overlay) << "urdf: " << kUrdf << "\ntool_link: panda_gripper\n";
+  ExpectThrowsWith([&] { LoadRobotModel(overlay); }, overlay + ": key 'tool_link': ");
+  ExpectThrowsWith([&] { LoadRobotModel(overlay); }, "no link 'panda_gripper'");
+
   // Errors name the file: a missing URDF, an unknown key, a bad limit.
   std::ofstream(overlay) << "urdf: nowhere.urdf\n";
   EXPECT_THROW(LoadRobotModel(overlay), std::runtime_error);

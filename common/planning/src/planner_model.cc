@@ -124,7 +124,7 @@ namespace iplan::planning {
 PlannerParams AdaptLinksToRobot(PlannerParams params, const collision::RobotModel& robot) {
   if (robot.link_names.empty()) return params;
   if (robot.FindLink(params.end_effector_link) < 0) {
-    params.end_effector_link = robot.link_names.back();
+    params.end_effector_link = robot.tool_link.empty() ? robot.link_names.back() : robot.tool_link;
     params.end_effector_offset = {0.0, 0.0, 0.0};
   }
   bool all_known = true;

@@ -503,6 +503,27 @@ TEST_F(PlannerTest, BadInputsThrowWithTheValues) {
   expect_throw(req, "num_frozen = 2 needs a warm_start");
 }
 
+TEST(PlannerConstruction, AdaptLinksToRobotGivesAnotherArmItsOwnLinks) {
+  const PlannerParams p;
+  // The Panda has the links the defaults name: nothing changes.
+  const PlannerParams panda = AdaptLinksToRobot(p, testing::LoadPanda());
+  EXPECT_EQ(panda.end_effector_link, p.end_effector_link);
+  EXPECT_EQ(panda.end_effector_offset, p.end_effector_offset);
+  EXPECT_EQ(panda.allowed_collisions, p.allowed_collisions);
+  // The UR5e: its tool0, its base and shoulder on the table; it plans.
+  collision::RobotModel ur = collision::LoadRobotModel(std::string(IPLAN_SHARED_DIR) + "/robots/ur5e/ur5e.urdf");
+  const PlannerParams q = AdaptLinksToRobot(p, ur);
+  EXPECT_EQ(q.end_effector_link, "tool0");
+  EXPECT_EQ(q.end_effector_offset, (std::array<double, 3>{0.0, 0.0, 0.0}));
+  const std::vector<std::pair<std::string, std::string>> base = {{"base_link_inertia", "table"},
+                                                                   {"shoulder_link", "table"}};
+  EXPECT_EQ(q.allowed_collisions, base);
+  EXPECT_NO_THROW(Planner(ur, testing::LoadCell(), q));
+  // A tool link the robot's file names wins over the last link.
+  ur.tool_link = "wrist_3_link";
+  EXPECT_EQ(AdaptLinksToRobot(p, ur).end_effector_link, "wrist_3_link");
+}
+
 TEST(PlannerConstruction, RejectsBadParamsAndNames) {
   PlannerParams p;
   p.end_effector_link = "nope";

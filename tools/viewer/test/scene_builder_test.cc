@@ -53,6 +53,29 @@ TEST(SceneBuilder, RobotSpheresFollowTheJoints) {
   EXPECT_EQ(b.rejected(), 0u);
 }
 
+// Another arm from its URDF (mesh collision geometry): the viewer draws the
+// spheres every check uses, where forward kinematics puts them.
+TEST(SceneBuilder, DrawsTheUr5eFromItsUrdf) {
+  SceneBuilder b(LoadCellModel(std::string(IPLAN_SHARED_DIR) + "/robots/ur5e/ur5e.urdf", kConfig + "/scenes/cell.yaml",
+                               kConfig + "/humans/upper_body.yaml"));
+  const collision::RobotModel& ur = b.model().robot;
+  ASSERT_EQ(ur.nq, 6);
+  msg::JointState js;
+  js.header.frame_id = "world";
+  js.name = ur.JointNames();
+  js.position = {0.3, -1.2, 1.1, -1.5, -1.57, 0.2};
+  const nlohmann::json* scene = b.Robot(js);
+  ASSERT_NE(scene, nullptr) << b.last_rejection();
+  const auto& spheres = (*scene)["entities"][0]["spheres"];
+  ASSERT_EQ(spheres.size(), ur.spheres.size());
+  collision::RobotData data(ur);
+  collision::CalcForwardKinematics(ur, Eigen::Map<const Eigen::VectorXd>(js.position.data(), 6), &data);
+  for (std::size_t i = 0; i < ur.spheres.size(); ++i) {
+    EXPECT_LT((At(spheres[i]) - data.p_WS.col(static_cast<int>(i))).norm(), 1e-9) << i;
+  }
+  EXPECT_EQ(b.rejected(), 0u);
+}
+
 TEST(SceneBuilder, RefusesJointStatesThatDoNotFit) {
   SceneBuilder b(Model());
   msg::JointState js = Joints(0.0);

@@ -83,6 +83,10 @@ struct RobotModel {
   /// Joint index for each configuration variable (size nq).
   std::vector<int> q_joints;
   std::vector<CollisionSphere> spheres;
+  /// The link whose pose a pose goal gives (the tool), when the robot's file
+  /// says (a URDF overlay's tool_link); empty: not said (planning::
+  /// AdaptLinksToRobot then takes the last link).
+  std::string tool_link;
   /// One entry per collision shape of the source file.
   std::vector<ShapeCoverEntry> cover_report;
 
@@ -185,6 +189,7 @@ RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptio
 /// paths relative to it), so that a cell's configs name a URDF robot the
 /// way they name a YAML one:
 ///   urdf: ur5e/ur5e.urdf
+///   tool_link: tool0
 ///   locked_joints: [{name: panda_finger_joint1, value: 0.0}]
 ///   acceleration: 7.5   # rad/s^2 (m/s^2), every joint
 ///   jerk: 3750.0        # rad/s^3 (m/s^3), every joint
@@ -199,12 +204,14 @@ struct UrdfOverlay {
     }
   };
   std::string urdf;
+  std::string tool_link;
   std::vector<LockedJoint> locked_joints;
   double acceleration = RobotModelOptions{}.default_acceleration;
   double jerk = RobotModelOptions{}.default_jerk;
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP_REQUIRED(urdf, "the URDF file, relative to this file"));
+    a->Visit(IPLAN_NVP(tool_link, "link whose pose pose goals give (default: none said; the planner takes the last link)"));
     a->Visit(IPLAN_NVP(locked_joints, "joints held at a fixed value (e.g. gripper fingers); they leave q"));
     a->Visit(IPLAN_NVP(acceleration, "rad/s^2 (m/s^2) limit of every joint (URDF has none), > 0"));
     a->Visit(IPLAN_NVP(jerk, "rad/s^3 (m/s^3) limit of every joint (URDF has none), > 0"));

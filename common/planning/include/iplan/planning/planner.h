@@ -214,8 +214,9 @@ class Planner {
 
 /// PlannerParams' defaults name the Panda's links (end_effector_link
 /// panda_link8 and its base pairs allowed on the table). For a robot that
-/// lacks them: end_effector_link becomes the robot's last link (the URDF's
-/// last in tree order, e.g. the UR5e's tool0) with offset 0, and
+/// lacks them: end_effector_link becomes its tool_link (a URDF overlay's),
+/// else its last link (the URDF's last in tree order, e.g. the UR5e's
+/// tool0), with offset 0; and
 /// allowed_collisions its first two links with spheres against "table".
 /// Parameters whose links the robot has are returned unchanged. For tools
 /// and benchmarks that plan without a robot-specific config; a config that
