@@ -4,11 +4,13 @@
 
 #include <cstdint>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include <Eigen/Core>
 
 #include "iplan/cell/ssm.h"
+#include "iplan/core/name_value.h"
 #include "iplan/cell/status.h"
 #include "iplan/collision/joint_mixture.h"
 #include "iplan/msg/types.h"
@@ -37,6 +39,18 @@ struct TrajectoryOutput {
   /// Fill velocities (rad/s) from the positions (central differences inside,
   /// one-sided at the ends, zero where the last position is held).
   bool velocities = true;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(zero_stamp, "header.stamp 0 (start on receipt, the joint_trajectory_controller way); false: the time of waypoint 0"));
+    a->Visit(IPLAN_NVP(min_duration, "s; shorter trajectories are extended by holding their last position, in [0, 60]"));
+    a->Visit(IPLAN_NVP(velocities, "fill velocities from the positions"));
+  }
+  /// "" when valid, else the reason.
+  std::string Validate() const {
+    if (!(min_duration >= 0.0 && min_duration <= 60.0)) return "output.min_duration must be in [0, 60] s";
+    return "";
+  }
 };
 
 /// A trajectory message: `positions` is nq x (n + 1), waypoint i at

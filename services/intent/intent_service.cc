@@ -15,6 +15,8 @@
 #include <memory>
 
 #include "core/intent_estimator.h"
+#include "core/intent_settings.h"
+#include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 #include "iplan/intent/baseline_predictors.h"
 #include "iplan/intent/model_io.h"
@@ -29,27 +31,17 @@ using framework::Result;
 class IntentService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    std::string model_path;
-    std::vector<std::string> joints;
-    double rate = 0;
-    const bool have_model = config.Require("model", &model_path);
-    const bool have_joints = config.Require("joints", &joints, framework::Check<std::vector<std::string>>(
-        [](const std::vector<std::string>& v) { return v.empty() ? "must name at least one joint" : ""; }));
-    const bool have_rate = config.Require("rate_hz", &rate, framework::Positive<double>());
-    config.Read("body_timeout", &params_.body_timeout, framework::Positive<double>());
-    config.Read("max_gap", &params_.max_gap, framework::Positive<double>());
-    config.Read("max_bodies", &params_.max_bodies, framework::InRange(1, 1000));
-    config.Read("predictor", &predictor_, framework::OneOf({"model", "constant-position", "constant-velocity"}));
-    framework::ConfigSection bc = config.Section("baseline");
-    bc.Read("window", &baseline_.window, framework::Positive<double>());
-    bc.Read("sensor_noise_std", &baseline_.sensor_noise_std, framework::NonNegative<double>());
-    bc.Read("speed_std", &baseline_.speed_std, framework::NonNegative<double>());
-    bc.Read("acceleration_std", &baseline_.acceleration_std, framework::NonNegative<double>());
-    bc.Read("covariance", &baseline_covariance_, framework::OneOf({"model", "growth"}));
-    if (!have_model || !have_joints || !have_rate) return Result::Fail("incomplete configuration");
-    if (const std::string why = params_.Validate(); !why.empty()) return Result::Fail(why);
+    IntentSettings settings;
+    core::ReadParams(config, &settings);  // every range: IntentSettings::Validate
+    if (const std::string why = settings.Validate(); !why.empty()) return Result::Fail(why);
+    params_ = settings.estimator;
+    predictor_ = settings.predictor;
+    settings.baseline.ApplyTo(&baseline_);
+    baseline_covariance_ = settings.baseline.covariance;
+    const std::vector<std::string>& joints = settings.joints;
+    const double rate = settings.rate_hz;
 
-    const std::string path = config.ResolvePath(model_path);
+    const std::string path = config.ResolvePath(settings.model);
     intent::ModelExpectation expected;
     expected.joints = joints;
     expected.rate = rate;

@@ -8,28 +8,20 @@ namespace iplan::trajopt {
 
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   TrajoptConfig c;
-  std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml",
-              scene_file = "scenes/cell.yaml";
-  config.Read("robot", &robot_file);
-  config.Read("human_body", &body_file);
-  config.Read("scene", &scene_file);
+  // The planner file's own overrides (--set trajopt.planner.KEY=VALUE), for
+  // LoadPlannerParams; the key itself is declared in TrajoptSettings.
   c.planner_overrides = config.ReadParamsFile("planner", "planner.yaml", &c.planner_file);
-  if (config.Has("safety")) {
-    std::string safety_file;
-    config.Read("safety", &safety_file);
-    c.safety_file = config.ResolvePath(safety_file);
-  }
-  config.Read("use_prediction", &c.use_prediction);
-  config.Read("replan_on_prediction", &c.replan_on_prediction);
-  config.Read("obstacle_timeout", &c.obstacle_timeout, framework::InRange(0.1, 60.0));
-  framework::ConfigSection output = config.Section("output");
-  output.Read("zero_stamp", &c.output.zero_stamp);
-  output.Read("min_duration", &c.output.min_duration, framework::InRange(0.0, 60.0));
-  output.Read("velocities", &c.output.velocities);
+  TrajoptSettings s;
+  core::ReadParams(config, &s);            // ranges: TrajoptSettings::Validate
   core::ReadParams(config, &c.replanner);  // ranges: ReplannerParams::Validate
-  c.robot_file = config.ResolvePath(robot_file);
-  c.human_body_file = config.ResolvePath(body_file);
-  c.scene_file = config.ResolvePath(scene_file);
+  c.use_prediction = s.use_prediction;
+  c.replan_on_prediction = s.replan_on_prediction;
+  c.obstacle_timeout = s.obstacle_timeout;
+  c.output = s.output;
+  if (s.safety) c.safety_file = config.ResolvePath(*s.safety);
+  c.robot_file = config.ResolvePath(s.robot);
+  c.human_body_file = config.ResolvePath(s.human_body);
+  c.scene_file = config.ResolvePath(s.scene);
   return c;
 }
 

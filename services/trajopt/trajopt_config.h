@@ -5,14 +5,50 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "common/adapters.h"
 #include "core/replanner.h"
+#include "iplan/core/name_value.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner.h"
 
 namespace iplan::trajopt {
+
+/// The keys of section `trajopt` (config/trajopt.yaml) besides
+/// ReplannerParams' (which sit in the same section), declared once; the
+/// file names as written (ReadTrajoptConfig resolves them into
+/// TrajoptConfig). `iplan config defaults trajopt` lists both.
+struct TrajoptSettings {
+  std::string robot = "robots/panda.yaml";
+  std::string human_body = "humans/upper_body.yaml";
+  std::string scene = "scenes/cell.yaml";
+  std::string planner = "planner.yaml";
+  std::optional<std::string> safety;
+  bool use_prediction = true;
+  bool replan_on_prediction = true;
+  double obstacle_timeout = 2.0;
+  services::TrajectoryOutput output;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(robot, "robot model file (docs/robots.md), relative to the configuration file"));
+    a->Visit(IPLAN_NVP(human_body, "human body model file, relative to the configuration file"));
+    a->Visit(IPLAN_NVP(scene, "static scene file, relative to the configuration file"));
+    a->Visit(IPLAN_NVP(planner, "planner parameter file (PlannerParams), relative to the configuration file"));
+    a->Visit(IPLAN_NVP(safety, "the cell's safety file (delta_cl, iso_ts_15066 for the planner); absent: the planner file's"));
+    a->Visit(IPLAN_NVP(use_prediction, "false: plans ignore the person (only the monitor protects), for ablations"));
+    a->Visit(IPLAN_NVP(replan_on_prediction, "a cycle starts when a prediction arrives; false: only on the planning_step tick"));
+    a->Visit(IPLAN_NVP(obstacle_timeout, "s a box of /iplan/obstacles stays in the plans' scene after it was last seen, in [0.1, 60]"));
+    a->Visit(IPLAN_NVP(output, "how trajectories are stamped and shaped (docs/topics.md)"));
+  }
+  /// "" when valid, else the reason.
+  std::string Validate() const {
+    if (!(obstacle_timeout >= 0.1 && obstacle_timeout <= 60.0)) return "obstacle_timeout must be in [0.1, 60] s";
+    return output.Validate();
+  }
+};
 
 struct TrajoptConfig {
   ReplannerParams replanner;

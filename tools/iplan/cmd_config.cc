@@ -7,6 +7,7 @@
 
 #include "collision_risk/core/risk_monitor.h"
 #include "command_registry.h"
+#include "intent/core/intent_settings.h"
 #include "robot_sim/core/robot_sim_settings.h"
 #include "supervisor/core/supervisor_settings.h"
 #include "supervisor/core/task_planner.h"
@@ -31,6 +32,9 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
        {"config/safety.yaml (top level, named by `safety:` in collision_risk.yaml and trajopt.yaml); SafetyParams: "
         "the one source of delta_cl and iso_ts_15066 for monitor, planner, benchmark and cell-check",
         [] { return iplan::core::DescribeParams(iplan::cell::SafetyParams{}); }}},
+      {"intent",
+       {"config/intent.yaml, section intent; IntentSettings (IntentEstimatorParams' keys inline)",
+        [] { return iplan::core::DescribeParams(iplan::intent_service::IntentSettings{}); }}},
       {"collision-risk",
        {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066; with "
         "`safety:` both come from the safety file)",
@@ -38,6 +42,14 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"replanner",
        {"config/trajopt.yaml, section trajopt; ReplannerParams",
         [] { return iplan::core::DescribeParams(iplan::trajopt::ReplannerParams{}); }}},
+      {"trajopt",
+       {"config/trajopt.yaml, section trajopt; TrajoptSettings, then ReplannerParams (same section)",
+        [] {
+          std::vector<ParamDoc> docs = iplan::core::DescribeParams(iplan::trajopt::TrajoptSettings{});
+          const std::vector<ParamDoc> replanner = iplan::core::DescribeParams(iplan::trajopt::ReplannerParams{});
+          docs.insert(docs.end(), replanner.begin(), replanner.end());
+          return docs;
+        }}},
       {"supervisor",
        {"config/supervisor.yaml, section supervisor; SupervisorSettings (QLearningParams' keys inline)",
         [] { return iplan::core::DescribeParams(iplan::supervisor::SupervisorSettings{}); }}},

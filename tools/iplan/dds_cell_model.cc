@@ -5,7 +5,9 @@
 #include <fstream>
 #include <sstream>
 
+#include "intent/core/intent_settings.h"
 #include "perception/core/synthetic_person.h"
+#include "iplan/core/params.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/framework/config.h"
 #include "iplan/intent/intent_model.h"
@@ -66,18 +68,14 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
     throw std::runtime_error(perception_yaml + ": key 'perception.synthetic': " + why);
   }
   // What the intent service expects.
+  // What the intent service expects, read and checked as the service does.
   framework::ConfigSection iconf = framework::ConfigSection::Load(intent_yaml);
-  framework::ConfigSection isec = iconf.Section("intent");
-  std::string model_file;
-  std::vector<std::string> joints;
-  double rate = 15;
-  isec.Read("model", &model_file);
-  isec.Read("joints", &joints);
-  isec.Read("rate_hz", &rate);
-  if (model_file.empty() || joints.empty()) {
-    throw std::runtime_error(intent_yaml + ": keys 'intent.model' and 'intent.joints' are required");
-  }
-  const fs::path path = iconf.ResolvePath(model_file);
+  intent_service::IntentSettings isettings;
+  core::ReadParams(iconf.Section("intent"), &isettings);
+  if (!iconf.Problems().empty()) throw std::runtime_error(iconf.Problems().front());
+  const std::vector<std::string>& joints = isettings.joints;
+  const double rate = isettings.rate_hz;
+  const fs::path path = iconf.ResolvePath(isettings.model);
   const std::string key = ModelKey(person, joints, rate);
 
   CellModelResult result;

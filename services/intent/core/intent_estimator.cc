@@ -13,7 +13,7 @@ std::string IntentEstimatorParams::Validate() const {
     return "body_timeout must be > 0 s, got " + std::to_string(body_timeout);
   }
   if (!(max_gap > 0) || !std::isfinite(max_gap)) return "max_gap must be > 0 s, got " + std::to_string(max_gap);
-  if (max_bodies < 1) return "max_bodies must be >= 1, got " + std::to_string(max_bodies);
+  if (max_bodies < 1 || max_bodies > 1000) return "max_bodies must be in [1, 1000], got " + std::to_string(max_bodies);
   return "";
 }
 

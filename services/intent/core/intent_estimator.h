@@ -31,6 +31,7 @@
 
 #include <Eigen/Core>
 
+#include "iplan/core/name_value.h"
 #include "iplan/intent/belief_filter.h"
 #include "iplan/intent/intent_model.h"
 
@@ -59,6 +60,12 @@ struct IntentEstimatorParams {
   /// Bodies tracked at once; frames of further bodies are rejected.
   int max_bodies = 8;
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(body_timeout, "s without a skeleton after which a body is forgotten, > 0"));
+    a->Visit(IPLAN_NVP(max_gap, "s; a longer gap between two skeletons of a body restarts its history, > 0"));
+    a->Visit(IPLAN_NVP(max_bodies, "bodies tracked at once; skeletons of more are rejected, in [1, 1000]"));
+  }
   /// Empty when valid, else the offending field and value.
   std::string Validate() const;
 };

@@ -1,10 +1,14 @@
 #include "../core/intent_estimator.h"
+#include "../core/intent_settings.h"
 
 #include <cmath>
+#include <fstream>
 #include <limits>
 #include <random>
 
 #include <gtest/gtest.h>
+
+#include "iplan/core/params.h"
 
 namespace iplan::intent_service {
 namespace {
@@ -353,6 +357,58 @@ TEST(IntentEstimatorParamsTest, InvalidParamsAreNamed) {
   p.max_bodies = 0;
   EXPECT_NE(p.Validate().find("max_bodies"), std::string::npos);
   EXPECT_THROW(IntentEstimator(nullptr, {}), std::invalid_argument);
+}
+
+TEST(IntentSettingsTest, TheDocumentedDefaultsAreTheDeclaredOnesAndTheCellsFileIsValid) {
+  EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
+                                          core::DescribeParams(IntentSettings{})),
+            "");
+  // The cell's own file, read as the service reads it.
+  core::ConfigSection file = core::ConfigSection::Load(std::string(IPLAN_SOURCE_DIR) + "/config/intent.yaml");
+  IntentSettings s;
+  core::ReadParams(file.Section("intent"), &s);
+  EXPECT_TRUE(file.Problems().empty()) << file.Problems().front();
+  EXPECT_EQ(s.Validate(), "");
+  EXPECT_EQ(s.model, "models/cell_intent.model");
+  EXPECT_EQ(s.joints.size(), 9u);
+  EXPECT_EQ(s.rate_hz, 15.0);
+  EXPECT_EQ(s.estimator.max_bodies, 8);
+  EXPECT_EQ(s.baseline.covariance, "model");
+}
+
+TEST(IntentSettingsTest, BadValuesAreNamed) {
+  IntentSettings s;
+  s.model = "m.model";
+  s.joints = {"wrist_r"};
+  s.rate_hz = 15;
+  EXPECT_EQ(s.Validate(), "");
+  IntentSettings t = s;
+  t.rate_hz = 0;
+  EXPECT_NE(t.Validate().find("rate_hz"), std::string::npos);
+  t = s;
+  t.joints.clear();
+  EXPECT_NE(t.Validate().find("joints"), std::string::npos);
+  t = s;
+  t.estimator.max_bodies = 1001;
+  EXPECT_NE(t.Validate().find("max_bodies must be in [1, 1000]"), std::string::npos) << t.Validate();
+  t = s;
+  t.predictor = "oracle";
+  EXPECT_NE(t.Validate().find("'oracle'"), std::string::npos);
+  t = s;
+  t.baseline.covariance = "none";
+  EXPECT_NE(t.Validate().find("baseline.covariance"), std::string::npos);
+  t = s;
+  t.baseline.window = -1;
+  EXPECT_NE(t.Validate().find("baseline.window"), std::string::npos) << t.Validate();
+  // A missing required key is named by the reader, with the file.
+  const std::string path = ::testing::TempDir() + "/intent_missing_model.yaml";
+  { std::ofstream(path) << "intent:\n  joints: [a]\n  rate_hz: 15\n"; }
+  core::ConfigSection file = core::ConfigSection::Load(path);
+  IntentSettings u;
+  core::ReadParams(file.Section("intent"), &u);
+  ASSERT_FALSE(file.Problems().empty());
+  EXPECT_NE(file.Problems().front().find("key 'intent.model': is required but missing"), std::string::npos)
+      << file.Problems().front();
 }
 
 }  // namespace
