@@ -12,6 +12,7 @@
 
 #include "common/cloud_adapters.h"
 #include "core/cloud_stage.h"
+#include "core/cloud_settings.h"
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
@@ -28,19 +29,16 @@ using SI = const dds::SampleInfo&;
 class CloudService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    CloudStageParams p;
-    std::string pipeline_file, robot_file = "robots/panda.yaml";
+    std::string pipeline_file;
     const core::Overrides overrides = config.ReadParamsFile("pipeline", "cloud_pipeline.yaml", &pipeline_file);
-    config.Read("robot", &robot_file);
-    p.X_WS = services::ReadCameraPose(config.Section("camera"));
-    p.noise = services::ReadDepthNoise(config.Section("noise"));
-    ReadBox(config, &p);
-    config.Read("human_voxel", &p.human_voxel, framework::NonNegative<double>());
-    config.Read("joint_state_timeout", &joint_state_timeout_, framework::Positive<double>());
-    config.Read("frame_id", &frame_id_);
-    core::ReadParams(config.Section("tracking"), &p.tracking);
-    human_voxel_ = p.human_voxel;
+    CloudSettings settings;
+    core::ReadParams(config, &settings);  // every range: CloudSettings::Validate
     if (!config.Problems().empty()) return Result::Ok();  // reported by the configuration check
+    CloudStageParams p = settings.StageParams();
+    joint_state_timeout_ = settings.joint_state_timeout;
+    frame_id_ = settings.frame_id;
+    human_voxel_ = p.human_voxel;
+    const std::string& robot_file = settings.robot;
     try {
       if (!overrides.empty()) throw std::runtime_error("--set into " + pipeline_file + " is not supported; edit the file");
       p.pipeline = cloud::LoadCloudParams(pipeline_file);
@@ -69,15 +67,6 @@ class CloudService : public framework::Service {
   Result OnDeactivate(Node&) override { return Result::Ok(); }
 
  private:
-  static void ReadBox(ConfigSection& config, CloudStageParams* p) {
-    auto three = framework::Check<std::vector<double>>(
-        [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; });
-    std::vector<double> lo(p->workspace_min.data(), p->workspace_min.data() + 3);
-    std::vector<double> hi(p->workspace_max.data(), p->workspace_max.data() + 3);
-    if (config.Read("workspace_min", &lo, three)) p->workspace_min = Eigen::Vector3d(lo[0], lo[1], lo[2]);
-    if (config.Read("workspace_max", &hi, three)) p->workspace_max = Eigen::Vector3d(hi[0], hi[1], hi[2]);
-  }
-
   void OnJointState(Node& node, const msg::JointState& m) {
     if (joint_names_.empty()) return;
     std::vector<int> index;

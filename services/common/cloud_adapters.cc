@@ -3,6 +3,8 @@
 #include <cmath>
 #include <cstring>
 
+#include "iplan/core/params.h"
+
 namespace iplan::services {
 namespace {
 
@@ -97,29 +99,14 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
 }
 
 Eigen::Isometry3d ReadCameraPose(core::ConfigSection camera) {
-  auto three = core::Check<std::vector<double>>(
-      [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; });
-  std::vector<double> position = {0.45, 1.3, 1.1}, look_at = {0.6, 0.0, 0.1};
-  camera.Read("position", &position, three);
-  camera.Read("look_at", &look_at, three);
-  try {
-    if (position.size() == 3 && look_at.size() == 3) {
-      return cloud::CameraPoseLookAt({position[0], position[1], position[2]}, {look_at[0], look_at[1], look_at[2]});
-    }
-  } catch (const std::exception& e) {
-    camera.AddError("look_at", e.what());
-  }
-  return Eigen::Isometry3d::Identity();
+  cloud::CameraLookAt c;
+  core::ReadParams(camera, &c);  // a pose that cannot be: CameraLookAt::Validate
+  return c.Validate().empty() ? c.Pose() : Eigen::Isometry3d::Identity();
 }
 
 cloud::DepthNoiseParams ReadDepthNoise(core::ConfigSection noise) {
   cloud::DepthNoiseParams p;
-  noise.Read("axial_constant", &p.axial_constant);
-  noise.Read("axial_quadratic", &p.axial_quadratic);
-  noise.Read("axial_z0", &p.axial_z0);
-  noise.Read("lateral_px", &p.lateral_px);
-  noise.Read("focal_px", &p.focal_px);
-  if (const std::string why = p.Validate(); !why.empty()) noise.AddProblem(why);
+  core::ReadParams(noise, &p);  // ranges: DepthNoiseParams::Validate
   return p;
 }
 

@@ -247,7 +247,7 @@ TEST(CloudServiceTest, BadConfigurationIsRefused) {
   const std::vector<std::pair<std::string, std::string>> cases = {
       {"cloud.tracking.static_frames=0", "static_frames must be >= 1"},
       {"cloud.tracking.bogus=1", "unknown key 'cloud.tracking.bogus'"},
-      {"cloud.camera.look_at=[0.45, 1.3, 1.1]", "key 'cloud.camera.look_at'"},
+      {"cloud.camera.look_at=[0.45, 1.3, 1.1]", "section 'cloud': camera: camera position and look-at point must be finite and apart"},
       {"cloud.workspace_min=[0, 0]", "key 'cloud.workspace_min'"},
       {"cloud.pipeline.stride=3", "is not supported; edit the file"},
       {"cloud.robot=missing.yaml", "missing.yaml"},

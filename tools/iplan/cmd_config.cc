@@ -6,6 +6,7 @@
 #include <string>
 
 #include "collision_risk/core/risk_monitor.h"
+#include "cloud/core/cloud_settings.h"
 #include "command_registry.h"
 #include "intent/core/intent_settings.h"
 #include "robot_sim/core/robot_sim_settings.h"
@@ -35,6 +36,9 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"intent",
        {"config/intent.yaml, section intent; IntentSettings (IntentEstimatorParams' keys inline)",
         [] { return iplan::core::DescribeParams(iplan::intent_service::IntentSettings{}); }}},
+      {"cloud",
+       {"config/cloud.yaml, section cloud; CloudSettings (the pipeline file is CloudParams)",
+        [] { return iplan::core::DescribeParams(iplan::cloud_service::CloudSettings{}); }}},
       {"collision-risk",
        {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066; with "
         "`safety:` both come from the safety file)",

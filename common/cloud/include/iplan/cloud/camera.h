@@ -6,11 +6,15 @@
 // (x right, y down, z along the view). Metres, pixels where named.
 #pragma once
 
+#include <array>
+#include <stdexcept>
 #include <string>
 #include <vector>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "iplan/core/name_value.h"
 
 namespace iplan::cloud {
 
@@ -32,6 +36,32 @@ struct CameraIntrinsics {
 /// x_S). Throws
 /// std::invalid_argument when the points coincide or the view is vertical.
 Eigen::Isometry3d CameraPoseLookAt(const Eigen::Vector3d& p_WC, const Eigen::Vector3d& p_WT);
+
+/// A camera's pose as a config gives it: where it is and what it looks at
+/// (m, W); Pose() is CameraPoseLookAt of the two.
+struct CameraLookAt {
+  std::array<double, 3> position = {0.45, 1.3, 1.1};
+  std::array<double, 3> look_at = {0.6, 0.0, 0.1};
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(position, "m, W; the camera's optical centre"));
+    a->Visit(IPLAN_NVP(look_at, "m, W; the point the view is centred on (image up as close to +z as the view allows)"));
+  }
+  /// X_WS. Throws std::invalid_argument as CameraPoseLookAt does.
+  Eigen::Isometry3d Pose() const {
+    return CameraPoseLookAt({position[0], position[1], position[2]}, {look_at[0], look_at[1], look_at[2]});
+  }
+  /// Empty when valid, else the reason (coinciding points, a vertical view).
+  std::string Validate() const {
+    try {
+      Pose();
+    } catch (const std::invalid_argument& e) {
+      return std::string("camera: ") + e.what();
+    }
+    return "";
+  }
+};
 
 /// Voxel-grid reduction (PCL VoxelGrid): the centroid of the points in each
 /// occupied cube of edge `leaf` (m, > 0) of a grid aligned with the points'

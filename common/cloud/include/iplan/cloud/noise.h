@@ -12,6 +12,8 @@
 // Frame: the sensor's optical frame S (z along the view), metres.
 #pragma once
 
+#include "iplan/core/name_value.h"
+
 #include <string>
 #include <vector>
 
@@ -28,6 +30,14 @@ struct DepthNoiseParams {
   double lateral_px = 0.8;          ///< pixels
   double focal_px = 525.0;          ///< f_x = f_y of a 640x480 Kinect v1, pixels
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(axial_constant, "m; sigma_z = axial_constant + axial_quadratic (z - axial_z0)^2"));
+    a->Visit(IPLAN_NVP(axial_quadratic, "1/m"));
+    a->Visit(IPLAN_NVP(axial_z0, "m, the depth of the smallest sigma_z"));
+    a->Visit(IPLAN_NVP(lateral_px, "pixels; lateral sigma = lateral_px z / focal_px"));
+    a->Visit(IPLAN_NVP(focal_px, "pixels, > 0"));
+  }
   /// Empty when valid, else the first problem ("focal_px must be > 0").
   std::string Validate() const;
 };
