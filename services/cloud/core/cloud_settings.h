@@ -5,6 +5,7 @@
 #pragma once
 
 #include <array>
+#include <cmath>
 #include <string>
 
 #include "cloud_stage.h"  // beside this header
@@ -46,8 +47,8 @@ struct CloudSettings {
     for (int k = 0; k < 3; ++k) {
       if (!(workspace_min[k] < workspace_max[k])) return "workspace_min must be below workspace_max on every axis";
     }
-    if (!(human_voxel >= 0 && human_voxel < 1e3)) return "human_voxel must be >= 0 m";
-    if (!(joint_state_timeout > 0 && joint_state_timeout < 1e3)) return "joint_state_timeout must be > 0 s";
+    if (!(human_voxel >= 0 && std::isfinite(human_voxel))) return "human_voxel must be >= 0 m";
+    if (!(joint_state_timeout > 0 && std::isfinite(joint_state_timeout))) return "joint_state_timeout must be > 0 s";
     if (std::string why = tracking.Validate(); !why.empty()) return "tracking: " + why;
     return "";
   }

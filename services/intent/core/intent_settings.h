@@ -3,6 +3,7 @@
 // model the service will load), listed by `iplan config defaults intent`.
 #pragma once
 
+#include <cmath>
 #include <string>
 #include <vector>
 
@@ -67,7 +68,7 @@ struct IntentSettings {
   std::string Validate() const {
     if (model.empty()) return "model must name the model file";
     if (joints.empty()) return "joints must name at least one joint";
-    if (!(rate_hz > 0) || !(rate_hz < 1e6)) return "rate_hz must be > 0, got " + std::to_string(rate_hz);
+    if (!(rate_hz > 0) || !std::isfinite(rate_hz)) return "rate_hz must be > 0, got " + std::to_string(rate_hz);
     if (std::string why = estimator.Validate(); !why.empty()) return why;
     if (predictor != "model" && predictor != "constant-position" && predictor != "constant-velocity") {
       return "predictor must be model, constant-position or constant-velocity, got '" + predictor + "'";
