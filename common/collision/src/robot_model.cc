@@ -12,9 +12,8 @@
 
 #include <urdf_parser/urdf_parser.h>
 
-#include "iplan/core/params.h"
-
 #include "check.h"
+#include "iplan/core/params.h"
 #include "robot_model_mesh.h"
 
 namespace iplan::collision {
@@ -22,9 +21,7 @@ namespace {
 
 constexpr double kPi = 3.14159265358979323846;
 
-[[noreturn]] void Fail(const std::string& path, const std::string& what) {
-  throw std::runtime_error(path + ": " + what);
-}
+[[noreturn]] void Fail(const std::string& path, const std::string& what) { throw std::runtime_error(path + ": " + what); }
 
 Eigen::Isometry3d ToIsometry(const urdf::Pose& pose) {
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
@@ -449,10 +446,12 @@ struct RobotFile {
   std::vector<SphereEntry> spheres;
   std::vector<CapsuleEntry> capsules;
   std::vector<BoxEntry> boxes;
+  std::string tool_link;
 
   template <class Archive>
   void Serialize(Archive* ar) {
     ar->Visit(IPLAN_NVP_REQUIRED(name, "robot name"));
+    ar->Visit(IPLAN_NVP(tool_link, "link whose pose pose goals give (default: none said; the planner takes the last link)"));
     ar->Visit(IPLAN_NVP_REQUIRED(convention, "modified_dh (the only one)"));
     ar->Visit(IPLAN_NVP_REQUIRED(base_link, "name of the base link"));
     ar->Visit(IPLAN_NVP_REQUIRED(joints, "movable joints, base to tip"));
@@ -592,6 +591,8 @@ RobotModel LoadRobotModelFromYaml(const std::string& path, const RobotModelOptio
   for (std::size_t l = 0; l < per_link.size(); ++l) {
     AddLinkSpheres(static_cast<int>(l), std::move(per_link[l]), options.remove_contained_spheres, &model);
   }
+  if (!f.tool_link.empty() && model.FindLink(f.tool_link) < 0) Fail(path, "key 'tool_link': no link '" + f.tool_link + "'");
+  model.tool_link = f.tool_link;
   Finalize(options, path, &model);
   return model;
 }

@@ -24,6 +24,28 @@ std::string VectorText(const Eigen::VectorXd& v) {
   return s.str();
 }
 
+// The robot-neutral names of a planner file made this robot's: "" for the
+// end effector, "<base>" in allowed_collisions.
+PlannerParams ResolveRobotLinks(PlannerParams params, const collision::RobotModel& robot) {
+  if (params.end_effector_link.empty() && !robot.link_names.empty())
+    params.end_effector_link = robot.tool_link.empty() ? robot.link_names.back() : robot.tool_link;
+  std::vector<std::pair<std::string, std::string>> pairs;
+  for (const auto& [link, object] : params.allowed_collisions) {
+    if (link != "<base>") {
+      pairs.emplace_back(link, object);
+      continue;
+    }
+    std::vector<int> with_spheres;
+    for (const auto& s : robot.spheres) with_spheres.push_back(s.link);
+    std::sort(with_spheres.begin(), with_spheres.end());
+    with_spheres.erase(std::unique(with_spheres.begin(), with_spheres.end()), with_spheres.end());
+    for (std::size_t i = 0; i < with_spheres.size() && i < 2; ++i)
+      pairs.emplace_back(robot.link_names[with_spheres[i]], object);
+  }
+  params.allowed_collisions = std::move(pairs);
+  return params;
+}
+
 PlannerModel::PlannerModel(collision::RobotModel robot_in, collision::SceneParams scene_in, PlannerParams params_in) {
   if (const std::string why = params_in.Validate(); !why.empty())
     throw std::invalid_argument("PlannerParams: " + why);
@@ -31,7 +53,7 @@ PlannerModel::PlannerModel(collision::RobotModel robot_in, collision::SceneParam
     throw std::invalid_argument("SceneParams: " + why);
   robot = std::move(robot_in);
   scene = std::move(scene_in);
-  params = std::move(params_in);
+  params = ResolveRobotLinks(std::move(params_in), robot);
   if (robot.nq < 1) throw std::invalid_argument("Planner: robot has no joints");
   chains = std::make_unique<KinematicChains>(robot);
   ee_link = robot.FindLink(params.end_effector_link);
@@ -128,17 +150,11 @@ PlannerParams AdaptLinksToRobot(PlannerParams params, const collision::RobotMode
     params.end_effector_offset = {0.0, 0.0, 0.0};
   }
   bool all_known = true;
-  for (const auto& [link, object] : params.allowed_collisions) all_known = all_known && robot.FindLink(link) >= 0;
+  for (const auto& [link, object] : params.allowed_collisions)
+    all_known = all_known && (link == "<base>" || robot.FindLink(link) >= 0);
   if (all_known) return params;
-  std::vector<int> with_spheres;
-  for (const auto& s : robot.spheres) with_spheres.push_back(s.link);
-  std::sort(with_spheres.begin(), with_spheres.end());
-  with_spheres.erase(std::unique(with_spheres.begin(), with_spheres.end()), with_spheres.end());
-  params.allowed_collisions.clear();
-  for (std::size_t i = 0; i < with_spheres.size() && i < 2; ++i) {
-    params.allowed_collisions.push_back({robot.link_names[with_spheres[i]], "table"});
-  }
-  return params;
+  params.allowed_collisions = {{"<base>", "table"}};
+  return internal::ResolveRobotLinks(params, robot);
 }
 
 }  // namespace iplan::planning

@@ -173,6 +173,11 @@ struct Selection {
   double first_feasible_time = -1.0;
 };
 
+/// The robot-neutral link names of a planner file made `robot`'s:
+/// end_effector_link "" becomes its tool_link (else its last link), the link
+/// "<base>" of allowed_collisions its first two links with spheres.
+PlannerParams ResolveRobotLinks(PlannerParams params, const collision::RobotModel& robot);
+
 struct PlannerModel {
   collision::RobotModel robot;
   collision::SceneParams scene;

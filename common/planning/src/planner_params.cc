@@ -60,7 +60,6 @@ std::string PlannerParams::Validate() const {
   if (!nonneg(position_margin)) return "position_margin must be >= 0, got " + Num(position_margin);
   if (!(limit_scale > 0.0 && limit_scale <= 1.0))
     return "limit_scale must be in (0, 1], got " + Num(limit_scale);
-  if (end_effector_link.empty()) return "end_effector_link must not be empty";
   for (double v : end_effector_offset)
     if (!std::isfinite(v)) return "end_effector_offset must be finite, got " + Num(v);
   if (ik_max_iterations < 1)

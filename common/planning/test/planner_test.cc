@@ -524,6 +524,27 @@ TEST(PlannerConstruction, AdaptLinksToRobotGivesAnotherArmItsOwnLinks) {
   EXPECT_EQ(AdaptLinksToRobot(p, ur).end_effector_link, "wrist_3_link");
 }
 
+TEST(PlannerConstruction, RobotNeutralLinkNamesBecomeTheRobotsOwn) {
+  PlannerParams p;
+  p.end_effector_link = "";
+  p.allowed_collisions = {{"<base>", "table"}, {"panda_link2", "pillar"}};
+  // The Panda's file names its flange as the tool link: the same planner as
+  // with the names written out.
+  const Planner panda(testing::LoadPanda(), testing::LoadCell(), p);
+  EXPECT_EQ(panda.params().end_effector_link, "panda_link8");
+  const std::vector<std::pair<std::string, std::string>> pairs = {
+      {"panda_link0", "table"}, {"panda_link1", "table"}, {"panda_link2", "pillar"}};
+  EXPECT_EQ(panda.params().allowed_collisions, pairs);
+  // The UR5e (plain URDF, no tool link said): its last link and its base.
+  p.allowed_collisions = {{"<base>", "table"}};
+  const Planner ur(collision::LoadRobotModel(std::string(IPLAN_SHARED_DIR) + "/robots/ur5e/ur5e.urdf"),
+                   testing::LoadCell(), p);
+  EXPECT_EQ(ur.params().end_effector_link, "tool0");
+  const std::vector<std::pair<std::string, std::string>> base = {{"base_link_inertia", "table"},
+                                                                   {"shoulder_link", "table"}};
+  EXPECT_EQ(ur.params().allowed_collisions, base);
+}
+
 TEST(PlannerConstruction, RejectsBadParamsAndNames) {
   PlannerParams p;
   p.end_effector_link = "nope";

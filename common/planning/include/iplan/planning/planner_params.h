@@ -82,7 +82,10 @@ struct PlannerParams {
   double obstacle_margin = 0.05;
   double min_clearance = 0.0;
   int collision_check_substeps = 10;
-  /// Pairs (robot link, scene object) never checked, e.g. the base on the table.
+  /// Pairs (robot link, scene object) never checked, e.g. the base on the
+  /// table; the link "<base>" stands for the robot's first two links with
+  /// collision spheres (the base on its mount and the first moving link), so
+  /// that one planner file serves any arm.
   std::vector<std::pair<std::string, std::string>> allowed_collisions = {
       {"panda_link0", "table"}, {"panda_link1", "table"}};
   /// Waits: duration of one inserted wait (s, multiple of dt after rounding,
@@ -121,7 +124,8 @@ struct PlannerParams {
   /// Velocity/acceleration limits are scaled by this factor in (0, 1] for the
   /// optimiser's penalty (the feasibility check uses the full limits).
   double limit_scale = 0.9;
-  /// End effector for pose goals: link name and offset p_LE (m) in that link.
+  /// End effector for pose goals: link name ("" = the robot file's
+  /// tool_link, else its last link) and offset p_LE (m) in that link.
   std::string end_effector_link = "panda_link8";
   std::array<double, 3> end_effector_offset = {0.0, 0.0, 0.0};
   /// Inverse kinematics (damped least squares): iterations, damping (m), and
@@ -161,7 +165,7 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(obstacle_margin, "m; hinge margin of the obstacle cost, >= 0"));
   a->Visit(IPLAN_NVP(min_clearance, "m; static clearance a feasible trajectory keeps, <= obstacle_margin"));
   a->Visit(IPLAN_NVP(collision_check_substeps, "interpolated collision checks per interval, >= 1"));
-  a->Visit(IPLAN_NVP(allowed_collisions, "[robot link, scene object] pairs never checked"));
+  a->Visit(IPLAN_NVP(allowed_collisions, "[robot link, scene object] pairs never checked; link <base>: the robot's first two links with spheres (its base on the mount)"));
   a->Visit(IPLAN_NVP(wait_duration, "s; one inserted wait, >= dt"));
   a->Visit(IPLAN_NVP(max_waits, "waits inserted before giving up, >= 0"));
   a->Visit(IPLAN_NVP(human_separation, "m; soft keep-out from the predicted person, >= 0 (0 = off)"));
@@ -173,7 +177,7 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(ssm_stop_probability, "a waypoint is unsafe when the actions the monitor would stop have this probability, in (0, 1]"));
   a->Visit(IPLAN_NVP(position_margin, "rad; joint limits shrunk by this for the optimiser, >= 0"));
   a->Visit(IPLAN_NVP(limit_scale, "velocity/acceleration limits x this in the penalty, in (0, 1]"));
-  a->Visit(IPLAN_NVP(end_effector_link, "link of pose goals, not empty"));
+  a->Visit(IPLAN_NVP(end_effector_link, "link of pose goals; \"\" = the robot file's tool_link, else its last link"));
   a->Visit(IPLAN_NVP(end_effector_offset, "m; [x, y, z] of the end effector in that link, finite"));
   a->Visit(IPLAN_NVP(ik_max_iterations, "inverse kinematics iterations, >= 1"));
   a->Visit(IPLAN_NVP(ik_damping, "m; damping of the damped least squares, > 0"));
