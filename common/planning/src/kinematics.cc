@@ -91,6 +91,18 @@ Eigen::Vector3d RotationError(const Eigen::Matrix3d& R_target, const Eigen::Matr
   return aa.angle() * aa.axis();
 }
 
+// The rotation vector (world frame) that turns the unit axis a onto a_target
+// by the shortest way (its angle is the error).
+Eigen::Vector3d AxisError(const Eigen::Vector3d& a, const Eigen::Vector3d& a_target) {
+  Eigen::Vector3d c = a.cross(a_target);
+  const double angle = std::atan2(c.norm(), a.dot(a_target));
+  if (c.norm() < 1e-12) {
+    if (angle < 1.0) return Eigen::Vector3d::Zero();
+    c = a.unitOrthogonal();  // opposite: any perpendicular axis
+  }
+  return angle * c.normalized();
+}
+
 }  // namespace
 
 IkResult SolveIk(const KinematicChains& chains, int link, const Eigen::Vector3d& p_LE,
@@ -106,6 +118,9 @@ IkResult SolveIk(const KinematicChains& chains, int link, const Eigen::Vector3d&
   if (!q_seed.allFinite() || !X_WE_target.matrix().allFinite() || !p_LE.allFinite())
     throw std::invalid_argument("SolveIk: non-finite seed or target");
   if (rng == nullptr) throw std::invalid_argument("SolveIk: rng must not be null");
+  const bool axis_only = options.align_axis_L.squaredNorm() > 0.0;
+  if (axis_only && (!options.align_axis_L.allFinite() || std::abs(options.align_axis_L.norm() - 1.0) > 1e-6))
+    throw std::invalid_argument("SolveIk: align_axis_L must be a finite unit vector");
 
   Eigen::VectorXd lo = model.LowerLimits().array() + options.position_margin;
   Eigen::VectorXd hi = model.UpperLimits().array() - options.position_margin;
@@ -135,7 +150,9 @@ IkResult SolveIk(const KinematicChains& chains, int link, const Eigen::Vector3d&
       const Eigen::Vector3d p = X_WL * p_LE;
       Eigen::Matrix<double, 6, 1> e;
       e.head<3>() = p_target - p;
-      e.tail<3>() = RotationError(R_target, X_WL.linear());
+      const Eigen::Vector3d axis_W = X_WL.linear() * options.align_axis_L;
+      e.tail<3>() = axis_only ? AxisError(axis_W, R_target * options.align_axis_L)
+                              : RotationError(R_target, X_WL.linear());
       const double ep = e.head<3>().norm(), eo = e.tail<3>().norm();
       const double score = ep + 0.1 * eo;
       if (score < best_score) {
@@ -150,6 +167,8 @@ IkResult SolveIk(const KinematicChains& chains, int link, const Eigen::Vector3d&
       }
       chains.CalcPointJacobian(data, link, p, J.topRows<3>());
       chains.CalcRotationJacobian(data, link, J.bottomRows<3>());
+      // Turning about the free axis changes nothing that is asked for.
+      if (axis_only) J.bottomRows<3>() = (Eigen::Matrix3d::Identity() - axis_W * axis_W.transpose()) * J.bottomRows<3>();
       Eigen::Matrix<double, 6, 6> A = J * J.transpose();
       A.diagonal().array() += options.damping * options.damping;
       Eigen::VectorXd dq = J.transpose() * A.ldlt().solve(e);

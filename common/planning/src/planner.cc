@@ -92,22 +92,46 @@ Planner::~Planner() = default;
 const collision::RobotModel& Planner::robot() const { return impl_->robot; }
 const PlannerParams& Planner::params() const { return impl_->params; }
 
+namespace {
+
+IkOptions IkOptionsOf(const PlannerParams& p) {
+  IkOptions opt;
+  opt.max_iterations = p.ik_max_iterations;
+  opt.damping = p.ik_damping;
+  opt.position_tolerance = p.ik_position_tolerance;
+  opt.orientation_tolerance = p.ik_orientation_tolerance;
+  opt.restarts = p.ik_restarts;
+  opt.position_margin = p.position_margin;
+  return opt;
+}
+
+}  // namespace
+
 IkResult Planner::SolveIk(const Eigen::Vector3d& p_WE, const Eigen::Quaterniond& R_WE,
                           const Eigen::VectorXd& q_seed, std::uint64_t seed) const {
   const internal::PlannerModel& I = *impl_;
   if (!p_WE.allFinite() || !R_WE.coeffs().allFinite() || std::abs(R_WE.norm() - 1.0) > 1e-3)
     throw std::invalid_argument("SolveIk: goal pose must be finite with a unit quaternion, got p " +
                                 internal::VectorText(p_WE) + ", q (x,y,z,w) " + internal::VectorText(R_WE.coeffs()));
-  IkOptions opt;
-  opt.max_iterations = I.params.ik_max_iterations;
-  opt.damping = I.params.ik_damping;
-  opt.position_tolerance = I.params.ik_position_tolerance;
-  opt.orientation_tolerance = I.params.ik_orientation_tolerance;
-  opt.restarts = I.params.ik_restarts;
-  opt.position_margin = I.params.position_margin;
   Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
   X.linear() = R_WE.normalized().toRotationMatrix();
   X.translation() = p_WE;
+  std::mt19937_64 rng(internal::SplitMix(seed));
+  return planning::SolveIk(*I.chains, I.ee_link, I.ee_offset, X, q_seed, IkOptionsOf(I.params), &rng);
+}
+
+IkResult Planner::SolveIkForToolAxis(const Eigen::Vector3d& p_WE, const Eigen::Vector3d& z_W,
+                                     const Eigen::VectorXd& q_seed, std::uint64_t seed, int restarts) const {
+  const internal::PlannerModel& I = *impl_;
+  if (!p_WE.allFinite() || !z_W.allFinite() || std::abs(z_W.norm() - 1.0) > 1e-3)
+    throw std::invalid_argument("SolveIkForToolAxis: need a finite position and a unit axis, got p " +
+                                internal::VectorText(p_WE) + ", z " + internal::VectorText(z_W));
+  Eigen::Isometry3d X = Eigen::Isometry3d::Identity();
+  X.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), z_W).toRotationMatrix();
+  X.translation() = p_WE;
+  IkOptions opt = IkOptionsOf(I.params);
+  opt.align_axis_L = Eigen::Vector3d::UnitZ();
+  if (restarts >= 0) opt.restarts = restarts;
   std::mt19937_64 rng(internal::SplitMix(seed));
   return planning::SolveIk(*I.chains, I.ee_link, I.ee_offset, X, q_seed, opt, &rng);
 }

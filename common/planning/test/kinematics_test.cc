@@ -1,3 +1,5 @@
+#include <algorithm>
+#include <cmath>
 #include <random>
 
 #include <gtest/gtest.h>
@@ -64,6 +66,37 @@ TEST(Kinematics, IkReachesAReachablePoseAndFailsOnAnUnreachableOne) {
   const IkResult f = SolveIk(chains, flange, Eigen::Vector3d::Zero(), far, seed, opt, &rng);
   EXPECT_FALSE(f.success);
   EXPECT_GT(f.position_error, 0.5);
+}
+
+TEST(Kinematics, IkForAToolAxisLeavesTheTurnAboutItFree) {
+  const collision::RobotModel robot = testing::LoadPanda();
+  KinematicChains chains(robot);
+  const int flange = robot.FindLink("panda_link8");
+  Eigen::VectorXd seed(7);
+  seed << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785;
+  collision::RobotData d(robot);
+  // A target whose orientation turns 1.2 rad about the flange axis away from
+  // the seed's, the axis tilted: asked for the axis only, the solution may
+  // keep its own turn; asked for the whole orientation, it must turn.
+  collision::CalcForwardKinematics(robot, seed, &d);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.2, -0.1, -1.0).normalized();
+  Eigen::Isometry3d X_target = Eigen::Isometry3d::Identity();
+  X_target.linear() = Eigen::Quaterniond::FromTwoVectors(Eigen::Vector3d::UnitZ(), axis).toRotationMatrix() *
+                      Eigen::AngleAxisd(1.2, Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  X_target.translation() = Eigen::Vector3d(0.5, 0.1, 0.35);
+  IkOptions opt;
+  opt.align_axis_L = Eigen::Vector3d::UnitZ();
+  std::mt19937_64 rng(3);
+  const IkResult r = SolveIk(chains, flange, Eigen::Vector3d::Zero(), X_target, seed, opt, &rng);
+  ASSERT_TRUE(r.success) << r.position_error << " " << r.orientation_error;
+  collision::CalcForwardKinematics(robot, r.q, &d);
+  EXPECT_LT((d.X_WL[flange].translation() - X_target.translation()).norm(), 1e-4);
+  EXPECT_LT(std::acos(std::min(1.0, d.X_WL[flange].linear().col(2).dot(axis))), 1e-3);
+  // The turn about the axis is not the target's (it was free).
+  const double full = Eigen::AngleAxisd(d.X_WL[flange].linear() * X_target.linear().transpose()).angle();
+  EXPECT_GT(full, 0.05);
+  opt.align_axis_L = Eigen::Vector3d(0.0, 0.0, 2.0);
+  EXPECT_THROW(SolveIk(chains, flange, Eigen::Vector3d::Zero(), X_target, seed, opt, &rng), std::invalid_argument);
 }
 
 TEST(Kinematics, IkRejectsBadInput) {

@@ -54,6 +54,11 @@ struct IkOptions {
   double orientation_tolerance = 1e-3; ///< rad
   int restarts = 8;                    ///< extra attempts from random seeds
   double position_margin = 1e-3;       ///< solutions stay this far inside limits (rad)
+  /// Non-zero: only this axis of the link (unit, link frame) must point the
+  /// way the target's same axis does (X_WE_target.linear() * align_axis_L);
+  /// rotation about it is free (a tool that may turn about its own axis).
+  /// Zero: the whole orientation.
+  Eigen::Vector3d align_axis_L = Eigen::Vector3d::Zero();
 };
 
 struct IkResult {

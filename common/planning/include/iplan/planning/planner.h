@@ -185,6 +185,12 @@ class Planner {
   /// seeded at q_seed, restarts drawn from a generator seeded with `seed`.
   IkResult SolveIk(const Eigen::Vector3d& p_WE, const Eigen::Quaterniond& R_WE,
                    const Eigen::VectorXd& q_seed, std::uint64_t seed) const;
+  /// The same for a tool that may turn about its own axis: the end effector
+  /// at p_WE (m, world frame) with its link's z axis along z_W (unit, world
+  /// frame; orientation_error is the angle between them). `restarts` >= 0
+  /// replaces PlannerParams::ik_restarts (0: from q_seed only).
+  IkResult SolveIkForToolAxis(const Eigen::Vector3d& p_WE, const Eigen::Vector3d& z_W,
+                              const Eigen::VectorXd& q_seed, std::uint64_t seed, int restarts = -1) const;
 
   /// Minimum signed distance (m) between the robot spheres at q and the scene,
   /// skipping allowed collisions (analytic box/cylinder distances, the same
