@@ -5,6 +5,7 @@
 
 #include "core/robot_sim_settings.h"
 #include "core/supervisor_settings.h"
+#include "core/task_goals.h"
 #include "core/task_planner.h"
 #include "iplan/core/params.h"
 #include "iplan/collision/scene.h"
@@ -52,7 +53,7 @@ BenchmarkSetup CellConfig::MakeSetup() const {
   return s;
 }
 
-CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
+CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std::string& robot_file) {
   if (planner_threads < 0) throw std::runtime_error("planner threads must be >= 0");
   auto file = [&](const std::string& name) {
     const fs::path p = fs::path(dir) / (name + ".yaml");
@@ -65,8 +66,9 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // The trajectory optimiser and the models it names.
   framework::ConfigSection tconf = framework::ConfigSection::Load(file("trajopt"));
   framework::ConfigSection tsec = tconf.Section("trajopt");
-  const trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
+  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
   Check(tconf);
+  if (!robot_file.empty()) topt.robot_file = robot_file;
   if (const std::string why = topt.replanner.Validate(); !why.empty()) throw std::runtime_error(file("trajopt") + ": " + why);
   c.replanner = topt.replanner;
   // Simulated time: a wall-clock budget would make the benchmark depend on
@@ -81,8 +83,9 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   // The collision-risk monitor, as its service builds it.
   framework::ConfigSection rconf = framework::ConfigSection::Load(file("collision_risk"));
   framework::ConfigSection rsec = rconf.Section("collision_risk");
-  const collision_risk::RiskConfig risk = collision_risk::ReadRiskConfig(rsec);
+  collision_risk::RiskConfig risk = collision_risk::ReadRiskConfig(rsec);
   Check(rconf);
+  if (!robot_file.empty()) risk.robot_file = robot_file;
   if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(file("collision_risk") + ": " + why);
   c.monitor = std::make_unique<collision_risk::RiskMonitor>(collision_risk::MakeRiskMonitor(risk));
   c.loop.monitor_rate_hz = risk.rate_hz;
@@ -104,7 +107,8 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads) {
   core::ReadParams(vsec, &settings);  // the service's keys and ranges
   c.loop.resume_delay = settings.resume_delay;
   Check(vconf);
-  const supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
+  supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
+  c.goal_notes = supervisor::ResolveTaskGoals(*c.planner, &graph);  // poses: the planner's IK for this robot
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
 
   // The sensor and the synthetic person.

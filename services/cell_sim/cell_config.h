@@ -31,6 +31,9 @@ struct CellConfig {
   double sensor_rate_hz = 30;
   double sensor_noise_std = 0.01;
   std::vector<GraphTask> tasks;
+  /// Places of the task graph whose joint positions were not used as
+  /// written (supervisor::ResolveTaskGoals), for the tool to print.
+  std::vector<std::string> goal_notes;
 
   /// A setup whose model pointers point into this object (which must
   /// outlive it); intent model, recordings and benchmark options are the
@@ -41,7 +44,9 @@ struct CellConfig {
 /// Loads `dir`. `planner_threads` (>= 0; 0: the file's) replaces the
 /// planner's thread count, which changes no result (Planner::Plan is
 /// bit-identical for any thread count). Throws std::runtime_error naming the
-/// file and key on a bad configuration.
-CellConfig LoadCellConfig(const std::string& dir, int planner_threads);
+/// file and key on a bad configuration. A non-empty `robot_file` replaces
+/// the robot of the trajectory optimiser and collision risk (another arm,
+/// `--robot`); the task graph's poses are solved for it.
+CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std::string& robot_file = "");
 
 }  // namespace iplan::cell_sim

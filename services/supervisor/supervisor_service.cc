@@ -13,9 +13,11 @@
 #include "common/adapters.h"
 #include "core/safety_monitor.h"
 #include "core/supervisor_settings.h"
+#include "core/task_goals.h"
 #include "core/task_planner.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
+#include "trajopt_config.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -23,6 +25,20 @@ namespace {
 using framework::ConfigSection;
 using framework::Node;
 using framework::Result;
+
+// The task graph's places in joint positions of the cell's robot: the
+// robot, scene and planner of the trajectory optimiser's file (the robot
+// replaced by supervisor.robot when given), as that service plans with them.
+std::vector<std::string> ResolveGoals(const ConfigSection& config, const SupervisorSettings& settings,
+                                      TaskGraph* graph) {
+  ConfigSection file = ConfigSection::Load(config.ResolvePath(settings.trajopt_config));
+  ConfigSection section = file.Section("trajopt");
+  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(section);
+  // Only the files it names matter here; the trajectory optimiser reports
+  // the rest of its keys itself.
+  if (!settings.robot.empty()) topt.robot_file = config.ResolvePath(settings.robot);
+  return ResolveTaskGoals(*trajopt::MakePlanner(topt), graph);
+}
 
 class SupervisorService : public framework::Service {
  public:
@@ -45,7 +61,9 @@ class SupervisorService : public framework::Service {
     permit_validity_ = settings.permit_validity;
     resend_period_ = settings.command_resend_period;
     try {
-      planner_ = std::make_unique<TaskPlanner>(LoadTaskGraph(config.ResolvePath(graph_file)), q);
+      TaskGraph graph = LoadTaskGraph(config.ResolvePath(graph_file));
+      for (const std::string& note : ResolveGoals(config, settings, &graph)) node.log().info("{}", note);
+      planner_ = std::make_unique<TaskPlanner>(std::move(graph), q);
       if (!q_table_.empty()) {
         std::string note;
         planner_->Load(q_table_, &note);

@@ -78,6 +78,7 @@ TEST_F(CellCheck, ShippedCellPassesWithItsMarginTable) {
 TEST_F(CellCheck, RetreatInsideThePersonsSpaceIsNamed) {
   // The hand-over "withdraws" to where it handed over: in the assembly.
   Edit(dir_ / "tasks" / "table_top.yaml", R"(retreat: \[[^\]]*\])", "retreat: [-0.274, 0.417, 0.0, -1.68, 0.0, 2.097, 0.8]");
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(retreat_pose: \{position: \[[^\]]*\]\})", "retreat_pose: {position: [0.64, -0.18, 0.36]}");
   std::string out;
   EXPECT_EQ(Run(&out), 1) << out;
   EXPECT_NE(out.find("inconsistent: 'hand_over (retreat)': during 'assemble' the person comes within the protective "
@@ -109,6 +110,9 @@ TEST_F(CellCheck, GoalInsideASceneObjectIsNamed) {
   // fetch_left's tool down into the parts bin.
   Edit(dir_ / "tasks" / "table_top.yaml", R"(goal: \[0\.686, 0\.526, 0\.0, -1\.277, 0\.0, 1\.803, 0\.8\])",
        "goal: [0.686, 0.745, 0.0, -1.521, 0.0, 2.266, 0.8]");
+  // Given in joints only (a pose there would have no solution clear of the
+  // scene: ResolveTaskGoals refuses it, task_goals_test).
+  Edit(dir_ / "tasks" / "table_top.yaml", R"(goal_pose: \{position: \[0\.55, 0\.45, 0\.45\]\})", "");
   std::string out;
   EXPECT_EQ(Run(&out), 1) << out;
   EXPECT_NE(out.find("'fetch_left' rests in the static scene"), std::string::npos) << out;

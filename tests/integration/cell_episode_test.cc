@@ -7,7 +7,8 @@
 // secured --mixed is refused with its reason). Every robot task completes,
 // the robot never touches the person's true body, and trajectories come
 // with an end-to-end latency. The intent model is trained from the
-// synthetic person on the first run (cached in config/models). Each demo
+// synthetic person on the first run (cached in config/models). The same
+// with the UR5e of ../shared (--robot). Each demo
 // gets an XDG_DATA_HOME of its own, so the user's keystore is the test's.
 //
 // However `iplan demo` ends (SIGINT, SIGKILL), it leaves no service of its
@@ -63,6 +64,10 @@ TEST_P(CellEpisode, TasksCompleteWithoutContact) {
   EXPECT_GT(j["latency_ms"]["p50"].get<double>(), 0.0);
   EXPECT_LT(j["latency_ms"]["p99"].get<double>(), 1000.0);  // sanity only: the target lives in the demo figures
   for (const auto& [service, code] : j["service_exit_codes"].items()) EXPECT_EQ(code, 0) << service;
+  if (GetParam().name == "ur5e") {
+    EXPECT_NE(demo.Stdout().find("robot ur5e ("), std::string::npos) << demo.Stdout();
+    EXPECT_NE(demo.Stdout().find("6 joints), resting at ["), std::string::npos) << demo.Stdout();
+  }
   if (GetParam().name == "mixed") {
     EXPECT_NE(j["vendors"]["intent"], j["vendors"]["perception"]);
     EXPECT_NE(j["vendors"]["trajopt"], j["vendors"]["supervisor"]);
@@ -153,7 +158,9 @@ INSTANTIATE_TEST_SUITE_P(Signals, DemoEnds, ::testing::Values(SIGINT, SIGKILL),
 
 INSTANTIATE_TEST_SUITE_P(Vendors, CellEpisode,
                          ::testing::Values(Variant{"default", {}}, Variant{"fastdds", {"--dds", "fastdds"}},
-                                           Variant{"mixed", {"--dds", "cyclonedds", "--mixed", "--insecure"}}),
+                                           Variant{"mixed", {"--dds", "cyclonedds", "--mixed", "--insecure"}},
+                                           // Another arm: the same cell file's task poses solved for it.
+                                           Variant{"ur5e", {"--robot", std::string(IPLAN_SHARED_DIR) + "/robots/ur5e/ur5e.urdf"}}),
                          [](const auto& info) { return info.param.name; });
 
 }  // namespace

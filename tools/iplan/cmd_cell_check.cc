@@ -22,6 +22,7 @@
 
 #include "command_registry.h"
 #include "perception/core/synthetic_person.h"
+#include "supervisor/core/task_goals.h"
 #include "supervisor/core/task_planner.h"
 #include "iplan/framework/config.h"
 #include "iplan/framework/service.h"
@@ -37,6 +38,7 @@ namespace fs = std::filesystem;
 
 struct CheckOptions {
   std::string config_dir;
+  std::string robot;  // another arm; empty: the configured
   double margin = 0.05;  // m, clearance required beyond S_p for harmless pairs
   int repetitions = 5;
 };
@@ -122,7 +124,7 @@ struct CellInputs {
 
 // Tools read part of each service's file: its values are checked, its other
 // keys are the services' business. Throws std::runtime_error.
-void LoadCellInputs(const std::string& dir, CellInputs* in) {
+void LoadCellInputs(const std::string& dir, const std::string& robot, CellInputs* in) {
   auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
   auto check = [](const framework::ConfigSection& c) {
     if (c.Problems().empty()) return;
@@ -142,6 +144,7 @@ void LoadCellInputs(const std::string& dir, CellInputs* in) {
   framework::ConfigSection rsec = rconf.Section("collision_risk");
   in->risk = collision_risk::ReadRiskConfig(rsec);
   check(rconf);
+  if (!robot.empty()) in->risk.robot_file = robot;
   if (const std::string why = in->risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
   // The check asks about the working cell, where predictions flow: the
   // separation layer with the person's measured speed, not the degraded
@@ -157,9 +160,11 @@ void LoadCellInputs(const std::string& dir, CellInputs* in) {
   // The static scene, as the trajectory optimiser sees it.
   framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
   framework::ConfigSection tsec = tconf.Section("trajopt");
-  const trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
+  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
   check(tconf);
+  if (!robot.empty()) topt.robot_file = robot;
   in->planner = trajopt::MakePlanner(topt);
+  for (const std::string& note : supervisor::ResolveTaskGoals(*in->planner, &in->graph)) std::cout << note << "\n";
 }
 
 // One row per place the robot rests at: every task's goal and, for tasks
@@ -209,7 +214,7 @@ int RunCellCheck(const CheckOptions& o) {
   }
   CellInputs in;
   try {
-    LoadCellInputs(dir, &in);
+    LoadCellInputs(dir, o.robot.empty() ? "" : fs::absolute(o.robot).string(), &in);
   } catch (const std::exception& e) {
     std::cerr << "iplan cell-check: " << e.what() << "\n";
     return 2;
@@ -277,6 +282,10 @@ const bool kRegistered = RegisterCommand("cell-check", [](CLI::App& app) {
       "exit code 0 when consistent, 1 when not, 2 on bad configuration. Resting poses only: paths between them\n"
       "are not checked.");
   c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
+  c->add_option("--robot", o->robot,
+                "check the cell with another arm: a URDF or URDF overlay (docs/robots.md); the task graph's "
+                "poses are solved for it")
+      ->check(CLI::ExistingFile);
   c->add_option("--margin", o->margin, "m of clearance beyond S_p required for harmless pairs")->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   c->add_option("--repetitions", o->repetitions, "repetitions of each action (each with its own variation)")

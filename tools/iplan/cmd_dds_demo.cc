@@ -22,7 +22,9 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "supervisor/core/task_goals.h"
 #include "supervisor/core/task_planner.h"
+#include "trajopt/trajopt_config.h"
 #include "dds_cell_model.h"
 #include "dds_common.h"
 #include "dds_demo_security.h"
@@ -61,6 +63,8 @@ struct DemoOptions {
   /// "skeleton": the skeleton stream only; "depth": also the simulated depth
   /// camera (perception) and the cloud service.
   std::string sensor = "skeleton";
+  /// Another arm for the whole cell (docs/robots.md); empty: the configured.
+  std::string robot;
 };
 
 // The services in start order (executable suffix, config name).
@@ -149,11 +153,34 @@ class DemoRun {
       std::string graph_file = "tasks/table_top.yaml";
       sup.Section("supervisor").Read("task_graph", &graph_file);
       graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(graph_file));
+      if (!o_.robot.empty()) PrepareRobot();
     } catch (const std::exception& e) {
       std::cerr << "\niplan demo: " << e.what() << "\n";
       return 2;
     }
     return std::nullopt;
+  }
+
+  // --robot: every service's robot, and the simulated robot's start at the
+  // task graph's rest place solved for that arm (as the supervisor will).
+  void PrepareRobot() {
+    robot_file_ = fs::absolute(o_.robot).string();
+    framework::ConfigSection t = framework::ConfigSection::Load(Cfg("trajopt"));
+    framework::ConfigSection ts = t.Section("trajopt");
+    trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(ts);
+    topt.robot_file = robot_file_;
+    const std::unique_ptr<planning::Planner> planner = trajopt::MakePlanner(topt);
+    supervisor::TaskGraph graph = graph_;
+    for (const std::string& note : supervisor::ResolveTaskGoals(*planner, &graph)) std::cout << "  " << note << "\n";
+    const std::vector<double> rest = supervisor::RestPositions(graph);
+    if (rest.empty()) throw std::runtime_error("--robot: the task graph names no rest task (key 'rest'): where would the robot start?");
+    std::ostringstream q;
+    q << "[";
+    for (std::size_t i = 0; i < rest.size(); ++i) q << (i ? ", " : "") << std::setprecision(17) << rest[i];
+    q << "]";
+    rest_text_ = q.str();
+    std::cout << "  robot " << planner->robot().name << " (" << robot_file_ << ", " << planner->robot().nq
+              << " joints), resting at " << rest_text_ << " rad\n";
   }
 
   std::vector<std::string> ServiceArguments(const std::string& exe, const std::string& name) const {
@@ -169,6 +196,11 @@ class DemoRun {
                                                        "perception.publish_truth=true"});
     if (name == "perception" && o_.sensor == "depth") {
       argv.insert(argv.end(), {"--set", "perception.depth.provider=simulated"});
+    }
+    if (!robot_file_.empty()) {
+      if (name == "perception") argv.insert(argv.end(), {"--set", "perception.depth.simulated.robot=" + robot_file_});
+      else if (name != "intent") argv.insert(argv.end(), {"--set", name + ".robot=" + robot_file_});
+      if (name == "robot_sim") argv.insert(argv.end(), {"--set", "robot_sim.initial_positions=" + rest_text_});
     }
     if (name == "supervisor") {
       argv.insert(argv.end(), {"--set", "supervisor.max_episodes=" + std::to_string(o_.episodes)});
@@ -372,6 +404,8 @@ class DemoRun {
   CellModelResult model_;
   std::optional<DemoSecurity> security_;  // decided in Prepare (not for --prepare-only)
   supervisor::TaskGraph graph_;
+  std::string robot_file_;  ///< --robot, absolute; empty: the configured robot
+  std::string rest_text_;   ///< its rest joint positions, as a YAML list
   std::unique_ptr<core::Process> recorder_;
   Clock::time_point t0_;
   std::vector<std::unique_ptr<core::Process>> procs_;
@@ -411,6 +445,11 @@ void Register(CLI::App& app) {
                  "(obstacles and human points, docs/perception-clouds.md)")
       ->capture_default_str()
       ->check(CLI::IsMember({"skeleton", "depth"}));
+  d->add_option("--robot", o.robot,
+                 "run the whole cell with another arm: a URDF (collision meshes are covered by spheres) or a "
+                 "URDF overlay, mounted where the configured robot stands; task poses are solved for it "
+                 "(docs/robots.md)")
+      ->check(CLI::ExistingFile);
   d->add_option("--predictor", o.predictor,
                  "prediction the cell plans with: model (the trained intent model), constant-velocity or "
                  "constant-position (kinematic baselines from the intent service), none (the planner ignores "

@@ -50,6 +50,7 @@ struct InteractionOptions {
   uint64_t seed = 1;
   std::string json_file, config_dir, recordings, model_dir, monitor = "same";
   std::string suite = "default";
+  std::string robot;  // --robot: another arm; empty: the configured
   int threads = 1;
   int trace = -1;  // scenario whose runs are traced (-1: none)
   double time_limit = 20;
@@ -149,7 +150,8 @@ void LoadInputs(const InteractionOptions& o, EvalInputs* in) {
       o.recordings.empty()
           ? (fs::path(in->dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
           : o.recordings;
-  in->cell = cell_sim::LoadCellConfig(in->dir, o.threads);
+  in->cell = cell_sim::LoadCellConfig(in->dir, o.threads, o.robot.empty() ? "" : fs::absolute(o.robot).string());
+  for (const std::string& note : in->cell.goal_notes) std::cout << note << "\n";
   if (!fs::exists(in->recordings_file)) {
     throw std::runtime_error("no recorded motion at " + in->recordings_file + " (set --recordings)");
   }
@@ -466,6 +468,10 @@ const bool kRegistered = RegisterCommand("eval", [](CLI::App& app) {
   c->add_option("--seed", o->seed, "seed of the scenarios and the sensor noise")->capture_default_str();
   c->add_option("--json", o->json_file, "write the figures and every scenario's run as JSON to this file");
   c->add_option("--config-dir", o->config_dir, "configuration folder (default: $IPLAN_CONFIG_DIR, installed, or source)");
+  c->add_option("--robot", o->robot,
+                "another arm instead of the configured one: a URDF or URDF overlay (docs/robots.md); the task "
+                "graph's poses are solved for it")
+      ->check(CLI::ExistingFile);
   c->add_option("--recordings", o->recordings,
                 "skeleton CSV of recorded motion (default: CONFIG/../../shared/data/assembly.csv)");
   c->add_option("--monitor-prediction", o->monitor,

@@ -13,6 +13,8 @@ namespace iplan::supervisor {
 
 struct SupervisorSettings {
   std::string task_graph = "tasks/table_top.yaml";
+  std::string trajopt_config = "trajopt.yaml";
+  std::string robot;
   std::string q_table = "state/q_table.bin";
   std::string mode = "learning";
   QLearningParams learning;  ///< its keys sit in the section itself
@@ -28,6 +30,8 @@ struct SupervisorSettings {
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(task_graph, "task graph file, relative to the configuration file"));
+    a->Visit(IPLAN_NVP(trajopt_config, "the trajectory optimiser's file: its robot, scene and planner solve the task graph's poses"));
+    a->Visit(IPLAN_NVP(robot, "robot file instead of trajopt_config's (relative to this file; iplan demo --robot); \"\" = its"));
     a->Visit(IPLAN_NVP(q_table, "Q-table file, relative to the configuration file; empty = not kept"));
     a->Visit(IPLAN_NVP(mode, "learning or deployment (greedy, no updates)"));
     learning.Serialize(a);

@@ -35,6 +35,14 @@ bool Get(const std::string& in, std::size_t* pos, T* v) {
 
 }  // namespace
 
+std::string ToolPose::Validate() const {
+  auto finite = [](const std::vector<double>& v) { return std::all_of(v.begin(), v.end(), [](double x) { return std::isfinite(x); }); };
+  if (!position.empty() && (position.size() != 3 || !finite(position))) return "position must be 3 finite numbers (m)";
+  if (z_axis.size() != 3 || !finite(z_axis) || std::hypot(z_axis[0], z_axis[1], z_axis[2]) < 1e-9)
+    return "z_axis must be 3 finite numbers, not all 0";
+  return "";
+}
+
 std::string TaskGraph::Validate() const {
   if (tasks.empty()) return "no robot tasks";
   if (tasks.size() > 63) return "at most 63 robot tasks";
@@ -42,8 +50,12 @@ std::string TaskGraph::Validate() const {
     for (std::size_t j = 0; j < i; ++j) {
       if (tasks[i].name == tasks[j].name) return "task '" + tasks[i].name + "' defined twice";
     }
-    if (tasks[i].goal.empty()) return "task '" + tasks[i].name + "' has no goal";
-    if (!tasks[i].retreat.empty() && tasks[i].retreat.size() != tasks[i].goal.size()) {
+    const RobotTask& t = tasks[i];
+    if (t.goal.empty() && !t.goal_pose.given()) return "task '" + t.name + "' has no goal (give goal or goal_pose)";
+    for (const auto& [key, pose] : {std::pair{"goal_pose", &t.goal_pose}, std::pair{"retreat_pose", &t.retreat_pose}}) {
+      if (const std::string why = pose->Validate(); !why.empty()) return "task '" + t.name + "': " + key + ": " + why;
+    }
+    if (!t.retreat.empty() && !t.goal.empty() && t.retreat.size() != t.goal.size()) {
       return "task '" + tasks[i].name + "' has a retreat of " + std::to_string(tasks[i].retreat.size()) +
              " joint positions and a goal of " + std::to_string(tasks[i].goal.size());
     }
@@ -64,6 +76,8 @@ std::string TaskGraph::Validate() const {
       }
     }
   }
+  if (!rest.empty() && std::none_of(tasks.begin(), tasks.end(), [&](const RobotTask& t) { return t.name == rest; }))
+    return "rest names unknown task '" + rest + "'";
   // Cycles: repeatedly finish tasks whose predecessors are finished.
   std::vector<bool> done(tasks.size(), false);
   for (std::size_t round = 0; round < tasks.size(); ++round) {

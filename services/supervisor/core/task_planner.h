@@ -22,21 +22,47 @@
 
 namespace iplan::supervisor {
 
+/// A place of a task given as a tool pose in the cell (world) frame, so that
+/// one cell description serves any arm: the planner's end effector
+/// (end_effector_link and offset) at `position` with that link's z axis
+/// along `z_axis`, free to turn about it. Solved for the robot at hand by
+/// the planner's IK (ResolveTaskGoals, core/task_goals.h).
+struct ToolPose {
+  std::vector<double> position;             ///< m, [x, y, z]; empty: not given
+  std::vector<double> z_axis = {0.0, 0.0, -1.0};  ///< direction of the tool's z axis (normalised)
+
+  bool given() const { return !position.empty(); }
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(position, "m; [x, y, z] of the end effector, cell frame"));
+    a->Visit(IPLAN_NVP(z_axis, "direction of the end effector's z axis, cell frame (default: down)"));
+  }
+  /// "" when valid (position empty or 3 finite values, z_axis 3 finite
+  /// values, not zero), else the reason.
+  std::string Validate() const;
+};
+
 struct RobotTask {
   std::string name;
-  std::vector<double> goal;               ///< joint goal (rad), robot joint order
+  /// Joint goal (rad), robot joint order. Empty, or not of the robot's size,
+  /// when the task is given by goal_pose (ResolveTaskGoals fills it).
+  std::vector<double> goal;
   std::vector<std::string> after;         ///< tasks that must be finished first
   std::vector<std::string> conflicts_with; ///< human actions this task conflicts with
   /// Joint positions (rad) to withdraw to after the goal before the task
   /// counts as done (e.g. out of the person's space after a hand-over), so
   /// that the delay of leaving is charged to this task. Empty: none.
   std::vector<double> retreat = {};
+  ToolPose goal_pose = {};                ///< the goal as a tool pose (any arm)
+  ToolPose retreat_pose = {};             ///< the retreat as a tool pose (any arm)
 
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP_REQUIRED(name, "unique task name"));
-    a->Visit(IPLAN_NVP_REQUIRED(goal, "rad; joint goal, robot joint order"));
+    a->Visit(IPLAN_NVP(goal, "rad; joint goal, robot joint order (goal, goal_pose or both)"));
+    a->Visit(IPLAN_NVP(goal_pose, "the goal as a tool pose: position (m) and z_axis, cell frame (any arm)"));
     a->Visit(IPLAN_NVP(retreat, "rad; joint positions to withdraw to after the goal, [] = none"));
+    a->Visit(IPLAN_NVP(retreat_pose, "the retreat as a tool pose (any arm)"));
     a->Visit(IPLAN_NVP(after, "tasks that must be finished first"));
     a->Visit(IPLAN_NVP(conflicts_with, "human actions this task conflicts with"));
   }
@@ -45,15 +71,19 @@ struct RobotTask {
 struct TaskGraph {
   std::vector<RobotTask> tasks;            ///< at most 63
   std::vector<std::string> human_actions;
+  /// The task whose goal is where the robot rests between episodes (and
+  /// starts from); empty: not said.
+  std::string rest;
 
-  /// The file's keys: human_actions and robot_tasks (the list of tasks).
+  /// The file's keys: human_actions, robot_tasks (the list of tasks), rest.
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(human_actions, "the human actions the belief is over"));
     a->Visit(core::MakeNameValue("robot_tasks", &tasks, "the robot's tasks, at most 63", true));
+    a->Visit(IPLAN_NVP(rest, "the task whose goal the robot rests at between episodes and starts from"));
   }
-  /// Empty when consistent (unique names, known predecessors and actions,
-  /// no cycles), else the reason.
+  /// Empty when consistent (unique names, a goal or goal_pose each, known
+  /// predecessors, actions and rest task, no cycles), else the reason.
   std::string Validate() const;
 };
 

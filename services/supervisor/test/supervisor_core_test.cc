@@ -506,7 +506,7 @@ TEST(TaskGraph, MissingAndUnknownKeysNameTheFileAndTheKey) {
     LoadTaskGraph(path);
     FAIL() << "a task without a goal was accepted";
   } catch (const std::runtime_error& e) {
-    EXPECT_EQ(std::string(e.what()), path + ": key 'robot_tasks[0].goal': is required but missing\n" + path +
+    EXPECT_EQ(std::string(e.what()), path + ": task 'a' has no goal (give goal or goal_pose)\n" + path +
                                          ": unknown key 'robot_tasks[0].gaol'");
   }
   std::ofstream(path, std::ios::trunc) << "human_actions: [reach]\n";
