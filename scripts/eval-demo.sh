@@ -5,7 +5,9 @@
 # docs/demo.md. Run it on an otherwise idle machine: the figures are times.
 #   scripts/eval-demo.sh [RUNS] [EPISODES]        (defaults: 3 runs, 6 episodes)
 # Environment: BUILD (default: build), OUT (default: $BUILD/demo-eval),
-# DDS (cyclonedds or fastdds, default: cyclonedds).
+# DDS (cyclonedds or fastdds, default: cyclonedds), DEMO_ARGS (more
+# arguments of iplan demo, split at spaces, e.g.
+# DEMO_ARGS="--robot ../shared/robots/ur5e/ur5e.urdf").
 set -euo pipefail
 ROOT="$(cd "$(dirname "$0")/.." && pwd)"
 BUILD="${BUILD:-$ROOT/build}"
@@ -28,7 +30,7 @@ for run in $(seq 1 "$RUNS"); do
   grep -q "^  seed: $run\b" "$cfg/supervisor.yaml" || { echo "could not set the seed in $cfg/supervisor.yaml" >&2; exit 1; }
   echo "=== run $run of $RUNS: supervisor seed $run, $EPISODES episodes, $DDS"
   "$IPLAN" demo --dds "$DDS" --episodes "$EPISODES" --config-dir "$cfg" --state-dir "$OUT/state-$run" \
-    --summary "$OUT/run-$run.json" > "$OUT/run-$run.txt" 2>&1 || echo "run $run exited $? (see $OUT/run-$run.txt)"
+    --summary "$OUT/run-$run.json" ${DEMO_ARGS:-} > "$OUT/run-$run.txt" 2>&1 || echo "run $run exited $? (see $OUT/run-$run.txt)"
   sed -n '/^Summary/,$p' "$OUT/run-$run.txt"
 done
 
