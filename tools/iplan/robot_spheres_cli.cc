@@ -10,6 +10,7 @@
 #include <nlohmann/json.hpp>
 
 #include "iplan/collision/robot_model.h"
+#include "iplan/collision/self_collision.h"
 #include "iplan/core/atomic_file.h"
 
 namespace iplan::collision {
@@ -71,6 +72,27 @@ json CoverFile(const RobotModel& robot) {
   return {{"robot", robot.name}, {"spheres", spheres}};
 }
 
+// The self-collision link pairs: checked, and skipped with their reason.
+json SelfCollisionJson(const RobotModel& robot, const SelfCollisionModel& self) {
+  json checked = json::array(), skipped = json::array();
+  for (const auto& [a, b] : self.checked) checked.push_back({robot.link_names[a], robot.link_names[b]});
+  for (const LinkPair& p : self.skipped)
+    skipped.push_back({{"links", {robot.link_names[p.link_a], robot.link_names[p.link_b]}},
+                       {"reason", ToString(p.reason)},
+                       {"min_distance_m", p.min_distance}});
+  const SelfCollisionParams params;
+  return {{"samples", params.samples}, {"checked", checked}, {"skipped", skipped}};
+}
+
+void PrintSelfCollision(const RobotModel& robot, const SelfCollisionModel& self, std::ostream& out) {
+  int count[3] = {0, 0, 0};
+  for (const LinkPair& p : self.skipped) ++count[static_cast<int>(p.reason)];
+  out << "self-collision: " << self.checked.size() << " link pairs checked; skipped " << count[0] << " adjacent, "
+      << count[1] << " always touching, " << count[2] << " never within "
+      << SelfCollisionParams{}.never_margin << " m in " << SelfCollisionParams{}.samples << " samples\n";
+  for (const auto& [a, b] : self.checked) out << "  checked " << robot.link_names[a] << " / " << robot.link_names[b] << "\n";
+}
+
 void PrintTable(const RobotModel& robot, const std::vector<LinkRow>& rows, double median, int total_uncovered,
                 std::ostream& out) {
   out << "robot " << robot.name << ": " << robot.spheres.size() << " spheres on " << rows.size() << " links, "
@@ -113,6 +135,7 @@ int RunRobotSpheres(const RobotSpheresOptions& options, std::ostream& out, std::
       worst = std::max(worst, r.max_excess);
     }
     const double median = Median(excess);
+    const SelfCollisionModel self = ComputeSelfCollision(robot);
     if (!options.out.empty()) core::WriteFileAtomically(options.out, CoverFile(robot).dump(1) + "\n");
     if (options.json) {
       json links = json::array();
@@ -132,11 +155,13 @@ int RunRobotSpheres(const RobotSpheresOptions& options, std::ostream& out, std::
                   {"median_max_excess_m", median},
                   {"max_max_excess_m", worst},
                   {"uncovered_vertices", total_uncovered},
-                  {"links", links}}
+                  {"links", links},
+                  {"self_collision", SelfCollisionJson(robot, self)}}
                  .dump()
           << "\n";
     } else {
       PrintTable(robot, rows, median, total_uncovered, out);
+      PrintSelfCollision(robot, self, out);
     }
     return total_uncovered == 0 ? 0 : 1;
   } catch (const std::exception& e) {

@@ -25,7 +25,10 @@ struct RobotSpheresOptions {
 ///   {"robot":NAME,"file":PATH,"total_spheres":N,"median_max_excess_m":M,
 ///    "max_max_excess_m":M,"uncovered_vertices":N,
 ///    "links":[{"link":..,"shapes":[..],"spheres":N,"uncovered_vertices":N,
-///              "max_excess_m":M,"sampled_excess_m":M,"mesh_files":[..],"from_cache":bool},..]}
+///              "max_excess_m":M,"sampled_excess_m":M,"mesh_files":[..],"from_cache":bool},..],
+///    "self_collision":{"samples":N,"checked":[[LINK,LINK],..],
+///                      "skipped":[{"links":[LINK,LINK],"reason":"adjacent|always|never","min_distance_m":M},..]}}
+/// (self_collision.h: the link pairs worth checking, found by sampling).
 /// The median is over the links that have collision geometry. `out` gets
 /// {"robot":..,"spheres":[{"link":..,"centre":[x,y,z],"radius":r},..]}
 /// (centres in the link frame, m), written atomically.

@@ -10,6 +10,7 @@
 #include <stdexcept>
 
 #include "iplan/collision/robot_model.h"
+#include "iplan/collision/self_collision.h"
 
 namespace iplan::supervisor {
 namespace {
@@ -27,8 +28,12 @@ std::string Text(const Eigen::Vector3d& v) {
 
 class Resolver {
  public:
-  Resolver(const planning::Planner& planner, const PoseAgreement& agreement)
-      : planner_(planner), robot_(planner.robot()), data_(robot_), agreement_(agreement) {
+  Resolver(const planning::Planner& planner, const GoalOptions& agreement)
+      : planner_(planner),
+        robot_(planner.robot()),
+        data_(robot_),
+        agreement_(agreement),
+        self_(collision::ComputeSelfCollision(robot_)) {
     ee_link_ = robot_.FindLink(planner.params().end_effector_link);
     const auto& o = planner.params().end_effector_offset;
     ee_offset_ = Eigen::Vector3d(o[0], o[1], o[2]);
@@ -110,7 +115,7 @@ class Resolver {
       if (!ik.success) return std::nullopt;
       q = ik.q;
     }
-    if (planner_.CalcClearance(q) < 0.0) return std::nullopt;
+    if (Clearance(q) < 0.0) return std::nullopt;
     return q;
   }
 
@@ -120,6 +125,13 @@ class Resolver {
     for (const ToolPose& place : places_)
       n += Continue(q, Vec3(place.position), Vec3(place.z_axis).normalized(), 1).has_value() ? 1 : 0;
     return n;
+  }
+
+  // The smaller of the clearance from the static scene and from the arm
+  // itself (m; negative: in collision; GoalOptions::self_overlap allowed).
+  double Clearance(const Eigen::VectorXd& q) {
+    collision::CalcForwardKinematics(robot_, q, &data_);
+    return std::min(planner_.CalcClearance(q), collision::SelfDistance(robot_, self_, data_) + agreement_.self_overlap);
   }
 
   // A revolute joint at q + 2 pi k is the same pose: each joint takes the
@@ -169,7 +181,7 @@ class Resolver {
       NearestTurn(&ik.q);
       best_error = std::min(best_error, ik.position_error);
       if (!ik.success) continue;
-      const double clearance = planner_.CalcClearance(ik.q);
+      const double clearance = Clearance(ik.q);
       if (clearance < 0.0) {
         best_clearance = std::max(best_clearance, clearance);
         continue;
@@ -187,7 +199,7 @@ class Resolver {
     if (best) return std::vector<double>(best->data(), best->data() + best->size());
     std::ostringstream s;
     s.precision(3);
-    s << what << ": robot '" << robot_.name << "' has no solution clear of the scene for position " << Text(p)
+    s << what << ": robot '" << robot_.name << "' has no solution clear of the scene and of itself for position " << Text(p)
       << " m, z axis " << Text(z) << " (best position error " << best_error << " m";
     if (best_error <= planner_.params().ik_position_tolerance) s << ", best clearance " << best_clearance << " m";
     s << ")";
@@ -197,7 +209,8 @@ class Resolver {
   const planning::Planner& planner_;
   const collision::RobotModel& robot_;
   collision::RobotData data_;
-  PoseAgreement agreement_;
+  GoalOptions agreement_;
+  collision::SelfCollisionModel self_;  // the link pairs worth checking
   int ee_link_ = -1;
   Eigen::Vector3d ee_offset_;
   Eigen::VectorXd seed_;
@@ -208,7 +221,7 @@ class Resolver {
 }  // namespace
 
 std::vector<std::string> ResolveTaskGoals(const planning::Planner& planner, TaskGraph* graph,
-                                          const PoseAgreement& agreement) {
+                                          const GoalOptions& agreement) {
   if (const std::string why = graph->Validate(); !why.empty()) throw std::invalid_argument(why);
   Resolver resolver(planner, agreement);
   std::vector<ToolPose> places;

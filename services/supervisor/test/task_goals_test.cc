@@ -10,6 +10,7 @@
 #include "core/task_planner.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/scene.h"
+#include "iplan/collision/self_collision.h"
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::supervisor {
@@ -52,6 +53,7 @@ TEST(TaskGoals, Ur5eGetsEveryPlaceOfTheSameCellSolved) {
   EXPECT_EQ(notes.size(), 6u);  // five goals and the hand-over's retreat
   const std::vector<double> rest = RestPositions(g);
   ASSERT_EQ(rest.size(), 6u);
+  const collision::SelfCollisionModel self = collision::ComputeSelfCollision(ur.robot());
   for (const RobotTask& t : g.tasks) {
     for (const auto& [q, pose] : {std::pair{&t.goal, &t.goal_pose}, std::pair{&t.retreat, &t.retreat_pose}}) {
       if (!pose->given()) continue;
@@ -60,6 +62,9 @@ TEST(TaskGoals, Ur5eGetsEveryPlaceOfTheSameCellSolved) {
       EXPECT_LT((p - Eigen::Vector3d(pose->position[0], pose->position[1], pose->position[2])).norm(), 1e-3) << t.name;
       EXPECT_GT(z.dot(Eigen::Vector3d(0, 0, -1)), std::cos(1e-2)) << t.name;
       EXPECT_GE(ur.CalcClearance(Eigen::Map<const Eigen::VectorXd>(q->data(), 6)), 0.0) << t.name;
+      collision::RobotData d(ur.robot());
+      collision::CalcForwardKinematics(ur.robot(), Eigen::Map<const Eigen::VectorXd>(q->data(), 6), &d);
+      EXPECT_GE(collision::SelfDistance(ur.robot(), self, d), -GoalOptions{}.self_overlap) << t.name;
       // One arm configuration family: no joint turns half a turn or more
       // from the rest place (no elbow or wrist flip on the way).
       for (int j = 0; j < 6; ++j) EXPECT_LT(std::abs((*q)[j] - rest[j]), M_PI) << t.name << " joint " << j;
@@ -99,7 +104,7 @@ TEST(TaskGoals, PlacesThatCannotBeSolvedAreNamed) {
   TaskGraph far = CellGraph();
   far.tasks[3].goal = {};
   far.tasks[3].goal_pose.position = {3.0, 0.0, 0.5};
-  EXPECT_NE(error(far).find("task 'inspect' goal: robot 'panda' has no solution clear of the scene"), std::string::npos)
+  EXPECT_NE(error(far).find("task 'inspect' goal: robot 'panda' has no solution clear of the scene and of itself"), std::string::npos)
       << error(far);
   TaskGraph bad_axis = CellGraph();
   bad_axis.tasks[0].goal_pose.z_axis = {0.0, 0.0, 0.0};

@@ -55,6 +55,13 @@ TEST_F(RobotSpheresCliTest, Ur5eEveryVertexCoveredAndTheExcessStated) {
   }
   EXPECT_LE(first["median_max_excess_m"].get<double>(), 0.025);
   EXPECT_EQ(first["uncovered_vertices"], 0);
+  // Self-collision pairs by sampling: the six joints' neighbours skipped as
+  // adjacent, every one of the 21 pairs of the 7 links accounted for.
+  const json& self = first["self_collision"];
+  int adjacent = 0;
+  for (const json& p : self["skipped"]) adjacent += p["reason"] == "adjacent" ? 1 : 0;
+  EXPECT_EQ(adjacent, 6);
+  EXPECT_EQ(self["checked"].size() + self["skipped"].size(), 21u);
   // The written cover holds every sphere.
   std::ifstream f(o.out);
   const json cover = json::parse(f);
