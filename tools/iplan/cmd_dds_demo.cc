@@ -139,7 +139,9 @@ class DemoRun {
     std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain_ << "\n"
               << "  configuration " << config_dir_ << "\n  state and service logs (<service>.err) " << state_dir_ << "\n";
     if (o_.predictor != "model") std::cout << "  predictor: " << o_.predictor << " (ablation)\n";
-    if (!o_.prepare_only && !(security_ = SecureDemoOrExplain(o_.insecure, o_.security, o_.mixed, domain_))) return 2;
+    const std::string view_args = o_.robot.empty() ? "" : " --robot " + fs::absolute(o_.robot).string();
+    if (!o_.prepare_only && !(security_ = SecureDemoOrExplain(o_.insecure, o_.security, o_.mixed, domain_, view_args)))
+      return 2;
     try {
       if (!fs::exists(fs::path(config_dir_) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir_);
       std::cout << "  intent model: checking ..." << std::flush;

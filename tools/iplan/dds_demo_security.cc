@@ -61,11 +61,12 @@ void AddDemoSecurityOptions(CLI::App* demo, bool* insecure, std::string* keystor
                    "$XDG_DATA_HOME/iplan/keystore or ~/.local/share/iplan/keystore, made on first use)");
 }
 
-std::optional<DemoSecurity> SecureDemoOrExplain(bool insecure, const std::string& keystore, bool mixed, int domain) {
+std::optional<DemoSecurity> SecureDemoOrExplain(bool insecure, const std::string& keystore, bool mixed, int domain,
+                                                const std::string& view_args) {
   try {
     DemoSecurity s = SecureDemo(insecure, keystore, mixed);
     std::cout << "  " << s.summary << "\n  watch it: iplan view --domain " << domain
-              << (s.secured ? " --security " + s.keystore : std::string()) << "\n";
+              << (s.secured ? " --security " + s.keystore : std::string()) << view_args << "\n";
     return s;
   } catch (const std::exception& e) {
     std::cerr << "iplan demo: refused: " << e.what() << "\n";

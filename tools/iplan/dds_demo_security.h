@@ -47,8 +47,10 @@ void AddDemoSecurityOptions(CLI::App* demo, bool* insecure, std::string* keystor
 DemoSecurity SecureDemo(bool insecure, const std::string& keystore, bool mixed);
 
 /// SecureDemo, its summary and how to watch the cell on `domain` (the
-/// `iplan view` command line) printed as lines of the demo's header; nullopt
+/// `iplan view` command line, `view_args` appended, e.g. " --robot FILE")
+/// printed as lines of the demo's header; nullopt
 /// (the reason printed on stderr) when the demo must not run.
-std::optional<DemoSecurity> SecureDemoOrExplain(bool insecure, const std::string& keystore, bool mixed, int domain);
+std::optional<DemoSecurity> SecureDemoOrExplain(bool insecure, const std::string& keystore, bool mixed, int domain,
+                                                const std::string& view_args = "");
 
 }  // namespace iplan::cli
