@@ -22,6 +22,11 @@ int GeometricParent(const RobotModel& model, const std::vector<char>& has_sphere
   }
 }
 
+// Surface distance (m) between spheres i and k at the poses in `data`.
+double Gap(const RobotModel& model, const RobotData& data, int i, int k) {
+  return (data.p_WS.col(i) - data.p_WS.col(k)).norm() - model.spheres[i].radius - model.spheres[k].radius;
+}
+
 }  // namespace
 
 std::string SelfCollisionParams::Validate() const {
@@ -74,8 +79,7 @@ SelfCollisionModel ComputeSelfCollision(const RobotModel& model, const SelfColli
     CalcForwardKinematics(model, q, &data);
     for (Stats& p : pairs) {
       double d = std::numeric_limits<double>::infinity();
-      for (const auto& [i, k] : p.spheres)
-        d = std::min(d, (data.p_WS.col(i) - data.p_WS.col(k)).norm() - model.spheres[i].radius - model.spheres[k].radius);
+      for (const auto& [i, k] : p.spheres) d = std::min(d, Gap(model, data, i, k));
       p.min_distance = std::min(p.min_distance, d);
       if (d < 0.0) ++p.touching;
     }
@@ -99,8 +103,7 @@ SelfCollisionModel ComputeSelfCollision(const RobotModel& model, const SelfColli
 
 double SelfDistance(const RobotModel& model, const SelfCollisionModel& self, const RobotData& data) {
   double d = std::numeric_limits<double>::infinity();
-  for (const auto& [i, k] : self.sphere_pairs)
-    d = std::min(d, (data.p_WS.col(i) - data.p_WS.col(k)).norm() - model.spheres[i].radius - model.spheres[k].radius);
+  for (const auto& [i, k] : self.sphere_pairs) d = std::min(d, Gap(model, data, i, k));
   return d;
 }
 

@@ -28,12 +28,8 @@ std::string Text(const Eigen::Vector3d& v) {
 
 class Resolver {
  public:
-  Resolver(const planning::Planner& planner, const GoalOptions& agreement)
-      : planner_(planner),
-        robot_(planner.robot()),
-        data_(robot_),
-        agreement_(agreement),
-        self_(collision::ComputeSelfCollision(robot_)) {
+  Resolver(const planning::Planner& planner, const GoalOptions& options)
+      : planner_(planner), robot_(planner.robot()), data_(robot_), options_(options) {
     ee_link_ = robot_.FindLink(planner.params().end_effector_link);
     const auto& o = planner.params().end_effector_offset;
     ee_offset_ = Eigen::Vector3d(o[0], o[1], o[2]);
@@ -59,7 +55,7 @@ class Resolver {
     if (static_cast<int>(joints->size()) == nq) {
       if (!pose.given()) return;
       const double dp = PositionError(*joints, pose), da = AxisError(*joints, pose);
-      if (dp <= agreement_.position && da <= agreement_.axis) return;
+      if (dp <= options_.position && da <= options_.axis) return;
       std::ostringstream s;
       s.precision(3);
       s << what << ": the joint positions put the end effector " << dp << " m and " << da
@@ -99,7 +95,7 @@ class Resolver {
   }
 
   // IK along the straight line from the seed's end-effector pose to (p, z)
-  // in small steps, no restarts; the end only if it is clear of the scene.
+  // in small steps, no restarts; the end only if it is clear (Clearance).
   std::optional<Eigen::VectorXd> Continue(const Eigen::VectorXd& from, const Eigen::Vector3d& p, const Eigen::Vector3d& z,
                                          std::uint64_t seed) {
     const Eigen::Isometry3d X0 = EndEffector(std::vector<double>(from.data(), from.data() + from.size()));
@@ -130,8 +126,11 @@ class Resolver {
   // The smaller of the clearance from the static scene and from the arm
   // itself (m; negative: in collision; GoalOptions::self_overlap allowed).
   double Clearance(const Eigen::VectorXd& q) {
+    // Sampled on first use: a graph whose places are all joints of this
+    // robot never needs it.
+    if (!self_) self_ = collision::ComputeSelfCollision(robot_);
     collision::CalcForwardKinematics(robot_, q, &data_);
-    return std::min(planner_.CalcClearance(q), collision::SelfDistance(robot_, self_, data_) + agreement_.self_overlap);
+    return std::min(planner_.CalcClearance(q), collision::SelfDistance(robot_, *self_, data_) + options_.self_overlap);
   }
 
   // A revolute joint at q + 2 pi k is the same pose: each joint takes the
@@ -160,7 +159,7 @@ class Resolver {
     const Eigen::Vector3d p = Vec3(pose.position), z = Vec3(pose.z_axis).normalized();
     double best_error = std::numeric_limits<double>::infinity(), best_clearance = -1.0;
     // From the seed and from seeds near it (a fixed stream), each with the
-    // IK's own restarts: of the solutions clear of the scene, the one
+    // IK's own restarts: of the solutions that are clear (Clearance), the one
     // nearest the seed (the arm keeps its elbow and wrist from place to
     // place, so the optimiser can get there within its horizon).
     std::mt19937_64 rng(seed);
@@ -209,8 +208,8 @@ class Resolver {
   const planning::Planner& planner_;
   const collision::RobotModel& robot_;
   collision::RobotData data_;
-  GoalOptions agreement_;
-  collision::SelfCollisionModel self_;  // the link pairs worth checking
+  GoalOptions options_;
+  std::optional<collision::SelfCollisionModel> self_;  // the link pairs worth checking
   int ee_link_ = -1;
   Eigen::Vector3d ee_offset_;
   Eigen::VectorXd seed_;
@@ -221,9 +220,9 @@ class Resolver {
 }  // namespace
 
 std::vector<std::string> ResolveTaskGoals(const planning::Planner& planner, TaskGraph* graph,
-                                          const GoalOptions& agreement) {
+                                          const GoalOptions& options) {
   if (const std::string why = graph->Validate(); !why.empty()) throw std::invalid_argument(why);
-  Resolver resolver(planner, agreement);
+  Resolver resolver(planner, options);
   std::vector<ToolPose> places;
   for (const RobotTask& t : graph->tasks)
     for (const ToolPose* pose : {&t.goal_pose, &t.retreat_pose})

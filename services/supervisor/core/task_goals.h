@@ -42,7 +42,7 @@ struct GoalOptions {
 /// written. Deterministic. @throws std::invalid_argument naming the task
 /// (no solution: the best position error and clearance).
 std::vector<std::string> ResolveTaskGoals(const planning::Planner& planner, TaskGraph* graph,
-                                          const GoalOptions& agreement = {});
+                                          const GoalOptions& options = {});
 
 /// The rest task's joint positions after ResolveTaskGoals; empty when the
 /// graph names no rest task.
