@@ -3,6 +3,7 @@
 #include <filesystem>
 #include <stdexcept>
 
+#include "core/intent_settings.h"
 #include "core/robot_sim_settings.h"
 #include "core/supervisor_settings.h"
 #include "core/task_goals.h"
@@ -10,24 +11,16 @@
 #include "iplan/core/params.h"
 #include "iplan/collision/scene.h"
 #include "iplan/framework/config.h"
+#include "iplan/framework/service_file.h"
 #include "iplan/planning/planner_params.h"
 #include "risk_config.h"
-#include "synthetic_config.h"
+#include "perception_settings.h"
 #include "trajopt_config.h"
 
 namespace iplan::cell_sim {
 namespace {
 
 namespace fs = std::filesystem;
-
-// Tools read part of each service's file: its values are checked, its other
-// keys are the services' business.
-void Check(const framework::ConfigSection& c) {
-  if (c.Problems().empty()) return;
-  std::string msg;
-  for (const auto& p : c.Problems()) msg += (msg.empty() ? "" : "\n") + p;
-  throw std::runtime_error(msg);
-}
 
 Eigen::VectorXd ToEigen(const std::vector<double>& v) {
   return Eigen::Map<const Eigen::VectorXd>(v.data(), static_cast<Eigen::Index>(v.size()));
@@ -64,12 +57,9 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   c.dir = dir;
 
   // The trajectory optimiser and the models it names.
-  framework::ConfigSection tconf = framework::ConfigSection::Load(file("trajopt"));
-  framework::ConfigSection tsec = tconf.Section("trajopt");
-  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
-  Check(tconf);
-  if (!robot_file.empty()) topt.robot_file = robot_file;
-  if (const std::string why = topt.replanner.Validate(); !why.empty()) throw std::runtime_error(file("trajopt") + ": " + why);
+  // Every file is read as its service reads it (framework::ServiceFile):
+  // the same keys, defaults and checks.
+  trajopt::TrajoptConfig topt = trajopt::LoadTrajoptConfig(file("trajopt"), robot_file);
   c.replanner = topt.replanner;
   // Simulated time: a wall-clock budget would make the benchmark depend on
   // the machine's load; it plans every cycle to the end.
@@ -81,56 +71,41 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   c.body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(topt.human_body_file));
 
   // The collision-risk monitor, as its service builds it.
-  framework::ConfigSection rconf = framework::ConfigSection::Load(file("collision_risk"));
+  framework::ServiceFile rconf(file("collision_risk"));
   framework::ConfigSection rsec = rconf.Section("collision_risk");
   collision_risk::RiskConfig risk = collision_risk::ReadRiskConfig(rsec);
-  Check(rconf);
+  rconf.Finish();
   if (!robot_file.empty()) risk.robot_file = robot_file;
-  if (const std::string why = risk.params.Validate(); !why.empty()) throw std::runtime_error(file("collision_risk") + ": " + why);
   c.monitor = std::make_unique<collision_risk::RiskMonitor>(collision_risk::MakeRiskMonitor(risk));
   c.loop.monitor_rate_hz = risk.rate_hz;
 
   // The simulated robot.
-  framework::ConfigSection sconf = framework::ConfigSection::Load(file("robot_sim"));
-  framework::ConfigSection ssec = sconf.Section("robot_sim");
   robot_sim::RobotSimSettings sim;
-  core::ReadParams(ssec, &sim);  // the service's keys and ranges
+  framework::ServiceFile(file("robot_sim")).Read("robot_sim", &sim).Finish();
   c.loop.control_rate_hz = sim.control_rate_hz;
   c.loop.joint_state_rate_hz = sim.publish_rate_hz;
   c.simulator = sim.simulator;
-  Check(sconf);
 
   // The supervisor: task graph and resume hysteresis.
-  framework::ConfigSection vconf = framework::ConfigSection::Load(file("supervisor"));
-  framework::ConfigSection vsec = vconf.Section("supervisor");
+  framework::ServiceFile vconf(file("supervisor"));
   supervisor::SupervisorSettings settings;
-  core::ReadParams(vsec, &settings);  // the service's keys and ranges
+  vconf.Read("supervisor", &settings).Finish();
   c.loop.resume_delay = settings.resume_delay;
-  Check(vconf);
   supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
   c.goal_notes = supervisor::ResolveTaskGoals(*c.planner, &graph);  // poses: the planner's IK for this robot
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
 
   // The sensor and the synthetic person.
-  framework::ConfigSection pconf = framework::ConfigSection::Load(file("perception"));
-  framework::ConfigSection psec = pconf.Section("perception");
-  psec.Read("rate_hz", &c.sensor_rate_hz, framework::InRange(0.5, 1000.0));
-  framework::ConfigSection syn = psec.Section("synthetic");
-  perception::ScriptStart start;
-  c.person = perception::ReadSyntheticPerson(syn, &start);
-  Check(pconf);
-  if (const std::string why = c.person.Validate(); !why.empty()) {
-    throw std::runtime_error(file("perception") + ": key 'perception.synthetic': " + why);
-  }
+  perception::PerceptionSettings perception;
+  framework::ServiceFile(file("perception")).Read("perception", &perception).Finish();
+  c.sensor_rate_hz = perception.rate_hz;
+  c.person = perception.synthetic.Person();
   c.sensor_noise_std = c.person.noise_stddev;
 
   // The intent estimator's settings.
-  framework::ConfigSection iconf = framework::ConfigSection::Load(file("intent"));
-  framework::ConfigSection isec = iconf.Section("intent");
-  isec.Read("body_timeout", &c.estimator.body_timeout, framework::Positive<double>());
-  isec.Read("max_gap", &c.estimator.max_gap, framework::Positive<double>());
-  isec.Read("max_bodies", &c.estimator.max_bodies, framework::InRange(1, 1000));
-  Check(iconf);
+  intent_service::IntentSettings intent;
+  framework::ServiceFile(file("intent")).Read("intent", &intent).Finish();
+  c.estimator = intent.estimator;
   return c;
 }
 

@@ -7,21 +7,30 @@
 
 namespace iplan::collision_risk {
 
+std::string RiskSettings::Validate() const {
+  if (!(rate_hz >= 1 && rate_hz <= 1000)) return "rate_hz must be in [1, 1000], got " + core::ParamText(rate_hz);
+  if (!(permit_validity >= 0.01 && permit_validity <= 10)) {
+    return "permit_validity must be in [0.01, 10], got " + core::ParamText(permit_validity);
+  }
+  if (permit_validity < 2.0 / rate_hz) {
+    return "permit_validity must be at least two evaluation periods (2 / rate_hz = " + core::ParamText(2.0 / rate_hz) +
+           " s), got " + core::ParamText(permit_validity);
+  }
+  return params.Validate();
+}
+
 RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
+  RiskSettings settings;
+  core::ReadParams(config, &settings);  // every range: RiskSettings::Validate
   RiskConfig c;
   RiskParams& p = c.params;
-  std::string robot_file = "robots/panda.yaml", body_file = "humans/upper_body.yaml";
-  config.Read("robot", &robot_file);
-  config.Read("human_body", &body_file);
-  config.Read("rate_hz", &c.rate_hz, framework::InRange(1.0, 1000.0));
-  config.Read("permit_validity", &c.permit_validity, framework::InRange(0.01, 10.0));
-  core::ReadParams(config, &p);  // every range: RiskParams::Validate
+  p = settings.params;
+  c.rate_hz = settings.rate_hz;
+  c.permit_validity = settings.permit_validity;
   // The cell's safety file is the one source of delta_cl and the ISO/TS
   // 15066 parameters; values given here too must agree with it.
-  if (config.Has("safety")) {
-    std::string safety_file;
-    config.Read("safety", &safety_file);
-    c.safety_file = config.ResolvePath(safety_file);
+  if (!settings.safety.empty()) {
+    c.safety_file = config.ResolvePath(settings.safety);
     try {
       const cell::SafetyParams safety = cell::LoadSafetyParams(c.safety_file);
       if (config.Has("delta_cl") && p.delta_cl != safety.delta_cl) {
@@ -37,8 +46,8 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
       config.AddError("safety", e.what());
     }
   }
-  c.robot_file = config.ResolvePath(robot_file);
-  c.human_body_file = config.ResolvePath(body_file);
+  c.robot_file = config.ResolvePath(settings.robot);
+  c.human_body_file = config.ResolvePath(settings.human_body);
   return c;
 }
 

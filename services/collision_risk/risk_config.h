@@ -10,6 +10,28 @@
 
 namespace iplan::collision_risk {
 
+/// Section collision_risk, declared once: the service's own keys, then
+/// RiskParams' keys inline (listed by `iplan config defaults collision-risk`).
+struct RiskSettings {
+  std::string robot = "robots/panda.yaml";           ///< relative to the configuration file
+  std::string human_body = "humans/upper_body.yaml";  ///< relative to the configuration file
+  double rate_hz = 15;
+  double permit_validity = 0.2;
+  std::string safety;  ///< the cell's safety file; empty: none
+  RiskParams params;   ///< its keys sit in the section itself
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(robot, "robot file (URDF, overlay or DH yaml), relative to the configuration file"));
+    a->Visit(IPLAN_NVP(human_body, "human body spheres file, relative to the configuration file"));
+    a->Visit(IPLAN_NVP(rate_hz, "Hz, evaluations per second between predictions, in [1, 1000]"));
+    a->Visit(IPLAN_NVP(permit_validity, "s; the permit published with every evaluation lapses after this, in [0.01, 10]"));
+    a->Visit(IPLAN_NVP(safety, "the cell's safety file (delta_cl, iso_ts_15066: the one source); empty: none"));
+    params.Serialize(a);
+  }
+  std::string Validate() const;
+};
+
 struct RiskConfig {
   RiskParams params;
   double rate_hz = 15;        ///< evaluations per second between predictions

@@ -3,7 +3,6 @@
 #include <cmath>
 #include <cstring>
 
-#include "iplan/core/params.h"
 
 namespace iplan::services {
 namespace {
@@ -96,18 +95,6 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
     dense = dense && c.points[i].allFinite();
   }
   out->is_dense = dense;
-}
-
-Eigen::Isometry3d ReadCameraPose(core::ConfigSection camera) {
-  cloud::CameraLookAt c;
-  core::ReadParams(camera, &c);  // a pose that cannot be: CameraLookAt::Validate
-  return c.Validate().empty() ? c.Pose() : Eigen::Isometry3d::Identity();
-}
-
-cloud::DepthNoiseParams ReadDepthNoise(core::ConfigSection noise) {
-  cloud::DepthNoiseParams p;
-  core::ReadParams(noise, &p);  // ranges: DepthNoiseParams::Validate
-  return p;
 }
 
 }  // namespace iplan::services

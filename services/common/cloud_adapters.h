@@ -16,7 +16,6 @@
 #include "iplan/cloud/camera.h"
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/noise.h"
-#include "iplan/core/config.h"
 #include "iplan/msg/types.h"
 
 namespace iplan::services {
@@ -35,12 +34,5 @@ std::optional<std::string> FromPointCloud2(const msg::PointCloud2& m, cloud::Clo
 /// point_step 12, little-endian, is_dense when every point is finite.
 void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id,
                    msg::PointCloud2* out);
-
-/// Reads a camera's pose from a `camera` section (`position`: [x, y, z] m in
-/// world, `look_at`: [x, y, z] m in world; see cloud::CameraPoseLookAt) and
-/// its noise model (`noise`: axial_constant m, axial_quadratic 1/m, axial_z0
-/// m, lateral_px, focal_px). Problems are recorded in the sections.
-Eigen::Isometry3d ReadCameraPose(core::ConfigSection camera);
-cloud::DepthNoiseParams ReadDepthNoise(core::ConfigSection noise);
 
 }  // namespace iplan::services

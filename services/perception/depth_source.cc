@@ -44,8 +44,8 @@ struct DepthSource::Impl {
   msg::PointCloud2 message;
   double render_ms_sum = 0;
 
-  framework::Result ConfigureSimulated(framework::ConfigSection& depth);
-  framework::Result ConfigurePcd(framework::ConfigSection& depth);
+  framework::Result ConfigureSimulated(const framework::ConfigSection& config, const SimulatedDepthSettings& sim);
+  framework::Result ConfigurePcd(const framework::ConfigSection& config, const PcdSettings& pcd);
   void OnJointState(framework::Node& node, const msg::JointState& m);
   bool Produce(framework::Node& node);
   void Tick(framework::Node& node);
@@ -54,15 +54,16 @@ struct DepthSource::Impl {
 DepthSource::DepthSource() : impl_(std::make_unique<Impl>()) {}
 DepthSource::~DepthSource() = default;
 
-framework::Result DepthSource::Configure(framework::ConfigSection depth, framework::Node& node) {
+framework::Result DepthSource::Configure(const framework::ConfigSection& config, const DepthSettings& settings,
+                                         framework::Node& node) {
   Impl& s = *impl_;
-  depth.Read("provider", &s.provider, framework::OneOf({"none", "simulated", "pcd"}));
-  depth.Read("rate_hz", &s.rate_hz, framework::InRange(0.1, 120.0));
-  depth.Read("frame_id", &s.frame_id);
-  // Both providers' keys are read always, so that switching keeps the file valid.
-  if (framework::Result r = s.ConfigureSimulated(depth); !r.ok) return r;
-  if (framework::Result r = s.ConfigurePcd(depth); !r.ok) return r;
-  if (s.provider == "none") return framework::Result::Ok();
+  s.provider = settings.provider;
+  s.rate_hz = settings.rate_hz;
+  s.frame_id = settings.frame_id;
+  framework::Result r = framework::Result::Ok();
+  if (s.provider == "simulated") r = s.ConfigureSimulated(config, settings.simulated);
+  if (s.provider == "pcd") r = s.ConfigurePcd(config, settings.pcd);
+  if (!r.ok || s.provider == "none") return r;
   s.writer = &node.Advertise(framework::topics::DepthPoints());
   if (s.provider == "simulated" && s.robot) {
     using SI = const dds::SampleInfo&;
@@ -75,39 +76,15 @@ framework::Result DepthSource::Configure(framework::ConfigSection depth, framewo
   return framework::Result::Ok();
 }
 
-framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection& depth) {
-  framework::ConfigSection sim = depth.Section("simulated");
-  DepthCameraParams p;
-  p.X_WS = services::ReadCameraPose(sim.Section("camera"));
-  p.noise = services::ReadDepthNoise(sim.Section("noise"));
-  framework::ConfigSection in = sim.Section("intrinsics");
-  in.Read("width", &p.intrinsics.width);
-  in.Read("height", &p.intrinsics.height);
-  in.Read("fx", &p.intrinsics.fx);
-  in.Read("fy", &p.intrinsics.fy);
-  in.Read("cx", &p.intrinsics.cx);
-  in.Read("cy", &p.intrinsics.cy);
-  if (const std::string why = p.intrinsics.Validate(); !why.empty()) in.AddProblem(why);
-  sim.Read("add_noise", &p.add_noise);
-  sim.Read("min_range", &p.min_range, framework::NonNegative<double>());
-  sim.Read("max_range", &p.max_range, framework::Positive<double>());
-  int seed = 1;
-  sim.Read("seed", &seed);
-  p.seed = static_cast<uint64_t>(seed);
-  std::vector<std::string> scenes = {"scenes/cell.yaml"}, added_scenes;
-  std::string body_file = "humans/upper_body.yaml", robot_file = "robots/panda.yaml";
-  sim.Read("scenes", &scenes);
-  sim.Read("added_scenes", &added_scenes);
-  sim.Read("added_after", &added_after, framework::NonNegative<double>());
-  sim.Read("human_after", &human_after, framework::NonNegative<double>());
-  sim.Read("human_body", &body_file);
-  sim.Read("robot", &robot_file);
-  if (provider != "simulated" || !depth.Problems().empty()) return framework::Result::Ok();
+framework::Result DepthSource::Impl::ConfigureSimulated(const framework::ConfigSection& config,
+                                                        const SimulatedDepthSettings& sim) {
+  added_after = sim.added_after;
+  human_after = sim.human_after;
   try {
-    camera = std::make_unique<SimulatedDepthCamera>(p);
-    auto load = [&sim](const std::vector<std::string>& files, DepthScene* into) {
+    camera = std::make_unique<SimulatedDepthCamera>(sim.Camera());
+    auto load = [&config](const std::vector<std::string>& files, DepthScene* into) {
       for (const std::string& f : files) {
-        for (const collision::SceneObject& o : collision::LoadSceneParams(sim.ResolvePath(f)).objects) {
+        for (const collision::SceneObject& o : collision::LoadSceneParams(config.ResolvePath(f)).objects) {
           if (o.shape == collision::SceneObject::Shape::kBox) {
             into->boxes.push_back({o.X_WO, o.size});
           } else {
@@ -116,33 +93,25 @@ framework::Result DepthSource::Impl::ConfigureSimulated(framework::ConfigSection
         }
       }
     };
-    load(scenes, &fixed);
-    load(added_scenes, &added);
-    if (!body_file.empty()) {
-      body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(sim.ResolvePath(body_file)));
+    load(sim.scenes, &fixed);
+    load(sim.added_scenes, &added);
+    if (!sim.human_body.empty()) {
+      body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(config.ResolvePath(sim.human_body)));
     }
-    if (!robot_file.empty()) {
-      robot = std::make_unique<collision::RobotModel>(collision::LoadRobotModel(sim.ResolvePath(robot_file)));
+    if (!sim.robot.empty()) {
+      robot = std::make_unique<collision::RobotModel>(collision::LoadRobotModel(config.ResolvePath(sim.robot)));
       robot_data = std::make_unique<collision::RobotData>(*robot);
       robot_joints = robot->JointNames();
     }
   } catch (const std::exception& e) {
-    return framework::Result::Fail(sim.file() + ": key 'perception.depth.simulated': " + e.what());
+    return framework::Result::Fail(config.file() + ": key 'perception.depth.simulated': " + e.what());
   }
   return framework::Result::Ok();
 }
 
-framework::Result DepthSource::Impl::ConfigurePcd(framework::ConfigSection& depth) {
-  framework::ConfigSection pcd = depth.Section("pcd");
-  std::string path;
-  pcd.Read("path", &path);
-  pcd.Read("loop", &loop);
-  if (provider != "pcd") return framework::Result::Ok();
-  if (path.empty()) {
-    pcd.AddError("path", "required with provider pcd (a .pcd file or a folder of them)");
-    return framework::Result::Ok();
-  }
-  path = pcd.ResolvePath(path);
+framework::Result DepthSource::Impl::ConfigurePcd(const framework::ConfigSection& config, const PcdSettings& pcd) {
+  loop = pcd.loop;
+  const std::string path = config.ResolvePath(pcd.path);
   std::error_code ec;
   if (fs::is_directory(path, ec)) {
     for (const auto& e : fs::directory_iterator(path, ec)) {
@@ -153,12 +122,12 @@ framework::Result DepthSource::Impl::ConfigurePcd(framework::ConfigSection& dept
     files.push_back(path);
   }
   if (files.empty()) {
-    return framework::Result::Fail(pcd.file() + ": key 'perception.depth.pcd.path': no .pcd file at " + path);
+    return framework::Result::Fail(config.file() + ": key 'perception.depth.pcd.path': no .pcd file at " + path);
   }
   try {
     cloud::LoadPcd(files.front());  // a broken first file is a configuration problem, found now
   } catch (const std::exception& e) {
-    return framework::Result::Fail(pcd.file() + ": key 'perception.depth.pcd.path': " + e.what());
+    return framework::Result::Fail(config.file() + ": key 'perception.depth.pcd.path': " + e.what());
   }
   return framework::Result::Ok();
 }

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "core/synthetic_person.h"
+#include "perception_settings.h"
 #include "iplan/framework/service.h"
 
 namespace iplan::perception {
@@ -30,10 +31,11 @@ class DepthSource {
   DepthSource();
   ~DepthSource();
 
-  /// Reads `depth` (a section of the service's file), loads what the
-  /// provider needs, advertises the cloud topic. Configuration problems are
-  /// recorded in the section; a file that cannot be loaded fails.
-  framework::Result Configure(framework::ConfigSection depth, framework::Node& node);
+  /// Loads what the provider of `settings` (perception.depth, read and
+  /// checked) needs, with paths relative to `config`'s file, and advertises
+  /// the cloud topic. A file that cannot be loaded fails, naming the key.
+  framework::Result Configure(const framework::ConfigSection& config, const DepthSettings& settings,
+                              framework::Node& node);
   /// Starts the provider's timer (no-op for "none").
   void Activate(framework::Node& node, TruthFn truth);
   void Deactivate(framework::Node& node);

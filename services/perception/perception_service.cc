@@ -2,6 +2,7 @@
 // Provider "synthetic": a simulated person (core/synthetic_person.h).
 // Provider "replay": recorded sequences from a skeleton CSV file, at their
 // recorded times (core/skeleton_replay.h).
+#include <algorithm>
 #include <chrono>
 #include <filesystem>
 #include <vector>
@@ -9,7 +10,7 @@
 #include "core/skeleton_replay.h"
 #include "depth_source.h"
 #include "iplan/framework/service.h"
-#include "synthetic_config.h"
+#include "perception_settings.h"
 
 namespace iplan::perception {
 namespace {
@@ -21,16 +22,19 @@ using framework::Result;
 class PerceptionService : public framework::Service {
  public:
   Result OnConfigure(ConfigSection& config, Node& node) override {
-    config.Read("provider", &provider_, framework::OneOf({"synthetic", "replay"}));
-    config.Read("rate_hz", &rate_hz_, framework::InRange(0.5, 1000.0));
-    config.Read("frame_id", &frame_id_);
-    config.Read("publish_truth", &publish_truth_);
-    config.Read("publish_skeleton", &publish_skeleton_);
+    PerceptionSettings settings;
+    core::ReadParams(config, &settings);  // every range: PerceptionSettings::Validate
+    if (!config.Problems().empty()) return Result::Ok();  // reported by the configuration check
+    provider_ = settings.provider;
+    rate_hz_ = settings.rate_hz;
+    frame_id_ = settings.frame_id;
+    publish_truth_ = settings.publish_truth;
+    publish_skeleton_ = settings.publish_skeleton;
     start_ = std::chrono::system_clock::now();
-    ConfigSection syn = config.Section("synthetic");
-    std::vector<SyntheticPersonParams> others;
-    params_ = ReadSyntheticPerson(syn, &script_start_, &others);
-    if (Result r = ConfigureReplay(config); !r.ok) return r;
+    params_ = settings.synthetic.Person();
+    script_start_ = settings.synthetic.Start();
+    const std::vector<SyntheticPersonParams> others = settings.synthetic.MorePeople();
+    if (Result r = ConfigureReplay(config, settings.replay); !r.ok) return r;
     if (provider_ == "synthetic") {
       try {
         // Body 1 is the first person, bodies 2, 3, ... perception.synthetic.more_people.
@@ -59,7 +63,7 @@ class PerceptionService : public framework::Service {
     node.SetDiagnosticValue("publish_skeleton", publish_skeleton_ ? "true" : "false");
     if (publish_truth_) truth_writer_ = &node.Advertise(framework::topics::HumanTruth());
     node.SetDiagnosticValue("provider", provider_);
-    return depth_.Configure(config.Section("depth"), node);  // the depth camera, if any
+    return depth_.Configure(config, settings.depth, node);  // the depth camera, if any
   }
 
   Result OnActivate(Node& node) override {
@@ -88,46 +92,18 @@ class PerceptionService : public framework::Service {
   // Frames are published within this period of their play time.
   static constexpr std::chrono::milliseconds kReplayPoll{5};
 
-  // Reads perception.replay (its scalar keys always, so that switching the
-  // provider keeps the file valid; joint_map only for provider replay, since
-  // its keys are the file's joint names) and loads the file.
-  Result ConfigureReplay(ConfigSection& config) {
-    ConfigSection rep = config.Section("replay");
-    SkeletonReplayParams p;
-    rep.Read("file", &p.file);
-    rep.Read("sequences", &p.sequences);
-    rep.Read("subjects", &p.subjects);
-    rep.Read("loop", &p.loop);
-    rep.Read("rate", &p.rate, framework::Positive<double>());
-    rep.Read("pause", &p.pause, framework::Positive<double>());
-    rep.Read("start_delay", &p.start_delay, framework::NonNegative<double>());
-    ConfigSection tf = rep.Section("transform");
-    std::vector<double> translation = {0, 0, 0}, matrix;
-    double yaw = 0;
-    const bool has_xyz = tf.Read("translation", &translation, framework::Check<std::vector<double>>(
-        [](const std::vector<double>& v) { return v.size() == 3 ? "" : "must have 3 numbers (x, y, z in m)"; }));
-    const bool has_yaw = tf.Read("yaw", &yaw);
-    if (tf.Read("matrix", &matrix)) {
-      if (has_xyz || has_yaw) {
-        tf.AddError("matrix", "give either matrix or translation/yaw, not both");
-      } else if (const std::string why = TransformFromMatrix(matrix, &p.X_WS); !why.empty()) {
-        tf.AddError("matrix", why);
-      }
-    } else {
-      p.X_WS = TransformFromTranslationYaw({translation[0], translation[1], translation[2]}, yaw);
-    }
+  // Loads perception.replay's file (provider replay only); a joint_map name
+  // that the file does not have is refused.
+  Result ConfigureReplay(ConfigSection& config, const ReplaySettings& settings) {
     if (provider_ != "replay") return Result::Ok();
-    if (p.file.empty()) {
-      rep.AddError("file", "required with provider replay");
-      return Result::Ok();  // reported by the configuration check
-    }
-    p.file = config.ResolvePath(p.file);
+    const SkeletonReplayParams p = settings.ToParams(config.ResolvePath(settings.file));
     try {
       intent::SkeletonDataset data = intent::LoadSkeletonCsv(p.file);
-      ConfigSection map = rep.Section("joint_map");
-      for (const std::string& name : data.joint_names) {
-        std::string to;
-        if (map.Read(name, &to)) p.joint_map[name] = to;
+      for (const auto& [name, to] : p.joint_map) {
+        if (std::find(data.joint_names.begin(), data.joint_names.end(), name) == data.joint_names.end()) {
+          return Result::Fail(config.file() + ": key 'perception.replay.joint_map." + name + "': " + p.file +
+                              " has no joint '" + name + "'");
+        }
       }
       replay_ = std::make_unique<SkeletonReplay>(p, std::move(data));
     } catch (const std::exception& e) {

@@ -31,12 +31,8 @@ using framework::Result;
 // replaced by supervisor.robot when given), as that service plans with them.
 std::vector<std::string> ResolveGoals(const ConfigSection& config, const SupervisorSettings& settings,
                                       TaskGraph* graph) {
-  ConfigSection file = ConfigSection::Load(config.ResolvePath(settings.trajopt_config));
-  ConfigSection section = file.Section("trajopt");
-  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(section);
-  // Only the files it names matter here; the trajectory optimiser reports
-  // the rest of its keys itself.
-  if (!settings.robot.empty()) topt.robot_file = config.ResolvePath(settings.robot);
+  const trajopt::TrajoptConfig topt = trajopt::LoadTrajoptConfig(
+      config.ResolvePath(settings.trajopt_config), settings.robot.empty() ? "" : config.ResolvePath(settings.robot));
   return ResolveTaskGoals(*trajopt::MakePlanner(topt), graph);
 }
 

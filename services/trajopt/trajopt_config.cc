@@ -2,6 +2,7 @@
 
 #include "iplan/cell/safety.h"
 #include "iplan/core/params.h"
+#include "iplan/framework/service_file.h"
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::trajopt {
@@ -22,6 +23,15 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   c.robot_file = config.ResolvePath(s.robot);
   c.human_body_file = config.ResolvePath(s.human_body);
   c.scene_file = config.ResolvePath(s.scene);
+  return c;
+}
+
+TrajoptConfig LoadTrajoptConfig(const std::string& trajopt_yaml, const std::string& robot_file) {
+  framework::ServiceFile file(trajopt_yaml);
+  framework::ConfigSection section = file.Section("trajopt");
+  TrajoptConfig c = ReadTrajoptConfig(section);
+  file.Finish();
+  if (!robot_file.empty()) c.robot_file = robot_file;
   return c;
 }
 

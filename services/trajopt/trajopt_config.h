@@ -81,6 +81,13 @@ struct TrajoptConfig {
 /// configuration file), use_prediction, replan_on_prediction, obstacle_timeout and ReplannerParams::Serialize's.
 TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& section);
 
+/// Reads `trajopt_yaml` as the trajectory optimiser does (section trajopt,
+/// strictly: framework::ServiceFile), for tools and services that plan with
+/// its robot, scene and planner; a non-empty `robot_file` (a path as given,
+/// already resolved) replaces the file's robot. @throws core::ConfigError
+/// naming the file and the key.
+TrajoptConfig LoadTrajoptConfig(const std::string& trajopt_yaml, const std::string& robot_file = "");
+
 /// The planner parameters named by `config`: the planner file with its
 /// overrides, delta_cl and iso_ts_15066 from the safety file. A planner
 /// file (or override) that gives either and disagrees with the safety file

@@ -53,23 +53,23 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(BadConfig{"perception:\n  rat_hz: 30\n", "unknown key 'perception.rat_hz'"},
                       BadConfig{"perception:\n  rate_hz: fast\n",
                                 "key 'perception.rate_hz': expected a finite number, got 'fast'"},
-                      BadConfig{"perception:\n  rate_hz: 0\n", "key 'perception.rate_hz': must be in"},
+                      BadConfig{"perception:\n  rate_hz: 0\n", "section 'perception': rate_hz must be in [0.5, 1000], got 0"},
                       BadConfig{"perception:\n  provider: kinect9\n",
-                                "key 'perception.provider': must be one of: synthetic"},
+                                "section 'perception': provider must be synthetic or replay, got 'kinect9'"},
                       BadConfig{"perception:\n  synthetic:\n    torso: [1, 2]\n",
-                                "key 'perception.synthetic.torso': must have 3 numbers"},
-                      BadConfig{"node:\n  diagnostics_period: -1\n", "key 'node.diagnostics_period': must be >= 0"},
+                                "key 'perception.synthetic.torso': expected 3 numbers, got 2"},
+                      BadConfig{"node:\n  diagnostics_period: -1\n", "section 'node': diagnostics_period must be >= 0, got -1"},
                       BadConfig{"perceptoin:\n  rate_hz: 30\n", "unknown key 'perceptoin'"},
                       BadConfig{"perception:\n  provider: replay\n",
-                                "key 'perception.replay.file': required with provider replay"},
+                                "section 'perception': replay.file is required with provider replay"},
                       BadConfig{"perception:\n  provider: replay\n  replay:\n    file: " IPLAN_SHARED_DIR
                                 "/data/florence3d.csv\n    joint_map:\n      wrist: hand_r\n",
-                                "unknown key 'perception.replay.joint_map.wrist'"},
+                                "key 'perception.replay.joint_map.wrist': "},
                       BadConfig{"perception:\n  provider: replay\n  replay:\n    file: " IPLAN_SHARED_DIR
                                 "/data/florence3d.csv\n    sequences: [florence_nope]\n",
                                 "key 'perception.replay': sequence 'florence_nope' is not in"},
                       BadConfig{"perception:\n  replay:\n    transform:\n      matrix: [1, 0, 0]\n",
-                                "key 'perception.replay.transform.matrix': must have 16 numbers"}));
+                                "section 'perception': replay.transform.matrix: must have 16 numbers"}));
 
 // The fail-safe settings: a supervisor in deployment that watches nothing,
 // a key written twice, an empty file, a robot obeying no monitor, a permit

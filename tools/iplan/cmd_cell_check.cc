@@ -26,9 +26,11 @@
 #include "supervisor/core/task_planner.h"
 #include "iplan/framework/config.h"
 #include "iplan/framework/service.h"
+#include "iplan/framework/service_file.h"
 #include "iplan/planning/planner.h"
 #include "collision_risk/risk_config.h"
-#include "perception/synthetic_config.h"
+#include "perception/perception_settings.h"
+#include "supervisor/core/supervisor_settings.h"
 #include "trajopt/trajopt_config.h"
 
 namespace iplan::cli {
@@ -122,48 +124,28 @@ struct CellInputs {
   std::optional<collision_risk::RiskMonitor> monitor;
 };
 
-// Tools read part of each service's file: its values are checked, its other
-// keys are the services' business. Throws std::runtime_error.
+// Every file is read as its service reads it (framework::ServiceFile): the
+// same keys, defaults and checks. Throws std::runtime_error (ConfigError).
 void LoadCellInputs(const std::string& dir, const std::string& robot, CellInputs* in) {
-  auto cfg = [&](const std::string& name) { return (fs::path(dir) / (name + ".yaml")).string(); };
-  auto check = [](const framework::ConfigSection& c) {
-    if (c.Problems().empty()) return;
-    std::string msg;
-    for (const auto& p : c.Problems()) msg += (msg.empty() ? "" : "\n") + p;
-    throw std::runtime_error(msg);
-  };
-  framework::ConfigSection pconf = framework::ConfigSection::Load(cfg("perception"));
-  framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
-  perception::ScriptStart start;
-  in->person = perception::ReadSyntheticPerson(syn, &start);
-  check(pconf);
-  if (const std::string why = in->person.Validate(); !why.empty()) {
-    throw std::runtime_error(cfg("perception") + ": key 'perception.synthetic': " + why);
-  }
-  framework::ConfigSection rconf = framework::ConfigSection::Load(cfg("collision_risk"));
+  perception::PerceptionSettings perception;
+  framework::ServiceFile(framework::CellFile(dir, "perception")).Read("perception", &perception).Finish();
+  in->person = perception.synthetic.Person();
+  framework::ServiceFile rconf(framework::CellFile(dir, "collision_risk"));
   framework::ConfigSection rsec = rconf.Section("collision_risk");
   in->risk = collision_risk::ReadRiskConfig(rsec);
-  check(rconf);
+  rconf.Finish();
   if (!robot.empty()) in->risk.robot_file = robot;
-  if (const std::string why = in->risk.params.Validate(); !why.empty()) throw std::runtime_error(cfg("collision_risk") + ": " + why);
   // The check asks about the working cell, where predictions flow: the
   // separation layer with the person's measured speed, not the degraded
   // mode the monitor falls back to when intent is gone.
   in->risk.params.ssm.degrade_without_prediction = false;
   in->monitor = collision_risk::MakeRiskMonitor(in->risk);
-  framework::ConfigSection sconf = framework::ConfigSection::Load(cfg("supervisor"));
-  framework::ConfigSection ssec = sconf.Section("supervisor");
-  std::string graph_file = "tasks/table_top.yaml";
-  ssec.Read("task_graph", &graph_file);
-  check(sconf);
-  in->graph = supervisor::LoadTaskGraph(sconf.ResolvePath(graph_file));
+  framework::ServiceFile sconf(framework::CellFile(dir, "supervisor"));
+  supervisor::SupervisorSettings supervisor;
+  sconf.Read("supervisor", &supervisor).Finish();
+  in->graph = supervisor::LoadTaskGraph(sconf.ResolvePath(supervisor.task_graph));
   // The static scene, as the trajectory optimiser sees it.
-  framework::ConfigSection tconf = framework::ConfigSection::Load(cfg("trajopt"));
-  framework::ConfigSection tsec = tconf.Section("trajopt");
-  trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(tsec);
-  check(tconf);
-  if (!robot.empty()) topt.robot_file = robot;
-  in->planner = trajopt::MakePlanner(topt);
+  in->planner = trajopt::MakePlanner(trajopt::LoadTrajoptConfig(framework::CellFile(dir, "trajopt"), robot));
   for (const std::string& note : supervisor::ResolveTaskGoals(*in->planner, &in->graph)) std::cout << note << "\n";
 }
 

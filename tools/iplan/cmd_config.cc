@@ -5,7 +5,7 @@
 #include <map>
 #include <string>
 
-#include "collision_risk/core/risk_monitor.h"
+#include "collision_risk/risk_config.h"
 #include "cloud/core/cloud_settings.h"
 #include "command_registry.h"
 #include "intent/core/intent_settings.h"
@@ -14,6 +14,8 @@
 #include "supervisor/core/task_planner.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/core/params.h"
+#include "iplan/framework/node.h"
+#include "perception/perception_settings.h"
 #include "iplan/cell/safety.h"
 #include "iplan/planning/planner_params.h"
 #include "trajopt/trajopt_config.h"
@@ -40,9 +42,15 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
        {"config/cloud.yaml, section cloud; CloudSettings (the pipeline file is CloudParams)",
         [] { return iplan::core::DescribeParams(iplan::cloud_service::CloudSettings{}); }}},
       {"collision-risk",
-       {"config/collision_risk.yaml, section collision_risk; RiskParams (SsmParams under iso_ts_15066; with "
-        "`safety:` both come from the safety file)",
-        [] { return iplan::core::DescribeParams(iplan::collision_risk::RiskParams{}); }}},
+       {"config/collision_risk.yaml, section collision_risk; RiskSettings (RiskParams' keys inline, SsmParams under "
+        "iso_ts_15066; with `safety:` delta_cl and iso_ts_15066 come from the safety file)",
+        [] { return iplan::core::DescribeParams(iplan::collision_risk::RiskSettings{}); }}},
+      {"perception",
+       {"config/perception.yaml, section perception; PerceptionSettings",
+        [] { return iplan::core::DescribeParams(iplan::perception::PerceptionSettings{}); }}},
+      {"node",
+       {"section node of every service's file; NodeSettings (NodeOptions' keys inline)",
+        [] { return iplan::core::DescribeParams(iplan::framework::NodeSettings{}); }}},
       {"replanner",
        {"config/trajopt.yaml, section trajopt; ReplannerParams",
         [] { return iplan::core::DescribeParams(iplan::trajopt::ReplannerParams{}); }}},

@@ -22,6 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "supervisor/core/supervisor_settings.h"
 #include "supervisor/core/task_goals.h"
 #include "supervisor/core/task_planner.h"
 #include "trajopt/trajopt_config.h"
@@ -35,6 +36,7 @@
 #include "iplan/framework/config.h"
 #include "iplan/framework/node.h"
 #include "iplan/framework/service.h"
+#include "iplan/framework/service_file.h"
 
 namespace iplan::cli {
 namespace {
@@ -151,10 +153,10 @@ class DemoRun {
         std::cout << "  model path: " << model_.path << "\n";
         return 0;
       }
-      framework::ConfigSection sup = framework::ConfigSection::Load(Cfg("supervisor"));
-      std::string graph_file = "tasks/table_top.yaml";
-      sup.Section("supervisor").Read("task_graph", &graph_file);
-      graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(graph_file));
+      framework::ServiceFile sup(Cfg("supervisor"));
+      supervisor::SupervisorSettings supervisor;
+      sup.Read("supervisor", &supervisor).Finish();  // as the supervisor reads it
+      graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(supervisor.task_graph));
       if (!o_.robot.empty()) PrepareRobot();
     } catch (const std::exception& e) {
       std::cerr << "\niplan demo: " << e.what() << "\n";
@@ -167,11 +169,7 @@ class DemoRun {
   // task graph's rest place solved for that arm (as the supervisor will).
   void PrepareRobot() {
     robot_file_ = fs::absolute(o_.robot).string();
-    framework::ConfigSection t = framework::ConfigSection::Load(Cfg("trajopt"));
-    framework::ConfigSection ts = t.Section("trajopt");
-    trajopt::TrajoptConfig topt = trajopt::ReadTrajoptConfig(ts);
-    topt.robot_file = robot_file_;
-    const std::unique_ptr<planning::Planner> planner = trajopt::MakePlanner(topt);
+    const std::unique_ptr<planning::Planner> planner = trajopt::MakePlanner(trajopt::LoadTrajoptConfig(Cfg("trajopt"), robot_file_));
     supervisor::TaskGraph graph = graph_;
     for (const std::string& note : supervisor::ResolveTaskGoals(*planner, &graph)) std::cout << "  " << note << "\n";
     const std::vector<double> rest = supervisor::RestPositions(graph);

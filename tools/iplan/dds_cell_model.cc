@@ -9,10 +9,10 @@
 #include "perception/core/synthetic_person.h"
 #include "iplan/core/params.h"
 #include "iplan/core/atomic_file.h"
-#include "iplan/framework/config.h"
+#include "iplan/framework/service_file.h"
 #include "iplan/intent/intent_model.h"
 #include "iplan/intent/model_io.h"
-#include "perception/synthetic_config.h"
+#include "perception/perception_settings.h"
 
 namespace iplan::cli {
 namespace {
@@ -59,20 +59,14 @@ intent::SkeletonDataset RecordCellDemonstrations(const perception::SyntheticPers
 CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::string& intent_yaml,
                                 const std::string& fallback_dir, bool force) {
   // The person, as the perception service will simulate it.
-  framework::ConfigSection pconf = framework::ConfigSection::Load(perception_yaml);
-  framework::ConfigSection syn = pconf.Section("perception").Section("synthetic");
-  perception::ScriptStart start;
-  const perception::SyntheticPersonParams person = perception::ReadSyntheticPerson(syn, &start);
-  if (!pconf.Problems().empty()) throw std::runtime_error(pconf.Problems().front());
-  if (const std::string why = person.Validate(); !why.empty()) {
-    throw std::runtime_error(perception_yaml + ": key 'perception.synthetic': " + why);
-  }
+  // Both files read and checked as their services read them.
+  perception::PerceptionSettings psettings;
+  framework::ServiceFile(perception_yaml).Read("perception", &psettings).Finish();
+  const perception::SyntheticPersonParams person = psettings.synthetic.Person();
   // What the intent service expects.
-  // What the intent service expects, read and checked as the service does.
-  framework::ConfigSection iconf = framework::ConfigSection::Load(intent_yaml);
+  framework::ServiceFile iconf(intent_yaml);
   intent_service::IntentSettings isettings;
-  core::ReadParams(iconf.Section("intent"), &isettings);
-  if (!iconf.Problems().empty()) throw std::runtime_error(iconf.Problems().front());
+  iconf.Read("intent", &isettings).Finish();
   const std::vector<std::string>& joints = isettings.joints;
   const double rate = isettings.rate_hz;
   const fs::path path = iconf.ResolvePath(isettings.model);

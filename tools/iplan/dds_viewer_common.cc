@@ -5,21 +5,16 @@
 #include <chrono>
 #include <stdexcept>
 
-#include "iplan/framework/config.h"
+#include "iplan/framework/service_file.h"
+#include "trajopt/trajopt_config.h"
 
 namespace iplan::cli {
 
 viewer::CellModel LoadViewerCellModel(const std::string& config_dir, const std::string& robot, const std::string& scene,
                                       const std::string& body) {
-  const std::string file = config_dir + "/trajopt.yaml";
-  framework::ConfigSection cfg = framework::ConfigSection::Load(file);
-  framework::ConfigSection t = cfg.Section("trajopt");
-  std::string r = "robots/panda.yaml", s = "scenes/cell.yaml", b = "humans/upper_body.yaml";
-  t.Read("robot", &r);
-  t.Read("scene", &s);
-  t.Read("human_body", &b);
-  return viewer::LoadCellModel(robot.empty() ? t.ResolvePath(r) : robot, scene.empty() ? t.ResolvePath(s) : scene,
-                               body.empty() ? t.ResolvePath(b) : body);
+  // The robot, scene and person the trajectory optimiser plans with.
+  const trajopt::TrajoptConfig t = trajopt::LoadTrajoptConfig(framework::CellFile(config_dir, "trajopt"), robot);
+  return viewer::LoadCellModel(t.robot_file, scene.empty() ? t.scene_file : scene, body.empty() ? t.human_body_file : body);
 }
 
 std::unique_ptr<core::Process> StartRecorder(const std::string& vendor, int domain, const std::string& out,

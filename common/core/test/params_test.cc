@@ -93,6 +93,57 @@ TEST(Params, UnknownKeysWrongTypesAndValidateAreErrorsNamingFileAndKey) {
   EXPECT_EQ(LoadError(twice), twice + ": key 'dt': appears twice (lines 1 and 2)");
 }
 
+// A mapping of name: struct keeps the file's order (not sorted), replaces the
+// default entries, and checks each entry's keys; a mapping of strings or of
+// lists is read whole.
+struct Catalogue {
+  Named<Inner> gains = {{"default", Inner{}}};
+  std::map<std::string, std::string> renames;
+  std::map<std::string, std::vector<std::string>> lists;
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(gains, "name: gain"));
+    a->Visit(IPLAN_NVP(renames, "from: to"));
+    a->Visit(IPLAN_NVP(lists, "name: [items]"));
+  }
+  std::string Validate() const { return ""; }
+};
+
+TEST(Params, NamedStructsKeepTheFilesOrderAndMappingsReadWhole) {
+  const std::string path = Write("named.yaml",
+                                 "gains: {zeta: {gain: 1}, alpha: {gain: 3}, mid: {}}\n"
+                                 "renames: {wrist_r: hand_r}\nlists: {/t: [a, b]}\n");
+  const Catalogue c = LoadParamsFile<Catalogue>(path);
+  ASSERT_EQ(c.gains.size(), 3u);
+  EXPECT_EQ(c.gains[0].first, "zeta");
+  EXPECT_EQ(c.gains[1].first, "alpha");
+  EXPECT_EQ(c.gains[1].second.gain, 3.0);
+  EXPECT_EQ(c.gains[2].second.gain, 2.0);  // the entry's own default
+  EXPECT_EQ(c.renames, (std::map<std::string, std::string>{{"wrist_r", "hand_r"}}));
+  EXPECT_EQ(c.lists.at("/t"), (std::vector<std::string>{"a", "b"}));
+  // Absent: the defaults.
+  const Catalogue d = LoadParamsFile<Catalogue>(Write("named_empty.yaml", "renames: {}\n"));
+  ASSERT_EQ(d.gains.size(), 1u);
+  EXPECT_EQ(d.gains[0].first, "default");
+  // An entry's unknown key and a wrong type are named with the entry.
+  const std::string bad = Write("named_bad.yaml", "gains: {a: {gian: 1}, b: {gain: x}}\n");
+  try {
+    LoadParamsFile<Catalogue>(bad);
+    ADD_FAILURE() << "accepted";
+  } catch (const ConfigError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown key 'gains.a.gian'"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("key 'gains.b.gain': expected a finite number, got 'x'"), std::string::npos)
+        << e.what();
+  }
+  // Described: the entries' names, then one entry's fields.
+  const std::vector<ParamDoc> docs = DescribeParams(Catalogue{});
+  ASSERT_GE(docs.size(), 4u);
+  EXPECT_EQ(docs[0].key, "gains");
+  EXPECT_EQ(docs[0].value, "{default}");
+  EXPECT_EQ(docs[1].key, "gains.NAME.gain");
+  EXPECT_EQ(docs[2].value, "{}");
+}
+
 TEST(Params, OverridesAreAppliedBeforeReadingAndCheckedLikeTheFile) {
   const std::string path = Write("over.yaml", "dt: 0.05\n");
   const Demo d = LoadParamsFile<Demo>(path, {{"dt", "0.2"}, {"inner.gain", "4"}});

@@ -3,10 +3,13 @@
 #include <unistd.h>
 
 #include <algorithm>
+#include <cmath>
 #include <cstdio>
 
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
+
+#include "iplan/core/params.h"
 
 namespace iplan::framework {
 namespace {
@@ -30,6 +33,20 @@ std::string Join(const std::vector<std::string>& v) {
 }
 
 }  // namespace
+
+std::string NodeOptions::Validate() const {
+  if (!(diagnostics_period >= 0) || !std::isfinite(diagnostics_period)) {
+    return "diagnostics_period must be >= 0, got " + core::ParamText(diagnostics_period);
+  }
+  if (!(max_stamp_ahead >= 0 && max_stamp_ahead <= 60)) {
+    return "max_stamp_ahead must be in [0, 60], got " + core::ParamText(max_stamp_ahead);
+  }
+  if (frame_id.empty()) return "frame_id must not be empty";
+  if (realtime_priority < 0 || realtime_priority > 99) {
+    return "realtime_priority must be in 0..99, got " + std::to_string(realtime_priority);
+  }
+  return "";
+}
 
 Node::Node(std::string name, dds::Participant& participant, NodeOptions options)
     : name_(std::move(name)), participant_(participant), options_(std::move(options)) {

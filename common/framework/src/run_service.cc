@@ -8,9 +8,11 @@
 #include <spdlog/sinks/stdout_color_sinks.h>
 #include <spdlog/spdlog.h>
 
+#include "iplan/core/params.h"
 #include "iplan/dds/security.h"
 #include "iplan/framework/enclaves.h"
 #include "iplan/framework/service.h"
+#include "iplan/framework/service_file.h"
 #include "iplan/framework/topics.h"
 #include "realtime.h"
 #include "iplan/framework/systemd.h"
@@ -29,14 +31,9 @@ bool FileExists(const std::string& p) { return std::ifstream(p).good(); }
 // The topic remappings: `node.remap` ({FROM: TO}), then the command line's
 // --remap FROM:=TO rules over it; applied to the catalogue. False (printed)
 // on a bad rule.
-bool ApplyRemappings(const std::string& name, ConfigSection& node_section, const std::vector<std::string>& rules) {
-  std::map<std::string, std::string> from_to;
-  ConfigSection remap = node_section.Section("remap");
-  for (const std::string& from : remap.Keys()) {
-    std::string to;
-    remap.Read(from, &to);
-    from_to[from] = to;
-  }
+bool ApplyRemappings(const std::string& name, const std::map<std::string, std::string>& remap,
+                     const std::vector<std::string>& rules) {
+  std::map<std::string, std::string> from_to = remap;
   for (const std::string& rule : rules) {
     std::string from, to, error;
     if (!topics::ParseRemapRule(rule, &from, &to, &error)) {
@@ -59,32 +56,14 @@ bool ApplyRemappings(const std::string& name, ConfigSection& node_section, const
 
 bool LoadConfiguration(const std::string& name, const std::string& config_file,
                        const std::vector<std::string>& overrides, const std::vector<std::string>& remaps,
-                       std::unique_ptr<ConfigSection>* config, NodeOptions* nopts) {
+                       std::unique_ptr<ServiceFile>* config, NodeOptions* nopts) {
   try {
-    *config = std::make_unique<ConfigSection>(
-        config_file.empty() ? ConfigSection::FromString("{}", "(no configuration file)")
-                            : ConfigSection::Load(config_file));
-    for (const std::string& o : overrides) {
-      const auto [key, value] = core::ParseOverride(o);
-      (*config)->Override(key, value);
-    }
-    ConfigSection node_section = (*config)->Section("node");
-    node_section.Read("diagnostics_period", &nopts->diagnostics_period, NonNegative<double>());
-    node_section.Read("hardware_id", &nopts->hardware_id);
-    node_section.Read("max_stamp_ahead", &nopts->max_stamp_ahead, InRange(0.0, 60.0));
-    node_section.Read("realtime_priority", &nopts->realtime_priority, InRange(0, 99));
-    node_section.Read("lock_memory", &nopts->lock_memory);
-    node_section.Read("frame_id", &nopts->frame_id, Check<std::string>([](const std::string& f) {
-      return f.empty() ? std::string("must not be empty") : std::string();
-    }));
-    // entitled_writers: {"/iplan/robot/trajectory": [iplan-trajopt], ...}
-    ConfigSection entitled = node_section.Section("entitled_writers");
-    for (const std::string& topic : entitled.Keys()) {
-      std::vector<std::string> names;
-      entitled.Read(topic, &names);
-      nopts->entitled_writers[topic] = names;
-    }
-    if (!ApplyRemappings(name, node_section, remaps)) return false;
+    core::Overrides parsed;
+    for (const std::string& o : overrides) parsed.push_back(core::ParseOverride(o));
+    *config = std::make_unique<ServiceFile>(config_file, parsed);
+    const NodeSettings& node = (*config)->node();
+    if (node.Validate().empty()) *nopts = node.options;  // else refused after OnConfigure, naming the key
+    if (!ApplyRemappings(name, node.remap, remaps)) return false;
   } catch (const ConfigError& e) {
     std::cerr << "iplan-" << name << ": configuration error:\n" << e.what() << "\n";
     return false;
@@ -94,7 +73,7 @@ bool LoadConfiguration(const std::string& name, const std::string& config_file,
 
 // OnConfigure, then every key of the file accounted for: false (the
 // problems printed) when the configuration is bad.
-bool Configure(const std::string& name, ConfigSection* config, Service* service, Node* node) {
+bool Configure(const std::string& name, ServiceFile* config, Service* service, Node* node) {
   ConfigSection section = config->Section(name);
   const Result r = service->OnConfigure(section, *node);
   try {
@@ -314,7 +293,7 @@ int RunService(int argc, char** argv, const ServiceInfo& info,
   if (!ParticipantOptionsFrom(info.name, cl.vendor_text, cl.domain, cl.security_dir, &popts)) return kExitConfigError;
   if (!DecideSecurity(info.name, popts, &cl)) return kExitConfigError;
 
-  std::unique_ptr<ConfigSection> config;
+  std::unique_ptr<ServiceFile> config;
   NodeOptions nopts;
   if (!LoadConfiguration(info.name, cl.config_file, cl.overrides, cl.remaps, &config, &nopts)) return kExitConfigError;
 

@@ -16,14 +16,14 @@
 #include <ctime>
 #include <functional>
 
-#include "common/cloud_adapters.h"
 #include "core/cloud_stage.h"
 #include "core/depth_camera.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/scene.h"
 #include "iplan/core/stats.h"
-#include "iplan/framework/config.h"
-#include "synthetic_config.h"
+#include "core/cloud_settings.h"
+#include "iplan/framework/service_file.h"
+#include "perception_settings.h"
 
 namespace {
 
@@ -43,14 +43,14 @@ struct Cell {
 const Cell& TheCell() {
   static const Cell cell = [] {
     Cell c;
-    framework::ConfigSection cloud_file = framework::ConfigSection::Load(Cfg("cloud.yaml"));
-    framework::ConfigSection cs = cloud_file.Section("cloud");
-    c.stage.X_WS = c.camera.X_WS = services::ReadCameraPose(cs.Section("camera"));
+    // The cell's files, read as their services read them.
+    cloud_service::CloudSettings cloud_settings;
+    framework::ServiceFile(Cfg("cloud.yaml")).Read("cloud", &cloud_settings).Finish();
+    c.stage.X_WS = c.camera.X_WS = cloud_settings.camera.Pose();
     c.stage.pipeline = cloud::LoadCloudParams(Cfg("cloud_pipeline.yaml"));
-    framework::ConfigSection perc = framework::ConfigSection::Load(Cfg("perception.yaml"));
-    framework::ConfigSection syn = perc.Section("perception").Section("synthetic");
-    perception::ScriptStart start;
-    perception::SyntheticPerson person(perception::ReadSyntheticPerson(syn, &start));
+    perception::PerceptionSettings perception_settings;
+    framework::ServiceFile(Cfg("perception.yaml")).Read("perception", &perception_settings).Finish();
+    perception::SyntheticPerson person(perception_settings.synthetic.Person());
     person.StartScript(0);
     const collision::HumanBodyModel body(collision::LoadHumanBodyParams(Cfg("humans/upper_body.yaml")));
     perception::DepthScene fixed;

@@ -1,6 +1,7 @@
 // The risk monitor's verdicts from each layer, its ISO/TS 15066 arithmetic,
 // and its refusal of inputs it cannot map.
 #include "core/risk_monitor.h"
+#include "risk_config.h"
 
 #include <gtest/gtest.h>
 
@@ -380,9 +381,9 @@ TEST(RiskMonitorFailSafe, WithoutAUsablePredictionSeparationUsesTheDefaultHumanS
   EXPECT_NE(r.reason.find("degraded"), std::string::npos) << r.reason;
 }
 
-TEST(RiskParams, TheDocumentedDefaultsAreTheDeclaredOnes) {
+TEST(RiskSettings, TheDocumentedDefaultsAreTheDeclaredOnes) {
   EXPECT_EQ(core::CheckDocumentedDefaults(std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md",
-                                          core::DescribeParams(RiskParams{})),
+                                          core::DescribeParams(RiskSettings{})),
             "");
 }
 

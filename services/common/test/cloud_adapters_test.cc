@@ -7,6 +7,7 @@
 #include <cstring>
 
 #include "common/cloud_adapters.h"
+#include "iplan/core/params.h"
 
 namespace iplan::services {
 namespace {
@@ -61,7 +62,9 @@ TEST(CloudAdaptersTest, RosDriverLayoutWithPaddingDecodes) {
 
 TEST(CloudAdaptersTest, CameraPoseFromConfig) {
   auto file = core::ConfigSection::FromString("camera: {position: [0, -1, 1], look_at: [0, 0, 1]}\n", "test.yaml");
-  const Eigen::Isometry3d X_WS = ReadCameraPose(file.Section("camera"));
+  cloud::CameraLookAt camera;
+  core::ReadParams(file.Section("camera"), &camera);
+  const Eigen::Isometry3d X_WS = camera.Pose();
   EXPECT_TRUE(file.Problems().empty());
   // Looking along +y of the world: z_S = +y_W, x_S = +x_W... right is +x, down is -z.
   EXPECT_TRUE(X_WS.linear().col(2).isApprox(Eigen::Vector3d::UnitY()));

@@ -27,6 +27,15 @@ struct CameraIntrinsics {
   double cx = 319.5;  ///< principal point, pixels
   double cy = 239.5;  ///< pixels
 
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(width, "pixels, 1..4096"));
+    a->Visit(IPLAN_NVP(height, "pixels, 1..4096"));
+    a->Visit(IPLAN_NVP(fx, "pixels, focal length, > 0"));
+    a->Visit(IPLAN_NVP(fy, "pixels, > 0"));
+    a->Visit(IPLAN_NVP(cx, "pixels, principal point"));
+    a->Visit(IPLAN_NVP(cy, "pixels"));
+  }
   /// Empty when valid, else the first problem ("fx must be > 0, got 0").
   std::string Validate() const;
 };

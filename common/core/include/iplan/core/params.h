@@ -21,13 +21,16 @@
 // std::vector<double>, std::vector<std::string>, std::array<double, N>,
 // std::vector<std::pair<std::string, std::string>> (a list of [a, b]),
 // std::optional of those (absent: nullopt), and
-// any struct with its own Serialize (read from a nested mapping) and
-// std::vector of such structs (a list of mappings). IPLAN_NVP_REQUIRED marks
-// a key a file must give.
+// any struct with its own Serialize (read from a nested mapping),
+// std::vector of such structs (a list of mappings), core::Named<T> of such
+// structs (a mapping of name: struct, in the file's order) and
+// std::map<std::string, V> of a value type above (a mapping). IPLAN_NVP_REQUIRED
+// marks a key a file must give.
 #pragma once
 
 #include <array>
 #include <cstdint>
+#include <map>
 #include <optional>
 #include <string>
 #include <type_traits>
@@ -40,6 +43,11 @@
 namespace iplan::core {
 
 class ParamsReader;
+
+/// A mapping of name: struct (each struct read from its own mapping), in the
+/// file's order; present in a file, it replaces the default entries.
+template <class T>
+using Named = std::vector<std::pair<std::string, T>>;
 
 /// True for structs that declare their fields with Serialize.
 template <class T, class = void>
@@ -95,6 +103,32 @@ class ParamsReader {
       ParamsReader nested(element);
       item.Serialize(&nested);
       out.push_back(std::move(item));
+    }
+    *value = std::move(out);
+  }
+  // A mapping of name: struct; present, it replaces the default entries.
+  template <class T, class = std::enable_if_t<HasSerialize<T>::value>>
+  void ReadValue(const char* key, Named<T>* value) {
+    ConfigSection named = section_.Section(key);
+    if (!section_.Has(key)) return;
+    Named<T> out;
+    for (const std::string& name : named.Keys()) {
+      T item;
+      ParamsReader nested(named.Section(name));
+      item.Serialize(&nested);
+      out.emplace_back(name, std::move(item));
+    }
+    *value = std::move(out);
+  }
+  // A mapping of name: value; present, it replaces the default.
+  template <class V>
+  void ReadValue(const char* key, std::map<std::string, V>* value) {
+    ConfigSection m = section_.Section(key);
+    if (!section_.Has(key)) return;
+    std::map<std::string, V> out;
+    for (const std::string& name : m.Keys()) {
+      V v{};
+      if (m.Read(name, &v)) out[name] = v;
     }
     *value = std::move(out);
   }
@@ -155,6 +189,12 @@ std::string ParamText(const std::string& v);
 std::string ParamText(const std::vector<double>& v);
 std::string ParamText(const std::vector<std::string>& v);
 std::string ParamText(const std::vector<std::pair<std::string, std::string>>& v);
+template <class V>
+std::string ParamText(const std::map<std::string, V>& v) {
+  std::string s = "{";
+  for (const auto& [k, x] : v) s += (s.size() > 1 ? ", " : "") + ParamText(k) + ": " + ParamText(x);
+  return s + "}";
+}
 template <std::size_t N>
 std::string ParamText(const std::array<double, N>& v) {
   return ParamText(std::vector<double>(v.begin(), v.end()));
@@ -177,6 +217,11 @@ class ParamsDescriber {
     } else if constexpr (IsListOfStructs<T>::value) {
       docs_.push_back({key, nv.required ? "(required)" : ParamText(nv.value->size()) + " entries", nv.doc});
       Nested(key + "[]", typename T::value_type{});  // the fields of one entry
+    } else if constexpr (IsNamedStructs<T>::value) {
+      std::string names;
+      for (const auto& [name, item] : *nv.value) names += (names.empty() ? "" : ", ") + name;
+      docs_.push_back({key, nv.required ? "(required)" : "{" + names + "}", nv.doc});
+      Nested(key + ".NAME", typename T::value_type::second_type{});  // the fields of one entry
     } else {
       docs_.push_back({key, nv.required ? "(required)" : ParamText(*nv.value), nv.doc});
     }
@@ -188,6 +233,10 @@ class ParamsDescriber {
   struct IsListOfStructs : std::false_type {};
   template <class T>
   struct IsListOfStructs<std::vector<T>> : HasSerialize<T> {};
+  template <class T>
+  struct IsNamedStructs : std::false_type {};
+  template <class T>
+  struct IsNamedStructs<std::vector<std::pair<std::string, T>>> : HasSerialize<T> {};
   template <class T>
   void Nested(const std::string& key, T value) {
     ParamsDescriber nested(key);

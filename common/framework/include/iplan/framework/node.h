@@ -51,6 +51,7 @@
 
 #include <spdlog/logger.h>
 
+#include "iplan/core/name_value.h"
 #include "iplan/dds/participant.h"
 #include "iplan/framework/topics.h"
 #include "iplan/msg/check.h"
@@ -77,6 +78,33 @@ struct NodeOptions {
   /// Lock all memory (mlockall): no page faults on the executor. Needs
   /// LimitMEMLOCK=infinity or CAP_IPC_LOCK; refused, the service says so.
   bool lock_memory = false;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(diagnostics_period, "s between /diagnostics messages, >= 0; 0: none"));
+    a->Visit(IPLAN_NVP(hardware_id, "diagnostics hardware_id; empty: the host name"));
+    a->Visit(IPLAN_NVP(max_stamp_ahead, "s; header stamps further ahead of this host's clock are rejected, in [0, 60]"));
+    a->Visit(IPLAN_NVP(frame_id, "the cell frame: header.frame_id of messages in the cell frame, not empty"));
+    a->Visit(IPLAN_NVP(entitled_writers, "topic: [participant names] whose samples are accepted (replaces the catalogue's list; []: every writer)"));
+    a->Visit(IPLAN_NVP(realtime_priority, "SCHED_FIFO priority of the service's threads, 0..99; 0: the default scheduler"));
+    a->Visit(IPLAN_NVP(lock_memory, "lock all memory (mlockall); needs LimitMEMLOCK=infinity or CAP_IPC_LOCK"));
+  }
+  /// "" when valid, else the reason with the value.
+  std::string Validate() const;
+};
+
+/// Section `node` of every service's file: the node's options (keys
+/// inline) and the topic remappings.
+struct NodeSettings {
+  NodeOptions options;
+  std::map<std::string, std::string> remap;  ///< topic name -> name on the wire
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    options.Serialize(a);
+    a->Visit(IPLAN_NVP(remap, "FROM: TO topic remappings (a leading '/' may be left out); --remap FROM:=TO rules over them"));
+  }
+  std::string Validate() const { return options.Validate(); }
 };
 
 /// Counters of one subscribed topic.
