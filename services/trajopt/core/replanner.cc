@@ -152,6 +152,7 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   if (t.waiting || t.stopped) t.delay += (now_ns - t.last_cycle_ns) * 1e-9;
   t.waiting = false;
   t.stopped = robot_stopped_;
+  if (t.stopped) t.patience_from = t.delay;  // a protective stop restarts patience
   t.last_cycle_ns = now_ns;
   if (std::optional<CycleResult> over = CheckProgress(now_ns, &r)) return *over;
 
@@ -360,7 +361,7 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
   // Patience: the longer the person has held the task off, the closer the
   // plan may come to what the monitor allows.
   if (task_ && params_.ssm_patience > 0) {
-    req.ssm_scale = std::max(0.0, 1.0 - task_->delay / params_.ssm_patience);
+    req.ssm_scale = std::max(0.0, 1.0 - (task_->delay - task_->patience_from) / params_.ssm_patience);
   }
   req.obstacles = obstacles_;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);

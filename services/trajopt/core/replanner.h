@@ -61,8 +61,10 @@ struct ReplannerParams {
   /// 0 once the delay reaches this, so
   /// that a person who keeps working near the goal delays the task for a
   /// while and is then approached as closely as the monitor allows (a plan
-  /// the predicted monitor would stop stays infeasible). 0: off (the margin
-  /// is always the planner's).
+  /// the predicted monitor would stop stays infeasible). A protective stop
+  /// restarts it: the delay counts from the end of the last stop, so a robot
+  /// that came too close is not sent straight back at the person. 0: off
+  /// (the margin is always the planner's).
   double ssm_patience = 0.0;
   /// The keys of section trajopt (config/trajopt.yaml); ranges: Validate().
   template <class Archive>
@@ -76,7 +78,7 @@ struct ReplannerParams {
     a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a state further outside the limits is refused, >= 0"));
     a->Visit(IPLAN_NVP(joint_velocity_factor, "a state faster than this x the velocity limit is refused, >= 1"));
     a->Visit(IPLAN_NVP(cycle_budget, "s of wall time one cycle's planning may take, [0, planning_step); 0: none"));
-    a->Visit(IPLAN_NVP(ssm_patience, "s of a task's delay after which its plans keep no margin above S_p, >= 0; 0: off"));
+    a->Visit(IPLAN_NVP(ssm_patience, "s of a task's delay (since its last protective stop) after which its plans keep no margin above S_p, >= 0; 0: off"));
   }
   std::string Validate() const;
 };
@@ -192,6 +194,7 @@ class Replanner {
     std::optional<Eigen::VectorXd> goal_q;  // where the robot is going now (the retreat once the goal is reached)
     bool retreating = false;                // the goal is reached; withdrawing to spec.retreat
     double delay = 0;
+    double patience_from = 0;    // delay at the end of the last protective stop (patience counts from there)
     uint32_t waits = 0;
     double max_bound = 0;
     std::vector<double> planning_times;

@@ -406,7 +406,9 @@ TEST_F(ReplannerTest, PatienceLetsARobotHeldOffByAStayingPersonArriveOutsideTheP
   for (int i = 0; i < 60; ++i) (gap(0.5 * (lo + hi)) < 0.21 ? lo : hi) = 0.5 * (lo + hi);
   const Eigen::Vector3d hand = tool + Eigen::Vector3d(hi, 0, 0);
   ASSERT_NEAR(gap(hi), 0.21, 1e-6);
-  auto run = [&](double patience, double* closest) {
+  // stop_at: the cycle at which the robot is in protective stop for one
+  // cycle (-1: never).
+  auto run = [&](double patience, double* closest, int stop_at = -1) {
     ReplannerParams rp;
     rp.ssm_patience = patience;
     Replanner replanner(predicting, body_, rp);
@@ -418,10 +420,11 @@ TEST_F(ReplannerTest, PatienceLetsARobotHeldOffByAStayingPersonArriveOutsideTheP
     EXPECT_EQ(replanner.StartTask({14, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
     for (int k = 0; k < 80; ++k) {
       EXPECT_EQ(replanner.UpdatePrediction(PersonAt(t, hand)), std::nullopt);
+      replanner.SetRobotStopped(k == stop_at);
       const CycleResult c = replanner.Cycle(t);
       if (c.outcome) return c.outcome;
       t += kSec / 10;
-      if (c.publish) q = At(c, t);
+      if (c.publish && k != stop_at) q = At(c, t);
       collision::RobotData r(robot);
       collision::CalcForwardKinematics(robot, q, &r);
       *closest = std::min(*closest, (r.p_WS.col(static_cast<Eigen::Index>(robot.spheres.size()) - 1) - hand).norm());
@@ -437,6 +440,15 @@ TEST_F(ReplannerTest, PatienceLetsARobotHeldOffByAStayingPersonArriveOutsideTheP
   EXPECT_EQ(o->status, TaskStatus::kSucceeded) << o->reason;
   EXPECT_GT(o->delay, 0.5 * 1.5) << "not before the margin has shrunk to what the gap allows";
   EXPECT_LT(closest_with, closest_without);
+  // A protective stop restarts patience: stopped for one cycle just before
+  // it would have arrived, the robot waits for the margin to shrink again
+  // (half the patience at least) instead of going straight back in.
+  const int arrival = static_cast<int>(std::lround(o->duration * 10));
+  double closest_stopped = std::numeric_limits<double>::infinity();
+  const std::optional<TaskOutcome> stopped = run(1.5, &closest_stopped, arrival - 3);
+  ASSERT_TRUE(stopped.has_value()) << "with patience the robot still arrives";
+  EXPECT_EQ(stopped->status, TaskStatus::kSucceeded) << stopped->reason;
+  EXPECT_GT(stopped->duration, o->duration + 0.5 * 1.5) << "patience restarted at the stop";
 }
 
 TEST_F(ReplannerTest, RobotStatesOutsideTheJointLimitsAreRefused) {
