@@ -81,7 +81,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
 
   // The simulated robot.
   robot_sim::RobotSimSettings sim;
-  framework::ServiceFile(file("robot_sim")).Read("robot_sim", &sim).Finish();
+  framework::ServiceFile(file("robot_sim")).ReadSection("robot_sim", &sim).Finish();
   c.loop.control_rate_hz = sim.control_rate_hz;
   c.loop.joint_state_rate_hz = sim.publish_rate_hz;
   c.simulator = sim.simulator;
@@ -89,7 +89,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   // The supervisor: task graph and resume hysteresis.
   framework::ServiceFile vconf(file("supervisor"));
   supervisor::SupervisorSettings settings;
-  vconf.Read("supervisor", &settings).Finish();
+  vconf.ReadSection("supervisor", &settings).Finish();
   c.loop.resume_delay = settings.resume_delay;
   supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
   c.goal_notes = supervisor::ResolveTaskGoals(*c.planner, &graph);  // poses: the planner's IK for this robot
@@ -97,14 +97,14 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
 
   // The sensor and the synthetic person.
   perception::PerceptionSettings perception;
-  framework::ServiceFile(file("perception")).Read("perception", &perception).Finish();
+  framework::ServiceFile(file("perception")).ReadSection("perception", &perception).Finish();
   c.sensor_rate_hz = perception.rate_hz;
   c.person = perception.synthetic.Person();
   c.sensor_noise_std = c.person.noise_stddev;
 
   // The intent estimator's settings.
   intent_service::IntentSettings intent;
-  framework::ServiceFile(file("intent")).Read("intent", &intent).Finish();
+  framework::ServiceFile(file("intent")).ReadSection("intent", &intent).Finish();
   c.estimator = intent.estimator;
   return c;
 }

@@ -128,7 +128,7 @@ struct CellInputs {
 // same keys, defaults and checks. Throws std::runtime_error (ConfigError).
 void LoadCellInputs(const std::string& dir, const std::string& robot, CellInputs* in) {
   perception::PerceptionSettings perception;
-  framework::ServiceFile(framework::CellFile(dir, "perception")).Read("perception", &perception).Finish();
+  framework::ServiceFile(framework::CellFile(dir, "perception")).ReadSection("perception", &perception).Finish();
   in->person = perception.synthetic.Person();
   framework::ServiceFile rconf(framework::CellFile(dir, "collision_risk"));
   framework::ConfigSection rsec = rconf.Section("collision_risk");
@@ -142,7 +142,7 @@ void LoadCellInputs(const std::string& dir, const std::string& robot, CellInputs
   in->monitor = collision_risk::MakeRiskMonitor(in->risk);
   framework::ServiceFile sconf(framework::CellFile(dir, "supervisor"));
   supervisor::SupervisorSettings supervisor;
-  sconf.Read("supervisor", &supervisor).Finish();
+  sconf.ReadSection("supervisor", &supervisor).Finish();
   in->graph = supervisor::LoadTaskGraph(sconf.ResolvePath(supervisor.task_graph));
   // The static scene, as the trajectory optimiser sees it.
   in->planner = trajopt::MakePlanner(trajopt::LoadTrajoptConfig(framework::CellFile(dir, "trajopt"), robot));

@@ -155,7 +155,7 @@ class DemoRun {
       }
       framework::ServiceFile sup(Cfg("supervisor"));
       supervisor::SupervisorSettings supervisor;
-      sup.Read("supervisor", &supervisor).Finish();  // as the supervisor reads it
+      sup.ReadSection("supervisor", &supervisor).Finish();  // as the supervisor reads it
       graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(supervisor.task_graph));
       if (!o_.robot.empty()) PrepareRobot();
     } catch (const std::exception& e) {

@@ -61,12 +61,12 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   // The person, as the perception service will simulate it.
   // Both files read and checked as their services read them.
   perception::PerceptionSettings psettings;
-  framework::ServiceFile(perception_yaml).Read("perception", &psettings).Finish();
+  framework::ServiceFile(perception_yaml).ReadSection("perception", &psettings).Finish();
   const perception::SyntheticPersonParams person = psettings.synthetic.Person();
   // What the intent service expects.
   framework::ServiceFile iconf(intent_yaml);
   intent_service::IntentSettings isettings;
-  iconf.Read("intent", &isettings).Finish();
+  iconf.ReadSection("intent", &isettings).Finish();
   const std::vector<std::string>& joints = isettings.joints;
   const double rate = isettings.rate_hz;
   const fs::path path = iconf.ResolvePath(isettings.model);

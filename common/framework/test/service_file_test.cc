@@ -29,7 +29,7 @@ std::string Write(const std::string& name, const std::string& text) {
 std::string Error(const std::string& path, const core::Overrides& overrides = {}) {
   try {
     Section s;
-    ServiceFile(path, overrides).Read("svc", &s).Finish();
+    ServiceFile(path, overrides).ReadSection("svc", &s).Finish();
   } catch (const ConfigError& e) {
     return e.what();
   }
@@ -42,7 +42,7 @@ TEST(ServiceFile, ReadsTheNodeSectionAndDeclaredSectionsWithOverrides) {
                                  "  entitled_writers: {/iplan/robot/trajectory: [iplan-trajopt]}\nsvc:\n  rate_hz: 30\n");
   ServiceFile f(path, {{"svc.name", "b"}});
   Section s;
-  f.Read("svc", &s).Finish();
+  f.ReadSection("svc", &s).Finish();
   EXPECT_EQ(s.rate_hz, 30);
   EXPECT_EQ(s.name, "b");
   EXPECT_EQ(f.node().options.diagnostics_period, 2.5);
@@ -65,7 +65,7 @@ TEST(ServiceFile, UnknownKeysWrongTypesAndRangesAreRefusedNamingFileAndKey) {
   // A tool that reads only some sections asks for the problems so far.
   ServiceFile partial(Write("svc_partial.yaml", "svc:\n  rate_hz: 5\nother:\n  x: 1\n"));
   Section s;
-  partial.Read("svc", &s);
+  partial.ReadSection("svc", &s);
   EXPECT_NO_THROW(partial.ThrowProblems());
   EXPECT_THROW(partial.Finish(), ConfigError);
 }

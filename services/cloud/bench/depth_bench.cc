@@ -45,11 +45,11 @@ const Cell& TheCell() {
     Cell c;
     // The cell's files, read as their services read them.
     cloud_service::CloudSettings cloud_settings;
-    framework::ServiceFile(Cfg("cloud.yaml")).Read("cloud", &cloud_settings).Finish();
+    framework::ServiceFile(Cfg("cloud.yaml")).ReadSection("cloud", &cloud_settings).Finish();
     c.stage.X_WS = c.camera.X_WS = cloud_settings.camera.Pose();
     c.stage.pipeline = cloud::LoadCloudParams(Cfg("cloud_pipeline.yaml"));
     perception::PerceptionSettings perception_settings;
-    framework::ServiceFile(Cfg("perception.yaml")).Read("perception", &perception_settings).Finish();
+    framework::ServiceFile(Cfg("perception.yaml")).ReadSection("perception", &perception_settings).Finish();
     perception::SyntheticPerson person(perception_settings.synthetic.Person());
     person.StartScript(0);
     const collision::HumanBodyModel body(collision::LoadHumanBodyParams(Cfg("humans/upper_body.yaml")));

@@ -18,7 +18,7 @@ PerceptionSettings Read(const std::string& yaml, std::string* error = nullptr) {
   std::ofstream(path) << yaml;
   PerceptionSettings s;
   try {
-    framework::ServiceFile(path).Read("perception", &s).Finish();
+    framework::ServiceFile(path).ReadSection("perception", &s).Finish();
   } catch (const core::ConfigError& e) {
     if (error) *error = e.what();
   }
@@ -33,7 +33,7 @@ std::string Refusal(const std::string& yaml) {
 
 TEST(PerceptionSettings, TheShippedFileGivesTheCellsPerson) {
   PerceptionSettings s;
-  framework::ServiceFile(kConfig + "/perception.yaml").Read("perception", &s).Finish();
+  framework::ServiceFile(kConfig + "/perception.yaml").ReadSection("perception", &s).Finish();
   EXPECT_EQ(s.provider, "synthetic");
   EXPECT_EQ(s.rate_hz, 30);
   EXPECT_TRUE(s.publish_truth);

@@ -5,7 +5,7 @@
 //
 //   framework::ServiceFile f(framework::CellFile(dir, "perception"));
 //   perception::PerceptionSettings p;
-//   f.Read("perception", &p).Finish();   // throws ConfigError listing every problem
+//   f.ReadSection("perception", &p).Finish();   // throws ConfigError listing every problem
 //
 // The file's `node` section (NodeSettings) is read on loading; each section
 // is read into a struct declared with Serialize (iplan/core/params.h), its
@@ -35,7 +35,7 @@ class ServiceFile {
   /// Reads section `section` into `*settings` (problems recorded, reported
   /// by Finish). Returns *this, so reads chain.
   template <class S>
-  ServiceFile& Read(const std::string& section, S* settings) {
+  ServiceFile& ReadSection(const std::string& section, S* settings) {
     core::ReadParams(file_.Section(section), settings);
     return *this;
   }
