@@ -71,11 +71,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   c.body = std::make_unique<collision::HumanBodyModel>(collision::LoadHumanBodyParams(topt.human_body_file));
 
   // The collision-risk monitor, as its service builds it.
-  framework::ServiceFile rconf(file("collision_risk"));
-  framework::ConfigSection rsec = rconf.Section("collision_risk");
-  collision_risk::RiskConfig risk = collision_risk::ReadRiskConfig(rsec);
-  rconf.Finish();
-  if (!robot_file.empty()) risk.robot_file = robot_file;
+  collision_risk::RiskConfig risk = collision_risk::LoadRiskConfig(file("collision_risk"), robot_file);
   c.monitor = std::make_unique<collision_risk::RiskMonitor>(collision_risk::MakeRiskMonitor(risk));
   c.loop.monitor_rate_hz = risk.rate_hz;
 

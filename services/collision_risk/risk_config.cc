@@ -4,6 +4,7 @@
 
 #include "iplan/cell/safety.h"
 #include "iplan/core/params.h"
+#include "iplan/framework/service_file.h"
 
 namespace iplan::collision_risk {
 
@@ -48,6 +49,15 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   }
   c.robot_file = config.ResolvePath(settings.robot);
   c.human_body_file = config.ResolvePath(settings.human_body);
+  return c;
+}
+
+RiskConfig LoadRiskConfig(const std::string& collision_risk_yaml, const std::string& robot_file) {
+  framework::ServiceFile file(collision_risk_yaml);
+  framework::ConfigSection section = file.Section("collision_risk");
+  RiskConfig c = ReadRiskConfig(section);
+  file.Finish();
+  if (!robot_file.empty()) c.robot_file = robot_file;
   return c;
 }
 

@@ -53,6 +53,12 @@ struct RiskConfig {
 /// naming both files).
 RiskConfig ReadRiskConfig(framework::ConfigSection& section);
 
+/// Reads `collision_risk_yaml` as the collision-risk service does (section
+/// collision_risk, strictly: framework::ServiceFile), for tools that build
+/// the same monitor; a non-empty `robot_file` (a path as given) replaces the
+/// file's robot. @throws core::ConfigError naming the file and the key.
+RiskConfig LoadRiskConfig(const std::string& collision_risk_yaml, const std::string& robot_file = "");
+
 /// Loads the robot and human models named by `config` and builds the
 /// monitor. Throws std::exception (invalid params, unreadable models).
 RiskMonitor MakeRiskMonitor(const RiskConfig& config);

@@ -130,11 +130,7 @@ void LoadCellInputs(const std::string& dir, const std::string& robot, CellInputs
   perception::PerceptionSettings perception;
   framework::ServiceFile(framework::CellFile(dir, "perception")).ReadSection("perception", &perception).Finish();
   in->person = perception.synthetic.Person();
-  framework::ServiceFile rconf(framework::CellFile(dir, "collision_risk"));
-  framework::ConfigSection rsec = rconf.Section("collision_risk");
-  in->risk = collision_risk::ReadRiskConfig(rsec);
-  rconf.Finish();
-  if (!robot.empty()) in->risk.robot_file = robot;
+  in->risk = collision_risk::LoadRiskConfig(framework::CellFile(dir, "collision_risk"), robot);
   // The check asks about the working cell, where predictions flow: the
   // separation layer with the person's measured speed, not the degraded
   // mode the monitor falls back to when intent is gone.

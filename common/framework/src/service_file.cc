@@ -14,11 +14,4 @@ ServiceFile::ServiceFile(const std::string& path, const core::Overrides& overrid
   core::ReadParams(file_.Section("node"), &node_);  // every range: NodeOptions::Validate
 }
 
-void ServiceFile::ThrowProblems() const {
-  if (file_.Problems().empty()) return;
-  std::string msg;
-  for (const std::string& p : file_.Problems()) msg += (msg.empty() ? "" : "\n") + p;
-  throw ConfigError(msg);
-}
-
 }  // namespace iplan::framework

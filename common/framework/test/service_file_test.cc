@@ -62,12 +62,9 @@ TEST(ServiceFile, UnknownKeysWrongTypesAndRangesAreRefusedNamingFileAndKey) {
   const std::string ok = Write("svc_ok.yaml", "svc:\n  rate_hz: 5\n");
   EXPECT_EQ(Error(ok, {{"svc.rate_hz", "fast"}}), ok + ": key 'svc.rate_hz': expected a finite number, got 'fast'");
   EXPECT_EQ(Error(ok), "");
-  // A tool that reads only some sections asks for the problems so far.
-  ServiceFile partial(Write("svc_partial.yaml", "svc:\n  rate_hz: 5\nother:\n  x: 1\n"));
-  Section s;
-  partial.ReadSection("svc", &s);
-  EXPECT_NO_THROW(partial.ThrowProblems());
-  EXPECT_THROW(partial.Finish(), ConfigError);
+  // A section nobody declared is an unknown key too.
+  const std::string other = Write("svc_other.yaml", "svc:\n  rate_hz: 5\nother:\n  x: 1\n");
+  EXPECT_EQ(Error(other), other + ": unknown key 'other'");
 }
 
 TEST(NodeSettings, TheDocumentedDefaultsAreTheDeclaredOnes) {

@@ -44,9 +44,6 @@ class ServiceFile {
 
   /// Throws ConfigError listing every problem, unknown keys included.
   void Finish() const { file_.Finish(); }
-  /// Throws ConfigError listing the problems recorded so far (no unknown-key
-  /// check: for a tool that reads only some sections of a file).
-  void ThrowProblems() const;
 
   const NodeSettings& node() const { return node_; }
   const std::string& path() const { return file_.file(); }
