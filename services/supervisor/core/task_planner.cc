@@ -16,8 +16,11 @@ namespace iplan::supervisor {
 namespace {
 
 // Version 2 adds the number of learning episodes after the row count;
-// version 1 tables (without it) still load, as 0 episodes.
-constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
+// version 3 then the learned task durations (per task: outcomes observed,
+// their mean in s). Tables of versions 1 and 2 still load (0 episodes, no
+// durations).
+constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '3'};
+constexpr char kMagicV2[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
 constexpr char kMagicV1[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
 
 template <class T>
@@ -78,6 +81,7 @@ std::string TaskGraph::Validate() const {
   }
   if (!rest.empty() && std::none_of(tasks.begin(), tasks.end(), [&](const RobotTask& t) { return t.name == rest; }))
     return "rest names unknown task '" + rest + "'";
+  if (const std::string why = human_graph.Validate(human_actions); !why.empty()) return why;
   // Cycles: repeatedly finish tasks whose predecessors are finished.
   std::vector<bool> done(tasks.size(), false);
   for (std::size_t round = 0; round < tasks.size(); ++round) {
@@ -109,6 +113,8 @@ std::string QLearningParams::Validate() const {
   if (!(epsilon_decay > 0 && epsilon_decay <= 1)) return "epsilon_decay must be in (0, 1]";
   if (!(epsilon_min >= 0 && epsilon_min <= 1)) return "epsilon_min must be in [0, 1]";
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
+  if (!(anticipation_weight >= 0) || !std::isfinite(anticipation_weight)) return "anticipation_weight must be >= 0";
+  if (!(task_duration_prior > 0) || !std::isfinite(task_duration_prior)) return "task_duration_prior must be > 0";
   return "";
 }
 
@@ -125,6 +131,7 @@ TaskPlanner::TaskPlanner(TaskGraph graph, QLearningParams params)
     }
     prerequisites_.push_back(mask);
   }
+  durations_.assign(graph_.tasks.size(), {0, 0.0});
 }
 
 bool TaskPlanner::episode_done() const { return state_ == (1ULL << graph_.tasks.size()) - 1; }
@@ -164,16 +171,67 @@ double TaskPlanner::Epsilon() const {
   return std::min(params_.epsilon, std::max(params_.epsilon_min, decayed));
 }
 
-int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
+double TaskPlanner::TaskDuration(int task) const {
+  const auto& [count, mean] = durations_[static_cast<std::size_t>(task)];
+  return count > 0 ? mean : params_.task_duration_prior;
+}
+
+void TaskPlanner::ObserveDuration(int task, double seconds) {
+  if (!(seconds > 0) || !std::isfinite(seconds)) return;
+  auto& [count, mean] = durations_[static_cast<std::size_t>(task)];
+  ++count;
+  mean += (seconds - mean) / static_cast<double>(count);
+}
+
+double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast) const {
+  const RobotTask& t = graph_.tasks[static_cast<std::size_t>(task)];
+  std::vector<double> conflict(forecast.actions.size(), 0.0);
+  for (std::size_t c = 0; c < forecast.actions.size(); ++c) {
+    if (std::find(t.conflicts_with.begin(), t.conflicts_with.end(), forecast.actions[c]) != t.conflicts_with.end()) {
+      conflict[c] = 1.0;
+    }
+  }
+  const double duration = TaskDuration(task);
+  double seconds = 0;
+  for (std::size_t k = 0; k < forecast.p.size(); ++k) {
+    const double width = std::min(forecast.dt, duration - static_cast<double>(k) * forecast.dt);
+    if (width <= 0) break;
+    double p = 0;
+    for (std::size_t c = 0; c < conflict.size(); ++c) p += forecast.p[k][c] * conflict[c];
+    seconds += width * std::clamp(p, 0.0, 1.0);
+  }
+  return seconds;
+}
+
+double TaskPlanner::ExpectedConflict(int task, const ActionOutlook& outlook) const {
+  if (outlook.belief.empty()) return 0.0;
+  const int steps = static_cast<int>(std::ceil(TaskDuration(task) / kForecastStep));
+  return ExpectedConflict(task, ForecastActions(graph_.human_graph, outlook, kForecastStep, steps));
+}
+
+int TaskPlanner::Choose(const ActionOutlook& outlook) {
   const std::vector<int> avail = Available();
   if (avail.empty()) return -1;
   if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < Epsilon()) {
     return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
   }
+  // The anticipation: one forecast, as long as the longest candidate.
+  std::vector<double> cost(graph_.tasks.size(), 0.0);
+  if (params_.anticipation_weight > 0 && !outlook.belief.empty()) {
+    double longest = 0;
+    for (int a : avail) longest = std::max(longest, TaskDuration(a));
+    const ActionForecast forecast = ForecastActions(graph_.human_graph, outlook, kForecastStep,
+                                                    static_cast<int>(std::ceil(longest / kForecastStep)));
+    for (int a : avail) cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * ExpectedConflict(a, forecast);
+  }
+  auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };
   int best = avail.front();
   for (int a : avail) {
-    const double qa = Q(state_, a), qb = Q(state_, best);
-    if (qa > qb + 1e-12 || (std::abs(qa - qb) <= 1e-12 && Harmony(a, belief) > Harmony(best, belief))) best = a;
+    const double qa = score(a), qb = score(best);
+    if (qa > qb + 1e-12 ||
+        (std::abs(qa - qb) <= 1e-12 && Harmony(a, outlook.belief) > Harmony(best, outlook.belief))) {
+      best = a;
+    }
   }
   return best;
 }
@@ -240,6 +298,10 @@ void TaskPlanner::Write(const std::string& path) const {
   Put(&body, static_cast<uint64_t>(graph_.tasks.size()));
   Put(&body, static_cast<uint64_t>(q_.size()));
   Put(&body, episodes_learned_);
+  for (const auto& [count, mean] : durations_) {
+    Put(&body, count);
+    Put(&body, mean);
+  }
   for (const auto& [s, row] : q_) {
     Put(&body, s);
     for (double v : row) Put(&body, v);
@@ -250,9 +312,8 @@ void TaskPlanner::Write(const std::string& path) const {
   // rotating blindly would copy the corrupt bytes over the one good copy.
   if (std::ifstream(path).good()) {
     const std::string previous = core::ReadFile(path);
-    std::map<State, std::vector<double>> unused_q;
-    uint64_t unused_episodes = 0;
-    if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
+    Table unused;
+    if (!Parse(previous, path, &unused)) core::WriteFileAtomically(path + ".bak", previous);
   }
   core::WriteChecksummedFileAtomically(path, std::string_view(kMagic, sizeof(kMagic)), body,
                                       core::ChecksumAt::kBeforePayload);
@@ -265,33 +326,44 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   } catch (const std::exception& e) {
     return std::string(e.what());
   }
-  std::map<State, std::vector<double>> q;
-  uint64_t episodes = 0;
-  if (auto error = Parse(data, path, &q, &episodes)) return error;
-  q_ = std::move(q);
-  episodes_learned_ = episodes;
+  Table table;
+  if (auto error = Parse(data, path, &table)) return error;
+  q_ = std::move(table.q);
+  episodes_learned_ = table.episodes;
+  durations_.assign(graph_.tasks.size(), {0, 0.0});
+  if (!table.durations.empty()) durations_ = std::move(table.durations);
   return std::nullopt;
 }
 
-std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path,
-                                              std::map<State, std::vector<double>>* q_out,
-                                              uint64_t* episodes_out) const {
+std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path, Table* out) const {
   if (data.size() < sizeof(kMagic) + 8) return path + " is not an iplan Q-table";
-  const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
-  if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
+  int version = 0;
+  for (const auto& [magic, v] : {std::pair{kMagicV1, 1}, std::pair{kMagicV2, 2}, std::pair{kMagic, 3}}) {
+    if (std::memcmp(data.data(), magic, sizeof(kMagic)) == 0) version = v;
+  }
+  if (version == 0) return path + " is not an iplan Q-table";
   std::size_t pos = sizeof(kMagic);
   uint64_t hash = 0, ntasks = 0, nrows = 0;
   if (!core::OpenChecksummed(data, sizeof(kMagic), core::ChecksumAt::kBeforePayload)) {
     return path + " is corrupt (checksum mismatch)";
   }
   pos += sizeof(uint64_t);  // the checksum
-  uint64_t episodes = 0;
+  Table table;
   if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows) ||
-      (!v1 && !Get(data, &pos, &episodes))) {
+      (version >= 2 && !Get(data, &pos, &table.episodes))) {
     return path + " is truncated";
   }
   if (hash != GraphHash() || ntasks != graph_.tasks.size()) return path + " belongs to another task graph";
-  std::map<State, std::vector<double>> q;
+  if (version >= 3) {
+    table.durations.resize(ntasks);
+    for (std::size_t i = 0; i < ntasks; ++i) {
+      auto& [count, mean] = table.durations[i];
+      if (!Get(data, &pos, &count) || !Get(data, &pos, &mean)) return path + " is truncated";
+      if (!std::isfinite(mean) || mean < 0) {
+        return path + " has an impossible duration of task '" + graph_.tasks[i].name + "'";
+      }
+    }
+  }
   for (uint64_t r = 0; r < nrows; ++r) {
     State s = 0;
     std::vector<double> row(ntasks);
@@ -308,11 +380,10 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
         return why.str();
       }
     }
-    q[s] = std::move(row);
+    table.q[s] = std::move(row);
   }
   if (pos != data.size()) return path + " has trailing bytes";
-  *q_out = std::move(q);
-  *episodes_out = episodes;
+  *out = std::move(table);
   return std::nullopt;
 }
 
