@@ -40,6 +40,7 @@ struct CellOptions {
   int trace = -1;  // episode whose runs are traced (-1: none)
   double episode_limit = 120, time_limit = 20;
   double anticipation_weight = -1;  // < 0: supervisor.yaml's
+  int anticipation_depth = 0;       // 0: supervisor.yaml's
   bool retrain = false, quiet = false;
 };
 
@@ -167,6 +168,7 @@ bool Prepare(const CellOptions& o, eval_common::CellInputs* in, cell_sim::CellBe
     setup->episode_limit = o.episode_limit;
     setup->task_time_limit = o.time_limit;
     if (o.anticipation_weight >= 0) setup->learning.anticipation_weight = o.anticipation_weight;
+    if (o.anticipation_depth > 0) setup->learning.anticipation_depth = o.anticipation_depth;
     try {
       cell_sim::CalibrateBaselines(RecordCellDemonstrations(in->cell.person), &setup->base);
     } catch (const std::exception& e) {
@@ -212,7 +214,8 @@ int RunCell(const CellOptions& o) {
   std::cout << kCommand << ": " << episodes.size() << " episodes, seed " << o.seed << ", predictors";
   for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
   std::cout << "\n  configuration " << in.dir << "\n  " << in.model.summary << "\n  task planner: anticipation_weight "
-            << setup.learning.anticipation_weight << ", one per predictor, learning over the episodes\n\n";
+            << setup.learning.anticipation_weight << ", anticipation_depth " << setup.learning.anticipation_depth
+            << ", one per predictor, learning over the episodes\n\n";
 
   std::vector<std::vector<cell_sim::CellEpisodeResult>> results;
   Json runs = Json::array(), people = Json::array();
@@ -248,6 +251,7 @@ int RunCell(const CellOptions& o) {
   doc["episode_limit_s"] = o.episode_limit;
   doc["time_limit_s"] = o.time_limit;
   doc["anticipation_weight"] = setup.learning.anticipation_weight;
+  doc["anticipation_depth"] = setup.learning.anticipation_depth;
   doc["predictors"] = std::move(per);
   doc["model_recovers_oracle_gain"] = GainJson(summary);
   doc["people"] = std::move(people);
@@ -296,6 +300,9 @@ void AddEvalCellCommand(CLI::App* eval) {
   c->add_option("--anticipation-weight", o->anticipation_weight,
                 "the task planners' anticipation_weight instead of supervisor.yaml's (0: METHOD 6's choice)")
       ->check(CLI::NonNegativeNumber);
+  c->add_option("--anticipation-depth", o->anticipation_depth,
+                "the task planners' anticipation_depth instead of supervisor.yaml's")
+      ->check(CLI::Range(1, 8));
   c->add_option("--threads", o->threads, "planner threads (0: as planner_replanning.yaml; results do not depend on it)")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));

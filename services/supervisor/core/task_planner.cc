@@ -115,6 +115,7 @@ std::string QLearningParams::Validate() const {
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
   if (!(anticipation_weight >= 0) || !std::isfinite(anticipation_weight)) return "anticipation_weight must be >= 0";
   if (!(task_duration_prior > 0) || !std::isfinite(task_duration_prior)) return "task_duration_prior must be > 0";
+  if (anticipation_depth < 1 || anticipation_depth > 8) return "anticipation_depth must be in [1, 8]";
   return "";
 }
 
@@ -136,11 +137,13 @@ TaskPlanner::TaskPlanner(TaskGraph graph, QLearningParams params)
 
 bool TaskPlanner::episode_done() const { return state_ == (1ULL << graph_.tasks.size()) - 1; }
 
-std::vector<int> TaskPlanner::Available() const {
+std::vector<int> TaskPlanner::Available() const { return AvailableIn(state_); }
+
+std::vector<int> TaskPlanner::AvailableIn(State state) const {
   std::vector<int> out;
   for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
     const uint64_t bit = 1ULL << i;
-    if (!(state_ & bit) && (state_ & prerequisites_[i]) == prerequisites_[i]) out.push_back(static_cast<int>(i));
+    if (!(state & bit) && (state & prerequisites_[i]) == prerequisites_[i]) out.push_back(static_cast<int>(i));
   }
   return out;
 }
@@ -183,7 +186,7 @@ void TaskPlanner::ObserveDuration(int task, double seconds) {
   mean += (seconds - mean) / static_cast<double>(count);
 }
 
-double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast) const {
+double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast, double from) const {
   const RobotTask& t = graph_.tasks[static_cast<std::size_t>(task)];
   std::vector<double> conflict(forecast.actions.size(), 0.0);
   for (std::size_t c = 0; c < forecast.actions.size(); ++c) {
@@ -191,22 +194,59 @@ double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast) c
       conflict[c] = 1.0;
     }
   }
-  const double duration = TaskDuration(task);
+  const double to = from + TaskDuration(task);
   double seconds = 0;
-  for (std::size_t k = 0; k < forecast.p.size(); ++k) {
-    const double width = std::min(forecast.dt, duration - static_cast<double>(k) * forecast.dt);
-    if (width <= 0) break;
+  // Step k covers [k dt, (k + 1) dt); the part of it inside [from, to).
+  for (std::size_t k = static_cast<std::size_t>(std::max(0.0, std::floor(from / forecast.dt))); k < forecast.p.size(); ++k) {
+    const double begin = std::max(from, static_cast<double>(k) * forecast.dt);
+    const double end = std::min(to, static_cast<double>(k + 1) * forecast.dt);
+    if (end <= begin) {
+      if (begin >= to) break;
+      continue;
+    }
     double p = 0;
     for (std::size_t c = 0; c < conflict.size(); ++c) p += forecast.p[k][c] * conflict[c];
-    seconds += width * std::clamp(p, 0.0, 1.0);
+    seconds += (end - begin) * std::clamp(p, 0.0, 1.0);
   }
   return seconds;
+}
+
+double TaskPlanner::BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const {
+  if (depth <= 0) return 0.0;
+  double best = 0;
+  bool any = false;
+  for (int b : AvailableIn(state)) {
+    const double c = ExpectedConflict(b, forecast, from) +
+                     BestContinuation(state | (1ULL << b), forecast, from + TaskDuration(b), depth - 1);
+    best = any ? std::min(best, c) : c;
+    any = true;
+  }
+  return best;
+}
+
+ActionForecast TaskPlanner::SequenceForecast(State state, const ActionOutlook& outlook) const {
+  // Long enough for the anticipation_depth longest tasks left.
+  std::vector<double> left;
+  for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
+    if (!(state & (1ULL << i))) left.push_back(TaskDuration(static_cast<int>(i)));
+  }
+  std::sort(left.rbegin(), left.rend());
+  double horizon = 0;
+  for (std::size_t i = 0; i < left.size() && i < static_cast<std::size_t>(params_.anticipation_depth); ++i) horizon += left[i];
+  return ForecastActions(graph_.human_graph, outlook, kForecastStep, static_cast<int>(std::ceil(horizon / kForecastStep)));
 }
 
 double TaskPlanner::ExpectedConflict(int task, const ActionOutlook& outlook) const {
   if (outlook.belief.empty()) return 0.0;
   const int steps = static_cast<int>(std::ceil(TaskDuration(task) / kForecastStep));
-  return ExpectedConflict(task, ForecastActions(graph_.human_graph, outlook, kForecastStep, steps));
+  return ExpectedConflict(task, ForecastActions(graph_.human_graph, outlook, kForecastStep, steps), 0.0);
+}
+
+double TaskPlanner::AnticipatedConflict(int task, const ActionOutlook& outlook) const {
+  if (outlook.belief.empty()) return 0.0;
+  const ActionForecast forecast = SequenceForecast(state_, outlook);
+  return ExpectedConflict(task, forecast, 0.0) + BestContinuation(state_ | (1ULL << task), forecast, TaskDuration(task),
+                                                                   params_.anticipation_depth - 1);
 }
 
 int TaskPlanner::Choose(const ActionOutlook& outlook) {
@@ -215,14 +255,15 @@ int TaskPlanner::Choose(const ActionOutlook& outlook) {
   if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < Epsilon()) {
     return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
   }
-  // The anticipation: one forecast, as long as the longest candidate.
+  // The anticipation: one forecast, as long as the longest sequence.
   std::vector<double> cost(graph_.tasks.size(), 0.0);
   if (params_.anticipation_weight > 0 && !outlook.belief.empty()) {
-    double longest = 0;
-    for (int a : avail) longest = std::max(longest, TaskDuration(a));
-    const ActionForecast forecast = ForecastActions(graph_.human_graph, outlook, kForecastStep,
-                                                    static_cast<int>(std::ceil(longest / kForecastStep)));
-    for (int a : avail) cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * ExpectedConflict(a, forecast);
+    const ActionForecast forecast = SequenceForecast(state_, outlook);
+    for (int a : avail) {
+      const double seconds = ExpectedConflict(a, forecast, 0.0) +
+                             BestContinuation(state_ | (1ULL << a), forecast, TaskDuration(a), params_.anticipation_depth - 1);
+      cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * seconds;
+    }
   }
   auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };
   int best = avail.front();

@@ -5,10 +5,11 @@
 // person is predicted to do and penalises the delay a task caused:
 //   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
 // Our extension, the anticipating choice: the next task maximises
-//   Q(s, a) - w_c * E[conflict of a over its own duration],
+//   Q(s, a) - w_c * E[conflict of a over its own duration, and of the best
+//                    continuation of up to anticipation_depth - 1 tasks],
 // the expected seconds during which the person, forecast from the belief
 // and the person's own task graph (core/human_graph.h), does an action the
-// task conflicts with while it runs; the task's duration is learned from its
+// tasks conflict with while they run; task durations are learned from
 // outcomes. w_c = 0 is METHOD 6's choice.
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
 // with a message and the previous good copy is used. The backup is only
@@ -116,6 +117,10 @@ struct QLearningParams {
   /// w_c, per second of expected conflict of a task over its duration (our
   /// extension, the anticipating choice); 0: METHOD 6's choice (Q alone).
   double anticipation_weight = 0.0;
+  /// Tasks in the sequence the anticipation looks at: the candidate and the
+  /// best continuation of up to depth - 1 tasks after it (1: the candidate
+  /// alone).
+  int anticipation_depth = 1;
   /// s a task is expected to take before it has been done once (then: the
   /// mean of its outcomes' durations less their delays).
   double task_duration_prior = 3.0;
@@ -133,6 +138,8 @@ struct QLearningParams {
     a->Visit(IPLAN_NVP(delay_weight, "w_d, per second of delay, >= 0"));
     a->Visit(IPLAN_NVP(anticipation_weight,
                        "w_c, per second a task is expected to conflict with the person over its duration, >= 0; 0: off"));
+    a->Visit(IPLAN_NVP(anticipation_depth,
+                       "tasks looked at by the anticipation: the candidate and the best continuation, in [1, 8]"));
     a->Visit(IPLAN_NVP(task_duration_prior, "s a task is expected to take before it was done once, > 0"));
     a->Visit(IPLAN_NVP(seed, "seed of the exploration generator"));
   }
@@ -161,11 +168,17 @@ class TaskPlanner {
   /// 0 in deployment.
   double Epsilon() const;
   /// Chooses the next task: epsilon-greedy in learning mode, greedy in
-  /// deployment, on Q(s, a) - anticipation_weight * ExpectedConflict(a,
+  /// deployment, on Q(s, a) - anticipation_weight * AnticipatedConflict(a,
   /// outlook) (Q alone when the weight is 0 or the belief empty); ties
   /// broken by the harmony with the belief, then by index. -1 when the
   /// episode is done. Allocates (the forecast).
   int Choose(const ActionOutlook& outlook);
+  /// s of expected conflict of the sequence that starts with `task` (one
+  /// available now) and continues with the continuation of up to
+  /// anticipation_depth - 1 available tasks that has the least, each task
+  /// taking TaskDuration from the end of the one before (the pause between
+  /// tasks is not counted). With depth 1 this is ExpectedConflict.
+  double AnticipatedConflict(int task, const ActionOutlook& outlook) const;
   /// s of `task`'s expected duration (TaskDuration) during which the person
   /// is expected to do an action the task conflicts with:
   /// sum over forecast steps of dt * sum_c p_k(c) conflict(task, c), the
@@ -233,7 +246,13 @@ class TaskPlanner {
     std::vector<std::pair<uint64_t, double>> durations;  // empty: the file has none (format 1, 2)
   };
   std::optional<std::string> Parse(const std::string& data, const std::string& path, Table* table) const;
-  double ExpectedConflict(int task, const ActionForecast& forecast) const;
+  // s of conflict of `task` over [from, from + TaskDuration(task)).
+  double ExpectedConflict(int task, const ActionForecast& forecast, double from) const;
+  // The least conflict of up to `depth` tasks available in `state`, from `from` (s).
+  double BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const;
+  // The forecast long enough for the sequences from `state` (anticipation_depth tasks).
+  ActionForecast SequenceForecast(State state, const ActionOutlook& outlook) const;
+  std::vector<int> AvailableIn(State state) const;
   uint64_t GraphHash() const;
 
   TaskGraph graph_;

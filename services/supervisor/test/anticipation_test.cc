@@ -211,6 +211,38 @@ TEST(TaskPlanner, TheAnticipatingChoiceAvoidsTheActionPredictedNext) {
   EXPECT_NEAR(planner.ExpectedConflict(0, outlook), 0.05, 0.02);
 }
 
+TEST(TaskPlanner, LookingFurtherAheadFitsTheConflictingTaskBeforeTheAction) {
+  // The person rests for 3 s more, then works for 10 s. Hand-over (2.5 s)
+  // conflicts with working; filler (3 s) with nothing. One task ahead, both
+  // are clear now and the index picks filler, which leaves the hand-over to
+  // the work; two tasks ahead, the hand-over first fits before the work.
+  TaskGraph g;
+  g.human_actions = {"rest", "work"};
+  g.tasks = {{"filler", {0.1}, {}, {}}, {"hand_over", {0.2}, {}, {"work"}}};
+  g.human_graph.start = {{"rest", 1.0}};
+  g.human_graph.actions = {{"rest", {{3.0, 3.0}, {{"work", 1.0}}}}, {"work", {{10.0, 10.0}, {{"rest", 1.0}}}}};
+  ActionOutlook outlook;
+  outlook.belief = {{"rest", 1.0}};
+  QLearningParams params;
+  params.learning = false;
+  params.anticipation_weight = 1.0;
+  TaskPlanner one(g, params);
+  params.anticipation_depth = 2;
+  TaskPlanner two(g, params);
+  for (TaskPlanner* p : {&one, &two}) {
+    p->ObserveDuration(0, 3.0);
+    p->ObserveDuration(1, 2.5);
+  }
+  EXPECT_NEAR(one.AnticipatedConflict(0, outlook), 0.0, 1e-9);
+  EXPECT_NEAR(one.AnticipatedConflict(1, outlook), 0.0, 1e-9);
+  EXPECT_EQ(one.Choose(outlook), 0);
+  EXPECT_NEAR(two.AnticipatedConflict(0, outlook), 2.5, 1e-9);  // filler, then the hand-over into the work
+  EXPECT_NEAR(two.AnticipatedConflict(1, outlook), 0.0, 1e-9);
+  EXPECT_EQ(two.Choose(outlook), 1);
+  params.anticipation_depth = 0;
+  EXPECT_EQ(params.Validate(), "anticipation_depth must be in [1, 8]");
+}
+
 TEST(TaskPlanner, TaskDurationsAreLearnedAndSavedWithTheTable) {
   QLearningParams params;
   params.task_duration_prior = 4.0;
