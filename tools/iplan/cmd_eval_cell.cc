@@ -162,7 +162,12 @@ void PrintTable(const std::vector<cell_sim::CellSummary>& summary) {
 bool Prepare(const CellOptions& o, eval_common::CellInputs* in, cell_sim::CellBenchmarkSetup* setup,
              std::vector<cell_sim::EpisodeSpec>* episodes) {
   try {
-    eval_common::LoadCell(eval_common::ConfigDir(o.config_dir), o.robot, o.threads, o.model_dir, o.retrain, in);
+    eval_common::ReadConfiguration(eval_common::ConfigDir(o.config_dir), o.robot, o.threads, in);
+    // A cell the benchmark cannot run is refused before the model is trained.
+    cell_sim::CellBenchmarkSetup probe = in->cell.MakeCellSetup();
+    probe.base.intent_model = std::make_shared<const intent::IntentModel>();
+    if (const std::string why = probe.Validate(); !why.empty()) throw std::runtime_error(why);
+    eval_common::PrepareIntentModel(o.model_dir, o.retrain, in);
     *setup = in->cell.MakeCellSetup();
     setup->base.intent_model = in->intent_model;
     setup->episode_limit = o.episode_limit;

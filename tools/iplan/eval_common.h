@@ -92,20 +92,30 @@ inline std::string ConfigDir(const std::string& given) {
 }
 
 /// Loads the configuration folder `dir` (ConfigDir) for another arm `robot`
-/// (empty: the configured), printing the goal notes, and the intent model
-/// (trained or cached as `iplan demo --prepare-only` does; in `model_dir`
-/// when config/models is not writable, empty: a temporary folder). Throws
+/// (empty: the configured) into in->cell, printing the goal notes. Throws
 /// std::runtime_error.
-inline void LoadCell(const std::string& dir, const std::string& robot, int threads, const std::string& model_dir,
-                     bool retrain, CellInputs* in) {
-  namespace fs = std::filesystem;
+inline void ReadConfiguration(const std::string& dir, const std::string& robot, int threads, CellInputs* in) {
   in->dir = dir;
-  in->cell = cell_sim::LoadCellConfig(in->dir, threads, robot.empty() ? "" : fs::absolute(robot).string());
+  in->cell = cell_sim::LoadCellConfig(dir, threads, robot.empty() ? "" : std::filesystem::absolute(robot).string());
   for (const std::string& note : in->cell.goal_notes) std::cout << note << "\n";
+}
+
+/// Loads the intent model of in->dir's cell, trained or cached as `iplan
+/// demo --prepare-only` does (in `model_dir` when config/models is not
+/// writable; empty: a temporary folder). Throws std::runtime_error.
+inline void PrepareIntentModel(const std::string& model_dir, bool retrain, CellInputs* in) {
+  namespace fs = std::filesystem;
   const std::string fallback = model_dir.empty() ? (fs::temp_directory_path() / "iplan-eval-model").string() : model_dir;
   in->model = EnsureCellModel((fs::path(in->dir) / "perception.yaml").string(), (fs::path(in->dir) / "intent.yaml").string(),
                               fallback, retrain);
   in->intent_model = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(in->model.path));
+}
+
+/// Both: the configuration, then the intent model.
+inline void LoadCell(const std::string& dir, const std::string& robot, int threads, const std::string& model_dir,
+                     bool retrain, CellInputs* in) {
+  ReadConfiguration(dir, robot, threads, in);
+  PrepareIntentModel(model_dir, retrain, in);
 }
 
 }  // namespace iplan::cli::eval_common
