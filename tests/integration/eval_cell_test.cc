@@ -93,13 +93,19 @@ TEST_F(EvalCell, OneEpisodeWritesEveryFieldAndRepeatsForASeed) {
     }
     ASSERT_FALSE(e["tasks"].empty());
     for (const auto& t : e["tasks"]) {
-      for (const char* key : {"task", "person_action", "expected_conflict_s", "succeeded", "task_time_s"}) {
+      for (const char* key : {"task", "person_action", "believed_action", "believed_for_s", "expected_conflict_s",
+                              "succeeded", "task_time_s"}) {
         EXPECT_TRUE(t.contains(key)) << key << " in " << t.dump();
       }
     }
   }
-  // none gives the task planner nothing to anticipate with; model and oracle do.
-  for (const auto& t : j["episodes"][0]["tasks"]) EXPECT_EQ(t["expected_conflict_s"], 0.0);
+  // none gives the task planner nothing to anticipate with; the oracle the truth.
+  for (const auto& t : j["episodes"][0]["tasks"]) {
+    EXPECT_EQ(t["expected_conflict_s"], 0.0);
+    EXPECT_EQ(t["believed_action"], "");
+  }
+  ASSERT_EQ(j["episodes"][2]["predictor"], "oracle");
+  for (const auto& t : j["episodes"][2]["tasks"]) EXPECT_EQ(t["believed_action"], t["person_action"]);
 }
 
 TEST_F(EvalCell, BadRequestsAreRefusedWithExitCode2) {

@@ -72,6 +72,8 @@ Json EpisodeJson(const cell_sim::EpisodeSpec& e, const cell_sim::CellEpisodeResu
   for (const auto& t : r.tasks) {
     tasks.push_back(Json{{"task", t.task},
                          {"person_action", t.person_action},
+                         {"believed_action", t.believed_action},
+                         {"believed_for_s", t.believed_for},
                          {"expected_conflict_s", t.expected_conflict},
                          {"command_s", t.result.command_time},
                          {"succeeded", t.result.finished && t.result.status == trajopt::TaskStatus::kSucceeded},

@@ -108,6 +108,12 @@ CellEpisodeResult RunOne(const CellBenchmarkSetup& setup, const EpisodeSpec& spe
     chosen.task = task.name;
     chosen.person_action = spec.actions[SpanAt(spec.actions, t)].action;
     chosen.expected_conflict = planner->ExpectedConflict(current, o);
+    if (!o.belief.empty()) {
+      chosen.believed_action = std::max_element(o.belief.begin(), o.belief.end(), [](const auto& a, const auto& b) {
+                                 return a.second < b.second;
+                               })->first;
+      chosen.believed_for = o.elapsed;
+    }
     out.tasks.push_back(std::move(chosen));
     trajopt::TaskSpec s;
     s.id = ++id;

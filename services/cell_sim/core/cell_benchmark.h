@@ -78,6 +78,10 @@ struct ChosenTask {
   std::string task;
   std::string person_action;        ///< what the person truly did at the command
   double expected_conflict = 0;     ///< s, the planner's ExpectedConflict of the chosen task (0 without a forecast)
+  /// What the task planner was told: the belief's most likely action ("":
+  /// nothing) and how long it had lasted (s).
+  std::string believed_action;
+  double believed_for = 0;
   InteractionResult result;
 };
 
