@@ -46,6 +46,15 @@ BenchmarkSetup CellConfig::MakeSetup() const {
   return s;
 }
 
+CellBenchmarkSetup CellConfig::MakeCellSetup() const {
+  CellBenchmarkSetup s;
+  s.base = MakeSetup();
+  s.graph = graph;
+  s.learning = learning;
+  s.pause_between_tasks = pause_between_tasks;
+  return s;
+}
+
 CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std::string& robot_file) {
   if (planner_threads < 0) throw std::runtime_error("planner threads must be >= 0");
   auto file = [&](const std::string& name) {
@@ -82,7 +91,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   c.loop.joint_state_rate_hz = sim.publish_rate_hz;
   c.simulator = sim.simulator;
 
-  // The supervisor: task graph and resume hysteresis.
+  // The supervisor: task graph, resume hysteresis, the task planner's parameters.
   framework::ServiceFile vconf(file("supervisor"));
   supervisor::SupervisorSettings settings;
   vconf.ReadSection("supervisor", &settings).Finish();
@@ -90,6 +99,9 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   supervisor::TaskGraph graph = supervisor::LoadTaskGraph(vconf.ResolvePath(settings.task_graph));
   c.goal_notes = supervisor::ResolveTaskGoals(*c.planner, &graph);  // poses: the planner's IK for this robot
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
+  c.graph = std::move(graph);
+  c.learning = settings.learning;
+  c.pause_between_tasks = settings.pause_between_tasks;
 
   // The sensor and the synthetic person.
   perception::PerceptionSettings perception;

@@ -13,6 +13,7 @@
 #include <memory>
 #include <string>
 
+#include "core/cell_benchmark.h"
 #include "core/interaction_benchmark.h"
 #include "iplan/planning/planner.h"
 
@@ -31,6 +32,11 @@ struct CellConfig {
   double sensor_rate_hz = 30;
   double sensor_noise_std = 0.01;
   std::vector<GraphTask> tasks;
+  /// The task graph as the supervisor loads it, its places resolved for the
+  /// robot (joint goals), with the person's human_graph.
+  supervisor::TaskGraph graph;
+  supervisor::QLearningParams learning;  ///< supervisor.yaml's Q-learning and anticipation parameters
+  double pause_between_tasks = 0.5;      ///< s, supervisor.yaml
   /// Places of the task graph whose joint positions were not used as
   /// written (supervisor::ResolveTaskGoals), for the tool to print.
   std::vector<std::string> goal_notes;
@@ -39,6 +45,8 @@ struct CellConfig {
   /// outlive it); intent model, recordings and benchmark options are the
   /// caller's to fill in.
   BenchmarkSetup MakeSetup() const;
+  /// The same for the episode benchmark (`iplan eval cell`).
+  CellBenchmarkSetup MakeCellSetup() const;
 };
 
 /// Loads `dir`. `planner_threads` (>= 0; 0: the file's) replaces the

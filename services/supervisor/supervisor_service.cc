@@ -142,6 +142,10 @@ class SupervisorService : public framework::Service {
   void Belief(const msg::ActionBelief& b) {
     belief_.clear();
     for (std::size_t i = 0; i < b.actions.size(); ++i) belief_[b.actions[i]] = b.probabilities[i];
+    // How long the person has been at it, in the skeletons' time (the
+    // stamp of the observation the belief was computed from).
+    belief_at_ = msg::ToSeconds(b.observation_stamp);
+    tracker_.Update(belief_at_, belief_);
   }
 
   void PublishPermit(const SafetyDecision& d) {
@@ -192,7 +196,12 @@ class SupervisorService : public framework::Service {
       planner_->ResetEpisode();
       if (max_episodes_ > 0 && episodes_ >= max_episodes_) return;
     }
-    current_task_ = planner_->Choose(belief_);
+    // The anticipating choice (docs/supervisor.md): the belief and how long
+    // its action has lasted, as of the newest belief.
+    ActionOutlook outlook;
+    outlook.belief = belief_;
+    outlook.elapsed = tracker_.Elapsed(belief_at_);
+    current_task_ = planner_->Choose(outlook);
     if (current_task_ < 0) return;
     const RobotTask& t = planner_->graph().tasks[static_cast<std::size_t>(current_task_)];
     msg::TaskCommand& c = command_;
@@ -206,8 +215,11 @@ class SupervisorService : public framework::Service {
     c.episode = static_cast<uint32_t>(episodes_ + 1);
     command_writer_->Write(c);
     last_command_at_ = std::chrono::steady_clock::now();
-    node.log().info("task {} '{}' (episode {}, state {:#x}, epsilon {:.3f})", task_id_, t.name, episodes_ + 1,
-                    planner_->state(), planner_->Epsilon());
+    node.log().info("task {} '{}' (episode {}, state {:#x}, epsilon {:.3f}; expected conflict {:.2f} s of {:.2f} s, "
+                    "person: {} for {:.1f} s)",
+                    task_id_, t.name, episodes_ + 1, planner_->state(), planner_->Epsilon(),
+                    planner_->ExpectedConflict(current_task_, outlook), planner_->TaskDuration(current_task_),
+                    tracker_.action().empty() ? "unknown" : tracker_.action(), outlook.elapsed);
   }
 
   void ResendCommand() {
@@ -219,6 +231,8 @@ class SupervisorService : public framework::Service {
   void OnOutcome(Node& node, const msg::TaskOutcome& o) {
     if (current_task_ < 0 || o.task_id != task_id_) return;  // not ours / stale
     const bool ok = services::TaskStatusFromWire(o.status) == cell::TaskStatus::kSucceeded;
+    // Its time without the delay: how long it takes when nothing is in the way.
+    if (ok) planner_->ObserveDuration(current_task_, o.duration - o.delay);
     const double reward = planner_->Complete(current_task_, ok, o.delay, belief_);
     ++completed_;
     node.log().info("task {} '{}' {} in {:.2f} s, delay {:.2f} s, reward {:.3f}", o.task_id, o.task_name,
@@ -253,6 +267,8 @@ class SupervisorService : public framework::Service {
   std::vector<std::pair<std::string, double>> deadlines_;  // watched topic, s
   std::chrono::steady_clock::time_point last_permit_at_{}, last_command_at_{};
   std::map<std::string, double> belief_;
+  double belief_at_ = 0;  // s, observation stamp of the newest belief
+  ActionTracker tracker_;
   msg::TaskCommand command_;  // the running task's command (re-sent on resume)
   int current_task_ = -1;
   uint32_t task_id_ = 0, permit_seq_ = 0;

@@ -29,6 +29,8 @@
 #include "command_registry.h"
 #include "cell_sim/core/interaction_benchmark.h"
 #include "dds_cell_model.h"
+#include "eval_cell.h"
+#include "eval_common.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/core/stats.h"
 #include "iplan/framework/service.h"
@@ -40,12 +42,14 @@ namespace {
 
 namespace fs = std::filesystem;
 using cell_sim::Predictor;
-using Json = nlohmann::ordered_json;
-
-const char* kAllPredictors = "none,constant-position,constant-velocity,model,oracle";
+using eval_common::Fixed;
+using eval_common::Json;
+using eval_common::RatioJson;
+using eval_common::SpreadJson;
+using eval_common::SpreadText;
 
 struct InteractionOptions {
-  std::string predictors = kAllPredictors;
+  std::string predictors = eval_common::kAllPredictors;
   int scenarios = 40;
   uint64_t seed = 1;
   std::string json_file, config_dir, recordings, model_dir, monitor = "same";
@@ -57,53 +61,10 @@ struct InteractionOptions {
   bool retrain = false, quiet = false;
 };
 
-std::string Fixed(double v, int digits) {
-  if (std::isinf(v)) return "inf";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
-
-std::string SpreadText(const cell_sim::Spread& s, int digits) {
-  return Fixed(s.median, digits) + " [" + Fixed(s.p10, digits) + ", " + Fixed(s.p90, digits) + "]";
-}
-
-Json SpreadJson(const cell_sim::Spread& s) { return Json{{"median", s.median}, {"p10", s.p10}, {"p90", s.p90}}; }
-
-// A ratio for JSON: infinity (stops where `none` had none) has no JSON number.
-Json RatioJson(double r) { return std::isfinite(r) ? Json(r) : Json(nullptr); }
-
 Json VectorJson(const Eigen::VectorXd& v) {
   Json a = Json::array();
   for (Eigen::Index i = 0; i < v.size(); ++i) a.push_back(v[i]);
   return a;
-}
-
-// --predictors as a list; prints why and returns nullopt when it is bad.
-std::optional<std::vector<Predictor>> ParsePredictors(const std::string& text) {
-  std::vector<Predictor> predictors;
-  std::stringstream ss(text);
-  std::string name;
-  while (std::getline(ss, name, ',')) {
-    if (name.empty()) continue;
-    const auto p = cell_sim::ParsePredictor(name);
-    if (!p) {
-      std::string known;
-      for (const auto& n : cell_sim::PredictorNames()) known += (known.empty() ? "" : ", ") + n;
-      std::cerr << "iplan eval interaction: unknown predictor '" << name << "' (known: " << known << ")\n";
-      return std::nullopt;
-    }
-    if (std::find(predictors.begin(), predictors.end(), *p) != predictors.end()) {
-      std::cerr << "iplan eval interaction: predictor '" << name << "' named twice\n";
-      return std::nullopt;
-    }
-    predictors.push_back(*p);
-  }
-  if (predictors.empty()) {
-    std::cerr << "iplan eval interaction: --predictors names no predictor\n";
-    return std::nullopt;
-  }
-  return predictors;
 }
 
 // The other options; prints why and returns false when one is bad.
@@ -129,37 +90,28 @@ bool CheckOptions(const InteractionOptions& o) {
   return true;
 }
 
-// What the benchmark loads before it runs.
-struct EvalInputs {
-  std::string dir, recordings_file;
-  cell_sim::CellConfig cell;
+// What the benchmark loads before it runs: the cell and its intent model
+// (eval_common::CellInputs) and the recorded motion.
+struct EvalInputs : eval_common::CellInputs {
+  std::string recordings_file;
   intent::SkeletonDataset recordings;
-  CellModelResult model;
-  std::shared_ptr<const intent::IntentModel> intent_model;
 };
 
-// Loads the cell's configuration, the recorded motion and the intent model
-// (trained or taken from the cache exactly as `iplan demo --prepare-only`
-// does). Throws std::runtime_error.
+// Loads the recorded motion, the cell's configuration and the intent model.
+// Throws std::runtime_error.
 void LoadInputs(const InteractionOptions& o, EvalInputs* in) {
-  in->dir = o.config_dir.empty() ? framework::DefaultConfigDir() : o.config_dir;
-  if (in->dir.empty()) throw std::runtime_error("no configuration found (set --config-dir or $IPLAN_CONFIG_DIR)");
+  const std::string dir = eval_common::ConfigDir(o.config_dir);
   // The recorded motion sits beside the checkout (../shared, as the
   // perception replay's example path says).
   in->recordings_file =
       o.recordings.empty()
-          ? (fs::path(in->dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
+          ? (fs::path(dir) / ".." / ".." / "shared" / "data" / "assembly.csv").lexically_normal().string()
           : o.recordings;
-  in->cell = cell_sim::LoadCellConfig(in->dir, o.threads, o.robot.empty() ? "" : fs::absolute(o.robot).string());
-  for (const std::string& note : in->cell.goal_notes) std::cout << note << "\n";
   if (!fs::exists(in->recordings_file)) {
     throw std::runtime_error("no recorded motion at " + in->recordings_file + " (set --recordings)");
   }
   in->recordings = intent::LoadSkeletonCsv(in->recordings_file);
-  const std::string fallback = o.model_dir.empty() ? (fs::temp_directory_path() / "iplan-eval-model").string() : o.model_dir;
-  in->model = EnsureCellModel((fs::path(in->dir) / "perception.yaml").string(), (fs::path(in->dir) / "intent.yaml").string(),
-                              fallback, o.retrain);
-  in->intent_model = std::make_shared<const intent::IntentModel>(intent::LoadIntentModel(in->model.path));
+  eval_common::LoadCell(dir, o.robot, o.threads, o.model_dir, o.retrain, in);
 }
 
 void PrintHeader(const InteractionOptions& o, const EvalInputs& in, const cell_sim::BenchmarkSetup& setup,
@@ -361,7 +313,7 @@ bool RunScenarios(const InteractionOptions& o, const std::vector<Predictor>& pre
 
 int RunInteraction(const InteractionOptions& o) {
   // Options first: a bad request is refused before anything is loaded.
-  const std::optional<std::vector<Predictor>> parsed = ParsePredictors(o.predictors);
+  const std::optional<std::vector<Predictor>> parsed = eval_common::ParsePredictors(o.predictors, "iplan eval interaction");
   if (!parsed || !CheckOptions(o)) return 2;
   const std::vector<Predictor>& predictors = *parsed;
   const auto wall0 = std::chrono::steady_clock::now();
@@ -492,6 +444,7 @@ const bool kRegistered = RegisterCommand("eval", [](CLI::App& app) {
                 "run only scenario N (0-based) and print every planning cycle, stop and resume of each predictor's run "
                 "to stderr, to see why it went as it did");
   c->callback([o] { SetExitCode(RunInteraction(*o)); });
+  AddEvalCellCommand(eval);
 });
 
 }  // namespace

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "core/person_motion.h"
+#include "core/prediction_sources.h"
 #include "core/scenario_draws.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/core/stats.h"
@@ -49,134 +50,6 @@ Eigen::Isometry3d EndEffectorPose(const planning::Planner& planner, const Eigen:
   return X;
 }
 
-
-// The model's predictions of one scenario, made once (lazily, in frame
-// order) and shared by every predictor's run: the estimator is fed every
-// observed skeleton, as the intent service is.
-class ModelTrack {
- public:
-  ModelTrack(const BenchmarkSetup& setup, const PersonStream& person)
-      : person_(person), estimator_(setup.intent_model, setup.estimator), joints_(setup.intent_model->config.joints.joints) {
-    for (const auto& name : joints_) {
-      const auto it = std::find(person.joint_names.begin(), person.joint_names.end(), name);
-      if (it == person.joint_names.end()) {
-        throw std::invalid_argument("the intent model's joint '" + name + "' is not a joint of the body model");
-      }
-      body_index_.push_back(static_cast<int>(it - person.joint_names.begin()));
-    }
-    frame_.body_id = 1;
-    frame_.joints.resize(joints_.size());
-    for (std::size_t j = 0; j < joints_.size(); ++j) frame_.joints[j].name = joints_[j];
-  }
-
-  const std::vector<std::string>& joints() const { return joints_; }
-  int body_index(std::size_t model_joint) const { return body_index_[model_joint]; }
-
-  const collision::JointMixture* At(int frame) {
-    while (static_cast<int>(done_.size()) <= frame) Advance();
-    return done_[static_cast<std::size_t>(frame)] ? &mixtures_[static_cast<std::size_t>(frame)] : nullptr;
-  }
-  // The model's within-action covariance sum_c p_c Sigma_c at (step, model joint).
-  Eigen::Matrix3d WithinCovariance(int frame, int step, std::size_t joint) {
-    const collision::JointMixture* m = At(frame);
-    Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
-    if (!m) return c;
-    const std::size_t J = joints_.size();
-    for (std::size_t a = 0; a < m->actions.size(); ++a) {
-      c += m->probabilities[a] * m->covariances[a][static_cast<std::size_t>(step) * J + joint];
-    }
-    return c;
-  }
-
- private:
-  void Advance() {
-    const int i = static_cast<int>(done_.size());
-    const Eigen::Matrix3Xd& seen = person_.observed[static_cast<std::size_t>(i)];
-    const int64_t t0 = SimTimeNs(person_.stamp(i));
-    frame_.stamp = static_cast<double>(t0) * 1e-9;
-    for (std::size_t j = 0; j < joints_.size(); ++j) frame_.joints[j].position = seen.col(body_index_[j]);
-    const intent_service::FrameResult r = estimator_.Update(frame_, &mixture_);
-    mixtures_.push_back(r.accepted() ? ToJointMixture(mixture_, joints_, t0) : collision::JointMixture{});
-    done_.push_back(r.accepted());
-  }
-
-  const PersonStream& person_;
-  intent_service::IntentEstimator estimator_;
-  std::vector<std::string> joints_;
-  std::vector<int> body_index_;
-  intent_service::SkeletonFrame frame_;
-  intent::MixturePrediction mixture_;
-  std::vector<collision::JointMixture> mixtures_;
-  std::vector<bool> done_;
-};
-
-// A baseline fed every observed skeleton in order; repeated requests for
-// the same frame get the same prediction.
-class BaselineSource {
- public:
-  BaselineSource(intent::BaselinePredictorParams params, const PersonStream& person)
-      : person_(person), predictor_(params, static_cast<int>(person.joint_names.size())) {}
-
-  const collision::JointMixture* At(int frame) {
-    while (last_ < frame) {
-      ++last_;
-      const Eigen::Matrix3Xd& seen = person_.observed[static_cast<std::size_t>(last_)];
-      const Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(seen.data(), seen.size());
-      predictor_.Update(person_.stamp(last_), p, &mixture_);
-      current_ = ToJointMixture(mixture_, person_.joint_names, SimTimeNs(person_.stamp(last_)));
-    }
-    return last_ == frame ? &current_ : nullptr;
-  }
-
- private:
-  const PersonStream& person_;
-  intent::BaselinePredictor predictor_;
-  intent::MixturePrediction mixture_;
-  collision::JointMixture current_;
-  int last_ = -1;
-};
-
-// The true future at the model's steps with the model's within-action
-// covariances.
-class OracleSource {
- public:
-  OracleSource(const PersonStream& person, ModelTrack* model, const intent::IntentModel& config)
-      : person_(person), model_(model), dt_(1.0 / config.config.rate), steps_(config.config.horizon) {}
-
-  const collision::JointMixture* At(int frame) {
-    if (frame == frame_) return &current_;
-    if (!model_->At(frame)) return nullptr;
-    frame_ = frame;
-    const std::size_t J = model_->joints().size();
-    current_ = collision::JointMixture{};
-    current_.t0_ns = SimTimeNs(person_.stamp(frame));
-    current_.time_step = dt_;
-    current_.num_steps = steps_;
-    current_.joint_names = model_->joints();
-    current_.actions = {"oracle"};
-    current_.probabilities = {1.0};
-    current_.means.assign(1, std::vector<Eigen::Vector3d>(static_cast<std::size_t>(steps_) * J));
-    current_.covariances.assign(1, std::vector<Eigen::Matrix3d>(static_cast<std::size_t>(steps_) * J));
-    for (int k = 0; k < steps_; ++k) {
-      person_.TrueAt(person_.stamp(frame) + (k + 1) * dt_, &p_WJ_);
-      for (std::size_t j = 0; j < J; ++j) {
-        const std::size_t o = static_cast<std::size_t>(k) * J + j;
-        current_.means[0][o] = p_WJ_.col(model_->body_index(j));
-        current_.covariances[0][o] = model_->WithinCovariance(frame, k, j);
-      }
-    }
-    return &current_;
-  }
-
- private:
-  const PersonStream& person_;
-  ModelTrack* model_;
-  double dt_;
-  int steps_;
-  int frame_ = -1;
-  collision::JointMixture current_;
-  Eigen::Matrix3Xd p_WJ_;
-};
 
 // A recorded person seated across the table: shoulders from above its far
 // edge (x = 1.05 m) to 0.2 m behind it, at the synthetic person's shoulder
@@ -451,29 +324,12 @@ std::vector<InteractionResult> RunScenario(const BenchmarkSetup& setup, const Sc
                                            const std::vector<Predictor>& predictors) {
   if (const std::string why = setup.Validate(); !why.empty()) throw std::invalid_argument(why);
   const intent::IntentModel& model = *setup.intent_model;
-  const std::vector<std::string>& body_joints = setup.models.body->params().joints;
   // Long enough for the longest run and the oracle's look-ahead past it.
   const double duration = setup.loop.task_start + setup.loop.max_duration + model.config.horizon / model.config.rate + 1.0;
   const PersonStream person = MakePersonStream(setup, spec, duration);
 
   ModelTrack track(setup, person);
-  const PredictionSource model_source = [&track](int f) { return track.At(f); };
-  // The true bound's covariances: the model's first step, in body order.
-  std::vector<Eigen::Matrix3d> covs(body_joints.size());
-  int covs_frame = -1;
-  const CovarianceSource true_covariance = [&](int f) -> const std::vector<Eigen::Matrix3d>* {
-    if (!track.At(f)) return nullptr;
-    if (f != covs_frame) {
-      const Eigen::Matrix3d fallback =
-          setup.loop.true_bound_std * setup.loop.true_bound_std * Eigen::Matrix3d::Identity();
-      std::fill(covs.begin(), covs.end(), fallback);
-      for (std::size_t j = 0; j < track.joints().size(); ++j) {
-        covs[static_cast<std::size_t>(track.body_index(j))] = track.WithinCovariance(f, 0, j);
-      }
-      covs_frame = f;
-    }
-    return &covs;
-  };
+  const TrueCovariances true_covariance(setup, &track);
 
   TaskSetup task;
   task.start_q = spec.start_q;
@@ -485,33 +341,9 @@ std::vector<InteractionResult> RunScenario(const BenchmarkSetup& setup, const Sc
 
   std::vector<InteractionResult> results;
   for (Predictor p : predictors) {
-    std::optional<BaselineSource> baseline;
-    std::optional<OracleSource> oracle;
-    PredictionSource planner_source;
-    switch (p) {
-      case Predictor::kNone:
-        break;
-      case Predictor::kConstantPosition:
-      case Predictor::kConstantVelocity: {
-        intent::BaselinePredictorParams bp =
-            p == Predictor::kConstantPosition ? setup.constant_position : setup.constant_velocity;
-        bp.rate = model.config.rate;
-        bp.horizon = model.config.horizon;
-        baseline.emplace(bp, person);
-        planner_source = [&baseline](int f) { return baseline->At(f); };
-        break;
-      }
-      case Predictor::kModel:
-        planner_source = model_source;
-        break;
-      case Predictor::kOracle:
-        oracle.emplace(person, &track, model);
-        planner_source = [&oracle](int f) { return oracle->At(f); };
-        break;
-    }
-    const bool own = setup.monitor_input == MonitorInput::kSame && p != Predictor::kNone;
-    const PredictionSource& monitor_source = own ? planner_source : model_source;
-    results.push_back(RunInteraction(setup.models, setup.loop, task, person, planner_source, monitor_source, true_covariance));
+    const PredictorSources sources(setup, person, &track, p);
+    results.push_back(RunInteraction(setup.models, setup.loop, task, person, sources.planner(), sources.monitor(),
+                                     true_covariance.source()));
   }
   return results;
 }

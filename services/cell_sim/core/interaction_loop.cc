@@ -109,17 +109,17 @@ namespace {
 // person's frame, then the monitor, then planning.
 class Interaction {
  public:
-  Interaction(const CellModels& models, const LoopParams& params, const TaskSetup& setup, const PersonStream& person,
-              const PredictionSource& planner_prediction, const PredictionSource& monitor_prediction,
-              const CovarianceSource& true_covariance)
+  Interaction(const CellModels& models, const LoopParams& params, const Eigen::VectorXd& start_q, const TaskFeed& feed,
+              const PersonStream& person, const PredictionSource& planner_prediction,
+              const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance)
       : params_(params),
-        setup_(setup),
+        feed_(feed),
         person_(person),
         planner_prediction_(planner_prediction),
         monitor_prediction_(monitor_prediction),
         true_covariance_(true_covariance),
         body_(*models.body),
-        robot_(models.planner->robot(), setup.start_q, models.simulator),
+        robot_(models.planner->robot(), start_q, models.simulator),
         replanner_(*models.planner, body_, models.replanner),
         monitor_(*models.monitor),
         supervisor_({}),
@@ -136,13 +136,17 @@ class Interaction {
     supervisor_.SetResumeDelay(params.resume_delay);
   }
 
-  InteractionResult Run() {
+  EpisodeResult Run() {
     while (true) {
       const int64_t t = std::min({next_control_, FrameTime(frame_), next_monitor_, next_plan_});
       if (t >= end_) {
         finish_ = end_;
-        result_.reason = "no outcome within " + std::to_string(params_.max_duration) + " s";
-        result_.task_time = params_.max_duration;
+        if (in_task_) {
+          result_.reason = "no outcome within " + std::to_string(params_.max_duration) + " s";
+          // What is left of the run's limit (all of it for the first task).
+          result_.task_time = params_.max_duration - (command_ - task_start_) * 1e-9;
+          CloseTask(end_);
+        }
         break;
       }
       if (t == next_control_) {
@@ -157,10 +161,8 @@ class Interaction {
         break;
       }
     }
-    if (in_task_ && robot_.stopped()) result_.stop_time += (finish_ - stop_since_) * 1e-9;
-    if (in_task_ && robot_.speed_scale() < 1.0) result_.slow_time += (finish_ - slow_since_) * 1e-9;
-    result_.true_contacts = robot_.contacts() - contacts_before_;
-    return result_;
+    episode_.duration = (finish_ - task_start_) * 1e-9;
+    return episode_;
   }
 
  private:
@@ -217,17 +219,23 @@ class Interaction {
     person_.TrueAt(t * 1e-9, &p_WJ_);
     const int contacts = robot_.contacts();
     const double separation = robot_.UpdateContacts(p_WJ_, body_);
+    const double speed = robot_.qd().cwiseAbs().maxCoeff();
     if (in_task_) result_.min_separation = std::min(result_.min_separation, separation);
-    // A new contact of the task's: was the robot moving into the person, or
-    // standing still while the person moved into it?
-    if (in_task_ && robot_.contacts() > contacts) {
-      const double speed = robot_.qd().cwiseAbs().maxCoeff();
-      result_.contact_speeds.push_back(speed);
-      if (speed > kMovingContactSpeed) {
-        ++result_.robot_moving_contacts;
-      } else {
-        ++result_.robot_at_rest_contacts;
+    if (started_) episode_.min_separation = std::min(episode_.min_separation, separation);
+    // A new contact: was the robot moving into the person, or standing
+    // still while the person moved into it?
+    if (robot_.contacts() > contacts) {
+      const bool moving = speed > kMovingContactSpeed;
+      if (in_task_) {
+        result_.contact_speeds.push_back(speed);
+        ++(moving ? result_.robot_moving_contacts : result_.robot_at_rest_contacts);
       }
+      if (started_) ++(moving ? episode_.robot_moving_contacts : episode_.robot_at_rest_contacts);
+    }
+    // The step that just ran: standing still with a task, not stopped and
+    // not arriving (at its goal or retreat).
+    if (in_task_ && control_step_ > 0 && !robot_.stopped() && speed <= kMovingContactSpeed && !Arriving()) {
+      result_.wait_time += control_period_ * 1e-9;
     }
     if (control_step_ % state_every_ == 0) {
       const std::vector<double> q = ToStd(robot_.q()), qd = ToStd(robot_.qd());
@@ -260,36 +268,38 @@ class Interaction {
     ++frame_;
   }
 
-  // A planning step (the task is commanded at its first); true when the
-  // task's outcome ends the run.
+  // A planning step (a task is commanded at it when the feed has one
+  // due); true when the run ends.
   bool Plan(int64_t t) {
     const int64_t stamp = kEpochNs + t;
     next_plan_ += plan_period_;
-    if (t == task_start_) {
-      replanner_.StartTask(setup_.task, stamp);
-      in_task_ = true;
-      slow_since_ = t;
-      contacts_before_ = robot_.contacts();
-      if (robot_.stopped()) {
-        ++result_.protective_stops;
-        stop_since_ = t;
-        result_.first_stop_reason = "stopped when the task was commanded";
+    if (!in_task_ && t >= task_start_ && t >= next_task_at_) {
+      std::optional<trajopt::TaskSpec> task = feed_.next(t * 1e-9, frame_ - 1);
+      if (!task) {
+        finish_ = t;
+        episode_.ended_by_feed = true;
+        return true;
       }
+      StartTask(std::move(*task), t);
     }
     const trajopt::CycleResult r = replanner_.Cycle(stamp);
     if (params_.trace) {
-      const Eigen::VectorXd& goal = setup_.task.goal.q;
+      const Eigen::VectorXd& goal = task_.goal.q;
       const double error = goal.size() == robot_.q().size() ? (robot_.q() - goal).cwiseAbs().maxCoeff() : -1.0;
       params_.trace(t * 1e-9, "plan: " + r.status + " (bound " + std::to_string(r.max_bound) + ", robot " +
                                   std::to_string(error) + " rad from the goal, " +
                                   std::to_string(robot_.qd().cwiseAbs().maxCoeff()) + " rad/s)");
     }
     if (r.planning_time > 0) {
-      result_.planning_times.push_back(r.planning_time);
-      ++result_.planning_cycles;
+      if (in_task_) {
+        result_.planning_times.push_back(r.planning_time);
+        ++result_.planning_cycles;
+      } else {
+        pending_times_.push_back(r.planning_time);
+      }
     }
     if (r.publish) Publish(r);
-    if (!(r.outcome && in_task_)) return false;
+    if (!(r.outcome && in_task_ && r.outcome->id == task_.id)) return false;
     result_.finished = true;
     result_.status = r.outcome->status;
     result_.reason = r.outcome->reason;
@@ -297,7 +307,55 @@ class Interaction {
     result_.planner_delay = r.outcome->delay;
     result_.waits = r.outcome->num_waits;
     finish_ = t;
-    return true;
+    CloseTask(t);
+    if (!(feed_.done && feed_.done(t * 1e-9, frame_ - 1, *r.outcome))) {
+      episode_.ended_by_feed = true;
+      return true;
+    }
+    next_task_at_ = t + Ns(feed_.pause);
+    return false;
+  }
+
+  void StartTask(trajopt::TaskSpec task, int64_t t) {
+    task_ = std::move(task);
+    replanner_.StartTask(task_, kEpochNs + t);
+    // The planning cycles since the previous task (or the start) count as
+    // this task's, as they always have for a single task.
+    result_ = InteractionResult{};
+    result_.planning_times = std::move(pending_times_);
+    result_.planning_cycles = static_cast<int>(result_.planning_times.size());
+    pending_times_.clear();
+    result_.command_time = t * 1e-9;
+    in_task_ = true;
+    started_ = true;
+    command_ = t;
+    slow_since_ = t;
+    contacts_before_ = robot_.contacts();
+    if (robot_.stopped()) {
+      ++result_.protective_stops;
+      stop_since_ = t;
+      result_.first_stop_reason = "stopped when the task was commanded";
+    }
+  }
+
+  // The robot is within kArrivingDistance of the running task's goal or
+  // retreat (every joint).
+  bool Arriving() const {
+    const Eigen::VectorXd& q = robot_.q();
+    for (const Eigen::VectorXd* target : {&task_.goal.q, &task_.retreat}) {
+      if (target->size() == q.size() && (q - *target).cwiseAbs().maxCoeff() <= kArrivingDistance) return true;
+    }
+    return false;
+  }
+
+  // The running task's figures are complete at `t`: its open intervals
+  // closed, its contacts counted.
+  void CloseTask(int64_t t) {
+    if (robot_.stopped()) result_.stop_time += (t - stop_since_) * 1e-9;
+    if (robot_.speed_scale() < 1.0) result_.slow_time += (t - slow_since_) * 1e-9;
+    result_.true_contacts = robot_.contacts() - contacts_before_;
+    episode_.tasks.push_back(result_);
+    in_task_ = false;
   }
 
   // A new trajectory: to the robot and to the monitor.
@@ -315,7 +373,7 @@ class Interaction {
   }
 
   const LoopParams& params_;
-  const TaskSetup& setup_;
+  const TaskFeed& feed_;
   const PersonStream& person_;
   const PredictionSource& planner_prediction_;
   const PredictionSource& monitor_prediction_;
@@ -335,10 +393,16 @@ class Interaction {
   int64_t next_control_ = 0, next_plan_ = 0, next_monitor_ = 0;
   int control_step_ = 0, frame_ = 0;
 
-  InteractionResult result_;
+  InteractionResult result_;  // the running (or last) task's
+  EpisodeResult episode_;
+  trajopt::TaskSpec task_;    // the running (or last) task
   bool in_task_ = false;
+  bool started_ = false;      // a task has been commanded
   int contacts_before_ = 0;  // contacts before the command (the robot at rest) are not the task's
+  int64_t command_ = 0;       // scenario time of the running task's command
+  int64_t next_task_at_ = 0;  // scenario time from which the next task may be commanded
   int64_t finish_ = 0;       // scenario time the run ended
+  std::vector<double> pending_times_;  // s, planning cycles while no task ran
   int64_t last_evaluation_ = INT64_MIN / 2, stop_since_ = 0, slow_since_ = 0;
   std::vector<Eigen::Vector3d> skeleton_;
   Eigen::Matrix3Xd p_WJ_;
@@ -346,16 +410,46 @@ class Interaction {
 
 }  // namespace
 
-InteractionResult RunInteraction(const CellModels& models, const LoopParams& params, const TaskSetup& setup,
-                                 const PersonStream& person, const PredictionSource& planner_prediction,
-                                 const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance) {
+namespace {
+
+void CheckRun(const CellModels& models, const LoopParams& params, const PersonStream& person) {
   if (!models.planner || !models.body || !models.monitor) throw std::invalid_argument("RunInteraction: a model is missing");
   if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument("RunInteraction: " + why);
   if (const std::string why = person.Validate(); !why.empty()) throw std::invalid_argument("RunInteraction: " + why);
   if (person.joint_names != models.body->params().joints) {
     throw std::invalid_argument("RunInteraction: the person's joints are not the body model's, in its order");
   }
-  return Interaction(models, params, setup, person, planner_prediction, monitor_prediction, true_covariance).Run();
+}
+
+}  // namespace
+
+EpisodeResult RunEpisode(const CellModels& models, const LoopParams& params, const Eigen::VectorXd& start_q,
+                         const TaskFeed& feed, const PersonStream& person, const PredictionSource& planner_prediction,
+                         const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance) {
+  CheckRun(models, params, person);
+  if (!feed.next) throw std::invalid_argument("RunEpisode: the task feed has no next()");
+  if (!(feed.pause >= 0)) throw std::invalid_argument("RunEpisode: the pause between tasks must be >= 0");
+  return Interaction(models, params, start_q, feed, person, planner_prediction, monitor_prediction, true_covariance).Run();
+}
+
+InteractionResult RunInteraction(const CellModels& models, const LoopParams& params, const TaskSetup& setup,
+                                 const PersonStream& person, const PredictionSource& planner_prediction,
+                                 const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance) {
+  CheckRun(models, params, person);
+  // One task: commanded at the first planning step from task_start on; its
+  // outcome (or the limit) ends the run.
+  bool given = false;
+  TaskFeed feed;
+  feed.next = [&](double, int) -> std::optional<trajopt::TaskSpec> {
+    if (given) return std::nullopt;
+    given = true;
+    return setup.task;
+  };
+  EpisodeResult episode =
+      Interaction(models, params, setup.start_q, feed, person, planner_prediction, monitor_prediction, true_covariance)
+          .Run();
+  if (episode.tasks.empty()) throw std::runtime_error("RunInteraction: the task was never commanded");
+  return std::move(episode.tasks.front());
 }
 
 }  // namespace iplan::cell_sim

@@ -1,6 +1,8 @@
-// The robot cell in one process and in simulated time: one robot task while
-// a person moves nearby, closed through the same algorithm cores the
-// services run (no DDS):
+// The robot cell in one process and in simulated time: one robot task
+// (RunInteraction), or the tasks of a whole episode one after another
+// (RunEpisode, the next chosen when the previous ends: TaskFeed), while a
+// person moves nearby, closed through the same algorithm cores the services
+// run (no DDS):
 //
 //   skeletons (sensor rate, observed = true + noise)
 //     -> predictions (per skeleton: one source for the planner, one for the
@@ -28,6 +30,7 @@
 
 #include <cstdint>
 #include <functional>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -86,8 +89,8 @@ struct LoopParams {
   double joint_state_rate_hz = 50;  ///< Hz, robot states to the planner and the monitor (robot_sim publish_rate_hz)
   double monitor_rate_hz = 15;      ///< Hz, monitor evaluations between predictions (collision_risk rate_hz)
   double resume_delay = 0.5;        ///< s every stop cause stays clear before the robot resumes (supervisor resume_delay)
-  double task_start = 1.0;          ///< s: the task command, at the first planning cycle from then on
-  double max_duration = 30;         ///< s after the command: the run ends even without an outcome
+  double task_start = 1.0;          ///< s: the (first) task command, at the first planning cycle from then on
+  double max_duration = 30;         ///< s after the (first) command: the run ends even without an outcome
   double true_bound_std = 0.05;     ///< m, per coordinate, when the CovarianceSource gives none
   /// Optional: told every planning cycle's status and every stop / resume
   /// with its reason (t in s of scenario time), to see why a run went as it
@@ -108,6 +111,10 @@ struct TaskSetup {
 /// with the robot at rest (InteractionResult::robot_moving_contacts).
 constexpr double kMovingContactSpeed = 0.01;
 
+/// rad: a robot this near its goal or retreat (every joint) is arriving,
+/// not waiting (InteractionResult::wait_time), however slowly it settles.
+constexpr double kArrivingDistance = 0.05;
+
 /// Figures of one run, from the task command to its outcome (or the end).
 struct InteractionResult {
   bool finished = false;       ///< the replanner reported an outcome
@@ -120,6 +127,12 @@ struct InteractionResult {
   int stops_separation = 0;    ///< of which the ISO/TS 15066 separation layer started
   int stops_bound = 0;         ///< of which the collision bound along the executing trajectory started
   double stop_time = 0;        ///< s the robot spent stopped
+  /// s the robot stood still (no joint faster than kMovingContactSpeed)
+  /// while not stopped and not arriving (farther than kArrivingDistance
+  /// from the goal and the retreat), at the control rate: waiting for a
+  /// safe plan or holding off for the person.
+  double wait_time = 0;
+  double command_time = 0;     ///< s, scenario time of the task's command
   int slow_downs = 0;          ///< times the monitor slowed the robot (speed reduction) from full speed
   double slow_time = 0;        ///< s the robot ran slowed down (its path time-scaled below 1)
   double min_separation = 1e6; ///< m, smallest true robot-human surface distance (control rate)
@@ -141,6 +154,46 @@ struct InteractionResult {
   int planning_cycles = 0;
   std::vector<double> planning_times;  ///< s per cycle, wall time (not deterministic)
 };
+
+/// The tasks of a run, one after another (e.g. the task planner's episode).
+struct TaskFeed {
+  /// The next task, asked at a planning step when no task runs: the first
+  /// from LoopParams::task_start on, then the first at least `pause` s after
+  /// the previous outcome. `t`: scenario time (s); `frame`: the newest
+  /// skeleton frame delivered (-1: none yet). nullopt: the run ends there.
+  std::function<std::optional<trajopt::TaskSpec>(double t, int frame)> next;
+  /// Told every outcome of a commanded task (`t`: scenario time of the
+  /// planning step that reported it, s; `frame` as for next); returns
+  /// whether another task follows (false, or no function: the run ends
+  /// there).
+  std::function<bool(double t, int frame, const trajopt::TaskOutcome& outcome)> done;
+  double pause = 0;  ///< s from an outcome to the next task's command at the earliest (>= 0)
+};
+
+/// Figures of a run of tasks: each task's, and those of the whole run from
+/// the first command to its end, between the tasks too.
+struct EpisodeResult {
+  /// One per commanded task, in order; when the run hit its limit the last
+  /// one is unfinished (InteractionResult::finished false).
+  std::vector<InteractionResult> tasks;
+  bool ended_by_feed = false;  ///< the feed ended the run (else LoopParams::max_duration did)
+  double duration = 0;         ///< s from the first command to the end of the run
+  /// Contacts from the first command on, between tasks too (the robot then
+  /// stands still, so those are robot_at_rest_contacts).
+  int robot_moving_contacts = 0;
+  int robot_at_rest_contacts = 0;
+  double min_separation = 1e6;  ///< m, smallest true robot-human surface distance from the first command on
+};
+
+/// Runs the tasks `feed` gives, the robot starting at rest at `start_q`
+/// (rad, model order), against one person; the cores (replanner, monitor,
+/// robot) keep their state from one task to the next, as in the cell.
+/// Predictions, covariances and throws as RunInteraction, and
+/// std::invalid_argument without feed.next or with a negative pause.
+/// Allocates.
+EpisodeResult RunEpisode(const CellModels& models, const LoopParams& params, const Eigen::VectorXd& start_q,
+                         const TaskFeed& feed, const PersonStream& person, const PredictionSource& planner_prediction,
+                         const PredictionSource& monitor_prediction, const CovarianceSource& true_covariance);
 
 /// Runs one task against one person. `planner_prediction` feeds the
 /// replanner, `monitor_prediction` the monitor (either may return null: no

@@ -3,8 +3,12 @@
 // away changes nothing; a person standing in the path is protected by the
 // monitor alone when the planner knows nothing; the run is deterministic;
 // a contact is told apart by what the robot was doing when it began (moving
-// into the person, or standing still while the person moved into it).
+// into the person, or standing still while the person moved into it); an
+// episode runs the tasks its feed gives one after another, the cores
+// keeping their state between them.
 #include "core/interaction_loop.h"
+
+#include <cmath>
 
 #include <gtest/gtest.h>
 
@@ -238,6 +242,73 @@ TEST_F(InteractionLoopTest, AHandMovingIntoTheRobotAtRestCountsAsAtRest) {
   EXPECT_EQ(r.robot_moving_contacts, 0);
   ASSERT_EQ(r.contact_speeds.size(), 1u);
   EXPECT_LE(r.contact_speeds.front(), kMovingContactSpeed);
+}
+
+TEST_F(InteractionLoopTest, AnEpisodeRunsItsTasksInTurnFromWhereTheLastEnded) {
+  // Home -> hand_over -> home, chosen when asked; the person far away.
+  const PersonStream person = StandingPerson({2.5, 0.0, 0.25}, 0.3);
+  params_.max_duration = 10;
+  std::vector<std::pair<double, int>> asked;  // (t, frame)
+  std::vector<double> ended;
+  TaskFeed feed;
+  feed.pause = 0.5;
+  feed.next = [&](double t, int frame) -> std::optional<trajopt::TaskSpec> {
+    asked.emplace_back(t, frame);
+    trajopt::TaskSpec s = HandOver().task;
+    s.id = static_cast<uint32_t>(asked.size());
+    if (asked.size() == 2) s.goal = planning::Goal::Joint(kHome);
+    return s;
+  };
+  feed.done = [&](double t, int, const trajopt::TaskOutcome& o) {
+    EXPECT_EQ(o.id, ended.size() + 1);
+    ended.push_back(t);
+    return ended.size() < 2;
+  };
+  const EpisodeResult e = RunEpisode(models_, params_, kHome, feed, person, Holding(person), Holding(person), nullptr);
+  ASSERT_EQ(e.tasks.size(), 2u);
+  ASSERT_EQ(asked.size(), 2u);
+  ASSERT_EQ(ended.size(), 2u);
+  EXPECT_TRUE(e.ended_by_feed);
+  EXPECT_NEAR(asked[0].first, params_.task_start, 1e-9);
+  // The newest frame at 30 Hz when asked.
+  EXPECT_EQ(asked[0].second, static_cast<int>(std::floor(asked[0].first * 30 + 1e-6)));
+  // The second task: at the first planning step at least the pause after the first outcome.
+  EXPECT_GE(asked[1].first, ended[0] + feed.pause - 1e-9);
+  EXPECT_LT(asked[1].first, ended[0] + feed.pause + 0.1 + 1e-9);
+  for (const InteractionResult& r : e.tasks) {
+    EXPECT_TRUE(r.finished) << r.reason;
+    EXPECT_EQ(r.status, trajopt::TaskStatus::kSucceeded) << r.reason;
+    EXPECT_EQ(r.protective_stops, 0);
+    EXPECT_LT(r.wait_time, 0.5) << "standing still with nobody near";
+  }
+  EXPECT_NEAR(e.tasks[1].command_time, asked[1].first, 1e-9);
+  EXPECT_NEAR(e.duration, ended[1] - asked[0].first, 1e-9);
+  EXPECT_EQ(e.robot_moving_contacts + e.robot_at_rest_contacts, 0);
+  EXPECT_GT(e.min_separation, 0.8);
+
+  // With one task, RunInteraction is that episode's first task.
+  const InteractionResult one = RunInteraction(models_, params_, HandOver(), person, Holding(person), Holding(person), nullptr);
+  EXPECT_EQ(one.task_time, e.tasks[0].task_time);
+  EXPECT_EQ(one.planning_cycles, e.tasks[0].planning_cycles);
+  EXPECT_EQ(one.min_separation, e.tasks[0].min_separation);
+}
+
+TEST_F(InteractionLoopTest, AnEpisodeThatOutrunsItsLimitEndsWithTheTaskUnfinished) {
+  // The hand rests where the hand-over goes; the monitor keeps stopping the robot.
+  const PersonStream person = StandingPerson({1.0, -0.1, 0.25}, 0.3);
+  params_.max_duration = 3;
+  TaskFeed feed;
+  feed.next = [&](double, int) -> std::optional<trajopt::TaskSpec> { return HandOver().task; };
+  feed.done = [](double, int, const trajopt::TaskOutcome&) { return true; };
+  const EpisodeResult e = RunEpisode(models_, params_, kHome, feed, person, nullptr, Holding(person), nullptr);
+  ASSERT_EQ(e.tasks.size(), 1u);
+  EXPECT_FALSE(e.ended_by_feed);
+  EXPECT_FALSE(e.tasks[0].finished);
+  EXPECT_NEAR(e.duration, 3.0, 1e-9);
+  EXPECT_EQ(e.tasks[0].task_time, 3.0);
+  EXPECT_GT(e.tasks[0].stop_time + e.tasks[0].wait_time, 1.0);
+  feed.pause = -1;
+  EXPECT_THROW(RunEpisode(models_, params_, kHome, feed, person, nullptr, nullptr, nullptr), std::invalid_argument);
 }
 
 TEST_F(InteractionLoopTest, PersonStreamInterpolatesAndIsChecked) {

@@ -16,8 +16,11 @@ namespace iplan::supervisor {
 namespace {
 
 // Version 2 adds the number of learning episodes after the row count;
-// version 1 tables (without it) still load, as 0 episodes.
-constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
+// version 3 then the learned task durations (per task: outcomes observed,
+// their mean in s). Tables of versions 1 and 2 still load (0 episodes, no
+// durations).
+constexpr char kMagic[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '3'};
+constexpr char kMagicV2[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '2'};
 constexpr char kMagicV1[8] = {'I', 'P', 'L', 'Q', 'T', 'B', 'L', '1'};
 
 template <class T>
@@ -78,6 +81,7 @@ std::string TaskGraph::Validate() const {
   }
   if (!rest.empty() && std::none_of(tasks.begin(), tasks.end(), [&](const RobotTask& t) { return t.name == rest; }))
     return "rest names unknown task '" + rest + "'";
+  if (const std::string why = human_graph.Validate(human_actions); !why.empty()) return why;
   // Cycles: repeatedly finish tasks whose predecessors are finished.
   std::vector<bool> done(tasks.size(), false);
   for (std::size_t round = 0; round < tasks.size(); ++round) {
@@ -109,6 +113,9 @@ std::string QLearningParams::Validate() const {
   if (!(epsilon_decay > 0 && epsilon_decay <= 1)) return "epsilon_decay must be in (0, 1]";
   if (!(epsilon_min >= 0 && epsilon_min <= 1)) return "epsilon_min must be in [0, 1]";
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
+  if (!(anticipation_weight >= 0) || !std::isfinite(anticipation_weight)) return "anticipation_weight must be >= 0";
+  if (!(task_duration_prior > 0) || !std::isfinite(task_duration_prior)) return "task_duration_prior must be > 0";
+  if (anticipation_depth < 1 || anticipation_depth > 8) return "anticipation_depth must be in [1, 8]";
   return "";
 }
 
@@ -125,15 +132,18 @@ TaskPlanner::TaskPlanner(TaskGraph graph, QLearningParams params)
     }
     prerequisites_.push_back(mask);
   }
+  durations_.assign(graph_.tasks.size(), {0, 0.0});
 }
 
 bool TaskPlanner::episode_done() const { return state_ == (1ULL << graph_.tasks.size()) - 1; }
 
-std::vector<int> TaskPlanner::Available() const {
+std::vector<int> TaskPlanner::Available() const { return AvailableIn(state_); }
+
+std::vector<int> TaskPlanner::AvailableIn(State state) const {
   std::vector<int> out;
   for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
     const uint64_t bit = 1ULL << i;
-    if (!(state_ & bit) && (state_ & prerequisites_[i]) == prerequisites_[i]) out.push_back(static_cast<int>(i));
+    if (!(state & bit) && (state & prerequisites_[i]) == prerequisites_[i]) out.push_back(static_cast<int>(i));
   }
   return out;
 }
@@ -164,16 +174,105 @@ double TaskPlanner::Epsilon() const {
   return std::min(params_.epsilon, std::max(params_.epsilon_min, decayed));
 }
 
-int TaskPlanner::Choose(const std::map<std::string, double>& belief) {
+double TaskPlanner::TaskDuration(int task) const {
+  const auto& [count, mean] = durations_[static_cast<std::size_t>(task)];
+  return count > 0 ? mean : params_.task_duration_prior;
+}
+
+void TaskPlanner::ObserveDuration(int task, double seconds) {
+  if (!(seconds > 0) || !std::isfinite(seconds)) return;
+  auto& [count, mean] = durations_[static_cast<std::size_t>(task)];
+  ++count;
+  mean += (seconds - mean) / static_cast<double>(count);
+}
+
+double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast, double from) const {
+  const RobotTask& t = graph_.tasks[static_cast<std::size_t>(task)];
+  std::vector<double> conflict(forecast.actions.size(), 0.0);
+  for (std::size_t c = 0; c < forecast.actions.size(); ++c) {
+    if (std::find(t.conflicts_with.begin(), t.conflicts_with.end(), forecast.actions[c]) != t.conflicts_with.end()) {
+      conflict[c] = 1.0;
+    }
+  }
+  const double to = from + TaskDuration(task);
+  double seconds = 0;
+  // Step k covers [k dt, (k + 1) dt); the part of it inside [from, to).
+  for (std::size_t k = static_cast<std::size_t>(std::max(0.0, std::floor(from / forecast.dt))); k < forecast.p.size(); ++k) {
+    const double begin = std::max(from, static_cast<double>(k) * forecast.dt);
+    const double end = std::min(to, static_cast<double>(k + 1) * forecast.dt);
+    if (end <= begin) {
+      if (begin >= to) break;
+      continue;
+    }
+    double p = 0;
+    for (std::size_t c = 0; c < conflict.size(); ++c) p += forecast.p[k][c] * conflict[c];
+    seconds += (end - begin) * std::clamp(p, 0.0, 1.0);
+  }
+  return seconds;
+}
+
+double TaskPlanner::BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const {
+  if (depth <= 0) return 0.0;
+  double best = 0;
+  bool any = false;
+  for (int b : AvailableIn(state)) {
+    const double c = ExpectedConflict(b, forecast, from) +
+                     BestContinuation(state | (1ULL << b), forecast, from + TaskDuration(b), depth - 1);
+    best = any ? std::min(best, c) : c;
+    any = true;
+  }
+  return best;
+}
+
+ActionForecast TaskPlanner::SequenceForecast(State state, const ActionOutlook& outlook) const {
+  // Long enough for the anticipation_depth longest tasks left.
+  std::vector<double> left;
+  for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
+    if (!(state & (1ULL << i))) left.push_back(TaskDuration(static_cast<int>(i)));
+  }
+  std::sort(left.rbegin(), left.rend());
+  double horizon = 0;
+  for (std::size_t i = 0; i < left.size() && i < static_cast<std::size_t>(params_.anticipation_depth); ++i) horizon += left[i];
+  return ForecastActions(graph_.human_graph, outlook, kForecastStep, static_cast<int>(std::ceil(horizon / kForecastStep)));
+}
+
+double TaskPlanner::ExpectedConflict(int task, const ActionOutlook& outlook) const {
+  if (outlook.belief.empty()) return 0.0;
+  const int steps = static_cast<int>(std::ceil(TaskDuration(task) / kForecastStep));
+  return ExpectedConflict(task, ForecastActions(graph_.human_graph, outlook, kForecastStep, steps), 0.0);
+}
+
+double TaskPlanner::AnticipatedConflict(int task, const ActionOutlook& outlook) const {
+  if (outlook.belief.empty()) return 0.0;
+  const ActionForecast forecast = SequenceForecast(state_, outlook);
+  return ExpectedConflict(task, forecast, 0.0) + BestContinuation(state_ | (1ULL << task), forecast, TaskDuration(task),
+                                                                   params_.anticipation_depth - 1);
+}
+
+int TaskPlanner::Choose(const ActionOutlook& outlook) {
   const std::vector<int> avail = Available();
   if (avail.empty()) return -1;
   if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < Epsilon()) {
     return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
   }
+  // The anticipation: one forecast, as long as the longest sequence.
+  std::vector<double> cost(graph_.tasks.size(), 0.0);
+  if (params_.anticipation_weight > 0 && !outlook.belief.empty()) {
+    const ActionForecast forecast = SequenceForecast(state_, outlook);
+    for (int a : avail) {
+      const double seconds = ExpectedConflict(a, forecast, 0.0) +
+                             BestContinuation(state_ | (1ULL << a), forecast, TaskDuration(a), params_.anticipation_depth - 1);
+      cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * seconds;
+    }
+  }
+  auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };
   int best = avail.front();
   for (int a : avail) {
-    const double qa = Q(state_, a), qb = Q(state_, best);
-    if (qa > qb + 1e-12 || (std::abs(qa - qb) <= 1e-12 && Harmony(a, belief) > Harmony(best, belief))) best = a;
+    const double qa = score(a), qb = score(best);
+    if (qa > qb + 1e-12 ||
+        (std::abs(qa - qb) <= 1e-12 && Harmony(a, outlook.belief) > Harmony(best, outlook.belief))) {
+      best = a;
+    }
   }
   return best;
 }
@@ -240,6 +339,10 @@ void TaskPlanner::Write(const std::string& path) const {
   Put(&body, static_cast<uint64_t>(graph_.tasks.size()));
   Put(&body, static_cast<uint64_t>(q_.size()));
   Put(&body, episodes_learned_);
+  for (const auto& [count, mean] : durations_) {
+    Put(&body, count);
+    Put(&body, mean);
+  }
   for (const auto& [s, row] : q_) {
     Put(&body, s);
     for (double v : row) Put(&body, v);
@@ -250,9 +353,8 @@ void TaskPlanner::Write(const std::string& path) const {
   // rotating blindly would copy the corrupt bytes over the one good copy.
   if (std::ifstream(path).good()) {
     const std::string previous = core::ReadFile(path);
-    std::map<State, std::vector<double>> unused_q;
-    uint64_t unused_episodes = 0;
-    if (!Parse(previous, path, &unused_q, &unused_episodes)) core::WriteFileAtomically(path + ".bak", previous);
+    Table unused;
+    if (!Parse(previous, path, &unused)) core::WriteFileAtomically(path + ".bak", previous);
   }
   core::WriteChecksummedFileAtomically(path, std::string_view(kMagic, sizeof(kMagic)), body,
                                       core::ChecksumAt::kBeforePayload);
@@ -265,33 +367,44 @@ std::optional<std::string> TaskPlanner::TryLoad(const std::string& path) {
   } catch (const std::exception& e) {
     return std::string(e.what());
   }
-  std::map<State, std::vector<double>> q;
-  uint64_t episodes = 0;
-  if (auto error = Parse(data, path, &q, &episodes)) return error;
-  q_ = std::move(q);
-  episodes_learned_ = episodes;
+  Table table;
+  if (auto error = Parse(data, path, &table)) return error;
+  q_ = std::move(table.q);
+  episodes_learned_ = table.episodes;
+  durations_.assign(graph_.tasks.size(), {0, 0.0});
+  if (!table.durations.empty()) durations_ = std::move(table.durations);
   return std::nullopt;
 }
 
-std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path,
-                                              std::map<State, std::vector<double>>* q_out,
-                                              uint64_t* episodes_out) const {
+std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std::string& path, Table* out) const {
   if (data.size() < sizeof(kMagic) + 8) return path + " is not an iplan Q-table";
-  const bool v1 = std::memcmp(data.data(), kMagicV1, sizeof(kMagicV1)) == 0;
-  if (!v1 && std::memcmp(data.data(), kMagic, sizeof(kMagic)) != 0) return path + " is not an iplan Q-table";
+  int version = 0;
+  for (const auto& [magic, v] : {std::pair{kMagicV1, 1}, std::pair{kMagicV2, 2}, std::pair{kMagic, 3}}) {
+    if (std::memcmp(data.data(), magic, sizeof(kMagic)) == 0) version = v;
+  }
+  if (version == 0) return path + " is not an iplan Q-table";
   std::size_t pos = sizeof(kMagic);
   uint64_t hash = 0, ntasks = 0, nrows = 0;
   if (!core::OpenChecksummed(data, sizeof(kMagic), core::ChecksumAt::kBeforePayload)) {
     return path + " is corrupt (checksum mismatch)";
   }
   pos += sizeof(uint64_t);  // the checksum
-  uint64_t episodes = 0;
+  Table table;
   if (!Get(data, &pos, &hash) || !Get(data, &pos, &ntasks) || !Get(data, &pos, &nrows) ||
-      (!v1 && !Get(data, &pos, &episodes))) {
+      (version >= 2 && !Get(data, &pos, &table.episodes))) {
     return path + " is truncated";
   }
   if (hash != GraphHash() || ntasks != graph_.tasks.size()) return path + " belongs to another task graph";
-  std::map<State, std::vector<double>> q;
+  if (version >= 3) {
+    table.durations.resize(ntasks);
+    for (std::size_t i = 0; i < ntasks; ++i) {
+      auto& [count, mean] = table.durations[i];
+      if (!Get(data, &pos, &count) || !Get(data, &pos, &mean)) return path + " is truncated";
+      if (!std::isfinite(mean) || mean < 0) {
+        return path + " has an impossible duration of task '" + graph_.tasks[i].name + "'";
+      }
+    }
+  }
   for (uint64_t r = 0; r < nrows; ++r) {
     State s = 0;
     std::vector<double> row(ntasks);
@@ -308,11 +421,10 @@ std::optional<std::string> TaskPlanner::Parse(const std::string& data, const std
         return why.str();
       }
     }
-    q[s] = std::move(row);
+    table.q[s] = std::move(row);
   }
   if (pos != data.size()) return path + " has trailing bytes";
-  *q_out = std::move(q);
-  *episodes_out = episodes;
+  *out = std::move(table);
   return std::nullopt;
 }
 

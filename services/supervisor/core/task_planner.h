@@ -4,6 +4,13 @@
 // Q-learning. The reward prefers tasks that do not conflict with what the
 // person is predicted to do and penalises the delay a task caused:
 //   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
+// Our extension, the anticipating choice: the next task maximises
+//   Q(s, a) - w_c * E[conflict of a over its own duration, and of the best
+//                    continuation of up to anticipation_depth - 1 tasks],
+// the expected seconds during which the person, forecast from the belief
+// and the person's own task graph (core/human_graph.h), does an action the
+// tasks conflict with while they run; task durations are learned from
+// outcomes. w_c = 0 is METHOD 6's choice.
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
 // with a message and the previous good copy is used. The backup is only
 // ever replaced by a file that passes the loader's checks, so it stays good
@@ -18,6 +25,7 @@
 #include <string>
 #include <vector>
 
+#include "core/human_graph.h"
 #include "iplan/core/name_value.h"
 
 namespace iplan::supervisor {
@@ -74,6 +82,8 @@ struct TaskGraph {
   /// The task whose goal is where the robot rests between episodes (and
   /// starts from); empty: not said.
   std::string rest;
+  /// The person's own task graph over human_actions (empty: not given).
+  HumanGraph human_graph;
 
   /// The file's keys: human_actions, robot_tasks (the list of tasks), rest.
   template <class Archive>
@@ -81,9 +91,11 @@ struct TaskGraph {
     a->Visit(IPLAN_NVP(human_actions, "the human actions the belief is over"));
     a->Visit(core::MakeNameValue("robot_tasks", &tasks, "the robot's tasks, at most 63", true));
     a->Visit(IPLAN_NVP(rest, "the task whose goal the robot rests at between episodes and starts from"));
+    a->Visit(IPLAN_NVP(human_graph, "the person's own task graph: durations and successors of the human actions"));
   }
   /// Empty when consistent (unique names, a goal or goal_pose each, known
-  /// predecessors, actions and rest task, no cycles), else the reason.
+  /// predecessors, actions and rest task, no cycles, a consistent
+  /// human_graph), else the reason.
   std::string Validate() const;
 };
 
@@ -102,6 +114,16 @@ struct QLearningParams {
   double epsilon_decay = 1.0;
   double epsilon_min = 0.0;   ///< floor of the decayed epsilon
   double delay_weight = 1.0;  ///< w_d, per second of delay
+  /// w_c, per second of expected conflict of a task over its duration (our
+  /// extension, the anticipating choice); 0: METHOD 6's choice (Q alone).
+  double anticipation_weight = 0.0;
+  /// Tasks in the sequence the anticipation looks at: the candidate and the
+  /// best continuation of up to depth - 1 tasks after it (1: the candidate
+  /// alone).
+  int anticipation_depth = 1;
+  /// s a task is expected to take before it has been done once (then: the
+  /// mean of its outcomes' durations less their delays).
+  double task_duration_prior = 3.0;
   bool learning = true;       ///< false: deployment, greedy, no updates
   uint64_t seed = 1;
   /// The YAML keys (section supervisor); `learning` comes from the service's
@@ -114,6 +136,11 @@ struct QLearningParams {
     a->Visit(IPLAN_NVP(epsilon_decay, "factor on epsilon per finished learning episode, in (0, 1]"));
     a->Visit(IPLAN_NVP(epsilon_min, "floor of the decayed epsilon, in [0, 1]"));
     a->Visit(IPLAN_NVP(delay_weight, "w_d, per second of delay, >= 0"));
+    a->Visit(IPLAN_NVP(anticipation_weight,
+                       "w_c, per second a task is expected to conflict with the person over its duration, >= 0; 0: off"));
+    a->Visit(IPLAN_NVP(anticipation_depth,
+                       "tasks looked at by the anticipation: the candidate and the best continuation, in [1, 8]"));
+    a->Visit(IPLAN_NVP(task_duration_prior, "s a task is expected to take before it was done once, > 0"));
     a->Visit(IPLAN_NVP(seed, "seed of the exploration generator"));
   }
   std::string Validate() const;
@@ -140,10 +167,33 @@ class TaskPlanner {
   /// epsilon_decay^episodes_learned()) while learning (never above epsilon),
   /// 0 in deployment.
   double Epsilon() const;
-  /// Chooses the next task: epsilon-greedy on Q in learning mode, greedy in
-  /// deployment; ties broken by the harmony with the current belief, then by
-  /// index. -1 when the episode is done.
-  int Choose(const std::map<std::string, double>& belief);
+  /// Chooses the next task: epsilon-greedy in learning mode, greedy in
+  /// deployment, on Q(s, a) - anticipation_weight * AnticipatedConflict(a,
+  /// outlook) (Q alone when the weight is 0 or the belief empty); ties
+  /// broken by the harmony with the belief, then by index. -1 when the
+  /// episode is done. Allocates (the forecast).
+  int Choose(const ActionOutlook& outlook);
+  /// s of expected conflict of the sequence that starts with `task` (one
+  /// available now) and continues with the continuation of up to
+  /// anticipation_depth - 1 available tasks that has the least, each task
+  /// taking TaskDuration from the end of the one before (the pause between
+  /// tasks is not counted). With depth 1 this is ExpectedConflict.
+  double AnticipatedConflict(int task, const ActionOutlook& outlook) const;
+  /// s of `task`'s expected duration (TaskDuration) during which the person
+  /// is expected to do an action the task conflicts with:
+  /// sum over forecast steps of dt * sum_c p_k(c) conflict(task, c), the
+  /// forecast from `outlook` and the graph's human_graph
+  /// (ForecastActions, steps of kForecastStep). 0 with an empty belief.
+  double ExpectedConflict(int task, const ActionOutlook& outlook) const;
+  /// s per step of the forecast behind ExpectedConflict.
+  static constexpr double kForecastStep = 0.1;
+  /// s `task` is expected to take: the mean of the durations observed by
+  /// ObserveDuration, else task_duration_prior.
+  double TaskDuration(int task) const;
+  /// Learns that `task` took `seconds` without its delay (an outcome's
+  /// duration less its delay); ignored unless finite and > 0. Saved with the
+  /// Q-table.
+  void ObserveDuration(int task, double seconds);
   /// The largest delay (s) one task is charged: a finite but absurd delay
   /// from the network (1.7e308) would otherwise overflow the Q-values.
   static constexpr double kMaxDelay = 3600.0;
@@ -190,8 +240,19 @@ class TaskPlanner {
   /// Checks the bytes of a table file named `path` (for messages); empty
   /// and fills the outputs when it is a good table of this graph, else the
   /// reason. Does not touch the planner.
-  std::optional<std::string> Parse(const std::string& data, const std::string& path,
-                                   std::map<State, std::vector<double>>* q, uint64_t* episodes) const;
+  struct Table {
+    std::map<State, std::vector<double>> q;
+    uint64_t episodes = 0;
+    std::vector<std::pair<uint64_t, double>> durations;  // empty: the file has none (format 1, 2)
+  };
+  std::optional<std::string> Parse(const std::string& data, const std::string& path, Table* table) const;
+  // s of conflict of `task` over [from, from + TaskDuration(task)).
+  double ExpectedConflict(int task, const ActionForecast& forecast, double from) const;
+  // The least conflict of up to `depth` tasks available in `state`, from `from` (s).
+  double BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const;
+  // The forecast long enough for the sequences from `state` (anticipation_depth tasks).
+  ActionForecast SequenceForecast(State state, const ActionOutlook& outlook) const;
+  std::vector<int> AvailableIn(State state) const;
   uint64_t GraphHash() const;
 
   TaskGraph graph_;
@@ -203,6 +264,7 @@ class TaskPlanner {
   uint64_t save_failures_ = 0;
   std::string last_save_error_;
   std::vector<uint64_t> prerequisites_;  // bitmask per task
+  std::vector<std::pair<uint64_t, double>> durations_;  // per task: outcomes observed, their mean (s)
   std::mt19937_64 rng_;
 };
 

@@ -199,30 +199,43 @@ TEST(TaskPlanner, ExplorationDecaysPerLearnedEpisodeAndTheCountIsSaved) {
   std::filesystem::remove(path + ".bak");
 }
 
-TEST(TaskPlanner, TableOfTheFirstFormatStillLoads) {
-  // Version 1 had no episode count: magic "IPLQTBL1", FNV-1a 64 checksum of
-  // the body, then graph hash, task count, row count and the rows. Made from
-  // a version 2 file by dropping the count and re-summing.
+TEST(TaskPlanner, TablesOfEarlierFormatsStillLoad) {
+  // Version 3: magic "IPLQTBL3", FNV-1a 64 checksum of the body, then graph
+  // hash, task count, row count, episode count, per task the durations
+  // observed and their mean, and the rows. Version 2 had no durations,
+  // version 1 no episode count either. Made from a version 3 file by
+  // dropping those and re-summing.
   const std::string path = TempPath("v1.bin");
   TaskPlanner p(Graph(), QLearningParams{});
   p.Complete(1, true, 0.5, {});
+  p.ObserveDuration(1, 2.5);
   PlayEpisode(&p);
   p.Save(path);
-  std::string v2;
+  std::string v3;
   {
     std::ifstream in(path, std::ios::binary);
-    v2.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    v3.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  ASSERT_EQ(v2.substr(0, 8), "IPLQTBL2");
-  std::string body = v2.substr(16, 24) + v2.substr(48);  // without the episode count at 40..47
-  const uint64_t sum = core::Fnv1a64(body, core::kIplanFnvSeed);
-  std::string v1 = "IPLQTBL1";
-  v1.append(reinterpret_cast<const char*>(&sum), 8);
-  v1 += body;
-  std::ofstream(path, std::ios::binary | std::ios::trunc) << v1;
-  std::filesystem::remove(path + ".bak");
-  TaskPlanner q(Graph(), QLearningParams{});
+  ASSERT_EQ(v3.substr(0, 8), "IPLQTBL3");
+  const std::size_t durations = 3 * 16;  // 3 tasks x (count, mean)
+  auto write = [&](const std::string& magic, const std::string& body) {
+    const uint64_t sum = core::Fnv1a64(body, core::kIplanFnvSeed);
+    std::string file = magic;
+    file.append(reinterpret_cast<const char*>(&sum), 8);
+    file += body;
+    std::ofstream(path, std::ios::binary | std::ios::trunc) << file;
+    std::filesystem::remove(path + ".bak");
+  };
+  write("IPLQTBL2", v3.substr(16, 32) + v3.substr(48 + durations));
+  TaskPlanner q2(Graph(), QLearningParams{});
   std::string note;
+  ASSERT_TRUE(q2.Load(path, &note)) << note;
+  EXPECT_NE(note.find("1 episodes learned"), std::string::npos) << note;
+  EXPECT_EQ(q2.Q(0, 1), p.Q(0, 1));
+  EXPECT_EQ(q2.TaskDuration(1), QLearningParams{}.task_duration_prior);  // none learned in version 2
+
+  write("IPLQTBL1", v3.substr(16, 24) + v3.substr(48 + durations));  // without the episode count at 40..47 too
+  TaskPlanner q(Graph(), QLearningParams{});
   ASSERT_TRUE(q.Load(path, &note)) << note;
   EXPECT_NE(note.find("0 episodes learned"), std::string::npos) << note;
   EXPECT_EQ(q.Q(0, 1), p.Q(0, 1));
@@ -372,16 +385,17 @@ TEST(TaskPlanner, AnAbsurdDelayIsClampedAndANonFiniteOneRefused) {
 TEST(TaskPlanner, ATableWithANonFiniteValueIsRefusedByName) {
   // A table poisoned by an older planner: the checksum is right, a Q-value is
   // -inf. Layout: magic (8), checksum (8), then the body: graph hash, task
-  // count, row count, episodes (8 each), rows of state (8) and 3 doubles.
+  // count, row count, episodes (8 each), 3 task durations (count and mean,
+  // 16 each), rows of state (8) and 3 doubles.
   const std::string path = TempPath("poisoned.bin");
   TaskPlanner p(Graph(), QLearningParams{});
   p.Complete(1, true, 0.5, {});
   p.Save(path);
   p.Save(path);  // a good backup
   std::string data = core::ReadFile(path);
-  ASSERT_EQ(data.size(), 48u + 8 + 3 * 8);
+  ASSERT_EQ(data.size(), 48u + 3 * 16 + 8 + 3 * 8);
   const double inf = -std::numeric_limits<double>::infinity();
-  std::memcpy(&data[48 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
+  std::memcpy(&data[48 + 3 * 16 + 8 + 8], &inf, 8);  // Q(state 0, task 1)
   const uint64_t sum = core::Fnv1a64(data.data() + 16, data.size() - 16, core::kIplanFnvSeed);
   std::memcpy(&data[8], &sum, 8);
   std::ofstream(path, std::ios::binary | std::ios::trunc) << data;

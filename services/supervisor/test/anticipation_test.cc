@@ -1,0 +1,273 @@
+// The person's own task graph and the anticipating task choice (our
+// extension of METHOD 6): the graph is validated and loaded strictly; drawn
+// sequences follow its probabilities and durations (seeded); the forecast
+// of the person's actions is the semi-Markov chain's; the choice picks the
+// task that will not conflict with what the person is predicted to do
+// *next*, where METHOD 6's choice (and one looking at the current action
+// only) picks the conflicting one; task durations are learned and saved.
+#include <unistd.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <random>
+
+#include <gtest/gtest.h>
+
+#include "core/human_graph.h"
+#include "core/task_planner.h"
+
+namespace iplan::supervisor {
+namespace {
+
+HumanGraph Person() {
+  HumanGraph g;
+  g.start = {{"reach_bin", 0.5}, {"assemble", 0.5}};
+  g.actions = {{"reach_bin", {{2.0, 4.0}, {{"assemble", 0.8}, {"reach_bin", 0.2}}}},
+               {"assemble", {{1.0, 3.0}, {{"reach_bin", 1.0}}}}};
+  return g;
+}
+
+TaskGraph Graph() {
+  TaskGraph g;
+  g.human_actions = {"reach_bin", "assemble"};
+  g.tasks = {{"pick_left", {0.1}, {}, {"reach_bin"}},
+             {"pick_right", {0.2}, {}, {}},
+             {"place", {0.3}, {"pick_left", "pick_right"}, {"assemble"}}};
+  g.human_graph = Person();
+  return g;
+}
+
+TEST(HumanGraph, ValidationNamesTheProblem) {
+  const std::vector<std::string> actions = {"reach_bin", "assemble"};
+  EXPECT_EQ(Person().Validate(actions), "");
+  EXPECT_EQ(HumanGraph{}.Validate(actions), "");  // none given
+  HumanGraph g = Person();
+  g.actions[0].second.next = {{"assemble", 0.5}, {"reach_bin", 0.25}};
+  EXPECT_EQ(g.Validate(actions), "human_graph.actions.reach_bin.next has probabilities summing to 0.75, not 1");
+  g = Person();
+  g.actions[1].second.duration = {3.0, 1.0};
+  EXPECT_EQ(g.Validate(actions),
+            "human_graph.actions.assemble.duration must be [least, most] with 0 < least <= most, got [3.0, 1.0]");
+  g = Person();
+  g.start = {{"dance", 1.0}};
+  EXPECT_EQ(g.Validate(actions), "human_graph.start names unknown human action 'dance'");
+  g = Person();
+  g.actions.pop_back();
+  EXPECT_EQ(g.Validate(actions),
+            "human_graph.actions.reach_bin.next names 'assemble', which has no entry in human_graph.actions");
+  // The task graph checks its human graph.
+  TaskGraph t = Graph();
+  t.human_graph.actions[1].second.next = {{"reach_bin", 1.5}};
+  EXPECT_EQ(t.Validate(), "human_graph.actions.assemble.next gives 'reach_bin' a probability outside [0, 1]");
+}
+
+TEST(HumanGraph, LoadsFromTheTaskGraphFileStrictly) {
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("iplan-human-graph-" + std::to_string(getpid()) + ".yaml")).string();
+  std::ofstream(path) << "human_actions: [reach, work]\n"
+                         "robot_tasks:\n"
+                         "  - {name: fetch, goal: [0.1]}\n"
+                         "human_graph:\n"
+                         "  start: {reach: 1.0}\n"
+                         "  actions:\n"
+                         "    reach: {duration: [2, 4], next: {work: 1.0}}\n"
+                         "    work: {duration: [1, 1], next: {reach: 0.25, work: 0.75}}\n";
+  const TaskGraph g = LoadTaskGraph(path);
+  ASSERT_EQ(g.human_graph.actions.size(), 2u);
+  EXPECT_EQ(g.human_graph.actions[1].first, "work");
+  EXPECT_EQ(g.human_graph.actions[1].second.next.at("work"), 0.75);
+  std::ofstream(path) << "human_actions: [reach]\n"
+                         "robot_tasks:\n"
+                         "  - {name: fetch, goal: [0.1]}\n"
+                         "human_graph:\n"
+                         "  actions:\n"
+                         "    reach: {duration: [2, 4], nxt: {reach: 1.0}}\n";
+  try {
+    LoadTaskGraph(path);
+    FAIL() << "a misspelt key was accepted";
+  } catch (const std::runtime_error& e) {
+    EXPECT_NE(std::string(e.what()).find("nxt"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find(path), std::string::npos) << e.what();
+  }
+  std::filesystem::remove(path);
+}
+
+// Uniform numbers in [0, 1) from a seeded generator (its bits, not
+// std::uniform_real_distribution, which differs between standard libraries).
+std::function<double()> Uniform(std::mt19937_64* rng) {
+  return [rng] { return static_cast<double>((*rng)() >> 11) * 0x1.0p-53; };
+}
+
+TEST(HumanGraph, DrawsFollowTheGraphsProbabilitiesAndDurations) {
+  const HumanGraph g = Person();
+  std::mt19937_64 rng(7);
+  std::map<std::string, int> first;
+  std::map<std::string, std::map<std::string, int>> transitions;
+  std::map<std::string, std::pair<double, int>> durations;  // sum, count
+  for (int episode = 0; episode < 2000; ++episode) {
+    const std::vector<HumanActionSpan> spans = DrawHumanActions(g, 30.0, Uniform(&rng));
+    ASSERT_GE(spans.size(), 2u);
+    ++first[spans.front().action];
+    EXPECT_LE(spans.front().start, 0.0);
+    EXPECT_GT(spans.front().end(), 0.0);
+    EXPECT_GE(spans.back().end(), 30.0);
+    for (std::size_t i = 0; i < spans.size(); ++i) {
+      const auto& d = g.actions[static_cast<std::size_t>(g.Find(spans[i].action))].second.duration;
+      EXPECT_GE(spans[i].duration, d[0]);
+      EXPECT_LE(spans[i].duration, d[1]);
+      durations[spans[i].action].first += spans[i].duration;
+      ++durations[spans[i].action].second;
+      if (i > 0) {
+        EXPECT_DOUBLE_EQ(spans[i].start, spans[i - 1].end());
+        ++transitions[spans[i - 1].action][spans[i].action];
+      }
+    }
+  }
+  EXPECT_NEAR(first["reach_bin"] / 2000.0, 0.5, 0.03);
+  const auto& from_reach = transitions["reach_bin"];
+  const double n = from_reach.at("assemble") + from_reach.at("reach_bin");
+  EXPECT_GT(n, 5000);
+  EXPECT_NEAR(from_reach.at("assemble") / n, 0.8, 0.015);
+  EXPECT_EQ(transitions["assemble"].count("assemble"), 0u);
+  EXPECT_NEAR(durations["reach_bin"].first / durations["reach_bin"].second, 3.0, 0.03);
+  EXPECT_NEAR(durations["assemble"].first / durations["assemble"].second, 2.0, 0.03);
+  // The same seed draws the same sequence.
+  std::mt19937_64 a(11), b(11);
+  const auto x = DrawHumanActions(g, 20.0, Uniform(&a)), y = DrawHumanActions(g, 20.0, Uniform(&b));
+  ASSERT_EQ(x.size(), y.size());
+  for (std::size_t i = 0; i < x.size(); ++i) {
+    EXPECT_EQ(x[i].action, y[i].action);
+    EXPECT_EQ(x[i].duration, y[i].duration);
+  }
+  EXPECT_THROW(DrawHumanActions(HumanGraph{}, 20.0, Uniform(&a)), std::invalid_argument);
+}
+
+TEST(HumanGraph, TheForecastIsTheSemiMarkovChains) {
+  const HumanGraph g = Person();
+  ActionOutlook o;
+  o.belief = {{"assemble", 1.0}};
+  o.elapsed = 1.0;  // assemble lasts 1-3 s: from age 1 it ends uniformly within the next 2 s
+  const double dt = 0.05;
+  const ActionForecast f = ForecastActions(g, o, dt, 100);
+  ASSERT_EQ(f.actions, (std::vector<std::string>{"reach_bin", "assemble"}));
+  ASSERT_EQ(f.p.size(), 100u);
+  auto at = [&](double t, int action) { return f.p[static_cast<std::size_t>(std::lround(t / dt))][static_cast<std::size_t>(action)]; };
+  EXPECT_DOUBLE_EQ(at(0.0, 1), 1.0);
+  EXPECT_NEAR(at(1.0, 1), 0.5, 0.03);  // still assembling half the time, 1 s on
+  EXPECT_NEAR(at(1.0, 0), 0.5, 0.03);  // assemble -> reach_bin always (reach_bin lasts at least 2 s)
+  EXPECT_EQ(at(2.0, 1), 0.0);  // assembling ended by 3 s of age; reach_bin lasts past 2 s
+  for (const auto& p : f.p) EXPECT_NEAR(p[0] + p[1], 1.0, 1e-9);
+  // An oracle: assemble ends in 0.5 s, then reach_bin.
+  o.remaining = 0.5;
+  o.next = "reach_bin";
+  const ActionForecast known = ForecastActions(g, o, dt, 40);
+  EXPECT_DOUBLE_EQ(known.p[9][1], 1.0);
+  EXPECT_DOUBLE_EQ(known.p[11][0], 1.0);
+  // Without a graph the belief lasts; actions the graph does not know too.
+  ActionOutlook unknown;
+  unknown.belief = {{"wave", 0.3}, {"assemble", 0.7}};
+  const ActionForecast kept = ForecastActions(HumanGraph{}, unknown, dt, 10);
+  ASSERT_EQ(kept.actions.size(), 2u);
+  for (const auto& p : kept.p) EXPECT_NEAR(p[0] + p[1], 1.0, 1e-12);
+  const ActionForecast mixed = ForecastActions(g, unknown, dt, 80);
+  ASSERT_EQ(mixed.actions.back(), "wave");
+  EXPECT_DOUBLE_EQ(mixed.p.back().back(), 0.3);
+}
+
+TEST(TaskPlanner, TheAnticipatingChoiceAvoidsTheActionPredictedNext) {
+  // The person assembles, 1 s into an action of 1-3 s, and then reaches into
+  // the bin (always). pick_left (the bin) does not conflict with assembling,
+  // so METHOD 6's choice takes it (the tie goes to the harmony with the
+  // current action, then to the index); over its 3 s the person is expected
+  // to be at the bin about 1.9 of them. The anticipating choice takes
+  // pick_right, which conflicts with nothing.
+  ActionOutlook outlook;
+  outlook.belief = {{"assemble", 1.0}};
+  outlook.elapsed = 1.0;
+  QLearningParams method;
+  method.learning = false;
+  TaskPlanner plain(Graph(), method);
+  EXPECT_EQ(plain.Choose(outlook), 0);
+  QLearningParams anticipating = method;
+  anticipating.anticipation_weight = 1.0;
+  TaskPlanner planner(Graph(), anticipating);
+  EXPECT_NEAR(planner.ExpectedConflict(0, outlook), 1.9, 0.1);
+  EXPECT_DOUBLE_EQ(planner.ExpectedConflict(1, outlook), 0.0);
+  EXPECT_EQ(planner.Choose(outlook), 1);
+  // Looking at the current action only (no person's graph), it cannot know.
+  TaskGraph current_only = Graph();
+  current_only.human_graph = HumanGraph{};
+  TaskPlanner blind(current_only, anticipating);
+  EXPECT_DOUBLE_EQ(blind.ExpectedConflict(0, outlook), 0.0);
+  EXPECT_EQ(blind.Choose(outlook), 0);
+  // Nothing known of the person: Q alone.
+  EXPECT_EQ(planner.Choose(ActionOutlook{}), 0);
+  // The task's own duration counts: pick_left known to take 0.5 s is
+  // expected to meet the person at the bin for only about 0.05 s of it.
+  planner.ObserveDuration(0, 0.5);
+  EXPECT_DOUBLE_EQ(planner.TaskDuration(0), 0.5);
+  EXPECT_NEAR(planner.ExpectedConflict(0, outlook), 0.05, 0.02);
+}
+
+TEST(TaskPlanner, LookingFurtherAheadFitsTheConflictingTaskBeforeTheAction) {
+  // The person rests for 3 s more, then works for 10 s. Hand-over (2.5 s)
+  // conflicts with working; filler (3 s) with nothing. One task ahead, both
+  // are clear now and the index picks filler, which leaves the hand-over to
+  // the work; two tasks ahead, the hand-over first fits before the work.
+  TaskGraph g;
+  g.human_actions = {"rest", "work"};
+  g.tasks = {{"filler", {0.1}, {}, {}}, {"hand_over", {0.2}, {}, {"work"}}};
+  g.human_graph.start = {{"rest", 1.0}};
+  g.human_graph.actions = {{"rest", {{3.0, 3.0}, {{"work", 1.0}}}}, {"work", {{10.0, 10.0}, {{"rest", 1.0}}}}};
+  ActionOutlook outlook;
+  outlook.belief = {{"rest", 1.0}};
+  QLearningParams params;
+  params.learning = false;
+  params.anticipation_weight = 1.0;
+  TaskPlanner one(g, params);
+  params.anticipation_depth = 2;
+  TaskPlanner two(g, params);
+  for (TaskPlanner* p : {&one, &two}) {
+    p->ObserveDuration(0, 3.0);
+    p->ObserveDuration(1, 2.5);
+  }
+  EXPECT_NEAR(one.AnticipatedConflict(0, outlook), 0.0, 1e-9);
+  EXPECT_NEAR(one.AnticipatedConflict(1, outlook), 0.0, 1e-9);
+  EXPECT_EQ(one.Choose(outlook), 0);
+  EXPECT_NEAR(two.AnticipatedConflict(0, outlook), 2.5, 1e-9);  // filler, then the hand-over into the work
+  EXPECT_NEAR(two.AnticipatedConflict(1, outlook), 0.0, 1e-9);
+  EXPECT_EQ(two.Choose(outlook), 1);
+  params.anticipation_depth = 0;
+  EXPECT_EQ(params.Validate(), "anticipation_depth must be in [1, 8]");
+}
+
+TEST(TaskPlanner, TaskDurationsAreLearnedAndSavedWithTheTable) {
+  QLearningParams params;
+  params.task_duration_prior = 4.0;
+  TaskPlanner p(Graph(), params);
+  EXPECT_DOUBLE_EQ(p.TaskDuration(2), 4.0);
+  p.ObserveDuration(2, 2.0);
+  p.ObserveDuration(2, 3.0);
+  p.ObserveDuration(2, std::nan(""));  // ignored
+  p.ObserveDuration(2, -1.0);          // ignored
+  EXPECT_DOUBLE_EQ(p.TaskDuration(2), 2.5);
+  const std::string path =
+      (std::filesystem::temp_directory_path() / ("iplan-durations-" + std::to_string(getpid()) + ".bin")).string();
+  p.Save(path);
+  TaskPlanner q(Graph(), params);
+  std::string note;
+  ASSERT_TRUE(q.Load(path, &note)) << note;
+  EXPECT_DOUBLE_EQ(q.TaskDuration(2), 2.5);
+  EXPECT_DOUBLE_EQ(q.TaskDuration(0), 4.0);
+  q.ObserveDuration(2, 4.0);  // the count came back too: the mean of three
+  EXPECT_DOUBLE_EQ(q.TaskDuration(2), 3.0);
+  params.anticipation_weight = -1;
+  EXPECT_EQ(params.Validate(), "anticipation_weight must be >= 0");
+  std::filesystem::remove(path);
+  std::filesystem::remove(path + ".bak");
+}
+
+}  // namespace
+}  // namespace iplan::supervisor
