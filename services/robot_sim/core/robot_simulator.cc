@@ -9,6 +9,7 @@ namespace iplan::robot_sim {
 
 std::string SimulatorParams::Validate() const {
   if (!(stopping_time > 0)) return "stopping_time must be > 0";
+  if (!(braking_fraction >= 0 && braking_fraction <= 1)) return "braking_fraction must be in [0, 1]";
   if (!(contact_margin >= 0)) return "contact_margin must be >= 0";
   return "";
 }
@@ -59,8 +60,20 @@ std::optional<std::string> RobotSimulator::SetTrajectory(int64_t start_ns, const
 void RobotSimulator::Stop() {
   if (stop_requested_) return;
   stop_requested_ = true;
-  // Decelerate each joint uniformly to rest within the stopping time.
-  stop_decel_ = qd_.cwiseAbs() / params_.stopping_time;
+  // Decelerate each joint uniformly so that all come to rest together
+  // (the arm stays on its path): within the time the slowest needs at
+  // braking_fraction of its acceleration limit, at most the stopping time.
+  double duration = params_.stopping_time;
+  if (params_.braking_fraction > 0) {
+    double needed = 0.0;  // a joint without an acceleration limit brakes over the stopping time
+    for (int i = 0; i < robot_.nq; ++i) {
+      const double a = params_.braking_fraction * amax_[i];
+      needed = std::max(needed, a > 0 && std::isfinite(a) ? std::abs(qd_[i]) / a : params_.stopping_time);
+    }
+    duration = std::min(duration, needed);
+  }
+  last_stop_duration_ = duration;
+  stop_decel_ = duration > 0 ? Eigen::VectorXd(qd_.cwiseAbs() / duration) : Eigen::VectorXd::Zero(qd_.size());
   collision::CalcForwardKinematics(robot_, q_, &data_);
   stop_start_ee_ = data_.X_WL.back().translation();
   last_stopping_distance_ = 0;

@@ -25,10 +25,18 @@ namespace iplan::robot_sim {
 
 struct SimulatorParams {
   double stopping_time = 0.3;  ///< s, T_s: a protective stop brings every joint to rest within it
+  /// How hard a protective stop brakes: every joint decelerates uniformly
+  /// and all reach rest together (the arm stays on its path, a controlled
+  /// stop on the drives: ISO 10218-1 category 2), within the time the
+  /// slowest joint needs at this fraction of its acceleration limit, and
+  /// never later than stopping_time. 0: every stop takes stopping_time,
+  /// whatever the speed. In [0, 1].
+  double braking_fraction = 0.0;
   double contact_margin = 0.0; ///< m; spheres closer than this count as touching
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(stopping_time, "s; T_s, a protective stop brings every joint to rest within it, > 0"));
+    a->Visit(IPLAN_NVP(braking_fraction, "a stop brakes all joints together, the slowest at this fraction of its acceleration limit (at most stopping_time; 0: always stopping_time), in [0, 1]"));
     a->Visit(IPLAN_NVP(contact_margin, "m; spheres closer than this count as touching, >= 0"));
   }
   /// Empty when valid, else the reason.
@@ -48,7 +56,8 @@ class RobotSimulator {
   std::optional<std::string> SetTrajectory(int64_t start_ns, const std::vector<std::string>& names,
                                            const std::vector<double>& times,
                                            const std::vector<std::vector<double>>& positions);
-  /// Protective stop: decelerate every joint to rest within stopping_time.
+  /// Protective stop: decelerate every joint to rest, all at the same
+  /// moment, within stopping_time (sooner with braking_fraction > 0).
   void Stop();
   /// Resume following the trajectory (from where its timing says it is now).
   void Resume();
@@ -81,6 +90,8 @@ class RobotSimulator {
   int contacts() const { return contacts_; }
   /// Smallest separation UpdateContacts has seen (m); nullopt before the first.
   const cell::Separation& min_separation_seen() const { return min_separation_seen_; }
+  /// s the last stop took (or takes) from its command to rest.
+  double last_stop_duration() const { return last_stop_duration_; }
   /// Max over the last stop of the end-effector (last sphere) travel after the stop command (m).
   double last_stopping_distance() const { return last_stopping_distance_; }
   const collision::RobotModel& robot() const { return robot_; }
@@ -101,6 +112,7 @@ class RobotSimulator {
   Eigen::VectorXd stop_decel_;  // per joint deceleration of the current stop
   Eigen::Vector3d stop_start_ee_ = Eigen::Vector3d::Zero();
   double last_stopping_distance_ = 0;
+  double last_stop_duration_ = 0;
   bool touching_ = false;
   int contacts_ = 0;
   cell::Separation min_separation_seen_;

@@ -69,6 +69,54 @@ TEST_F(RobotSimulatorTest, ProtectiveStopComesToRestWithinTheStoppingTime) {
   EXPECT_LT((sim_.q() - goal).norm(), 1e-3);
 }
 
+// braking_fraction: a stop brakes every joint together (the direction of the
+// joint velocity kept: the arm stays on its path) within the time the
+// slowest joint needs at that fraction of its acceleration limit, never
+// longer than stopping_time. Joint 1 of the Panda (limit 15 rad/s^2) at
+// 1.2 rad/s: 0.08 s at the full limit, 0.16 s at half of it; joint 2
+// (7.5 rad/s^2) at 1.5 rad/s would need 0.4 s at half: capped at 0.3 s.
+TEST_F(RobotSimulatorTest, ProtectiveStopBrakesAtTheJointsAccelerationLimits) {
+  const auto model = collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
+  struct Case {
+    double fraction;
+    int joint;
+    double speed, expected;
+  };
+  for (const Case& c : {Case{1.0, 0, 1.2, 0.08}, Case{0.5, 0, 1.2, 0.16}, Case{0.5, 1, 1.5, 0.3}, Case{0.0, 0, 1.2, 0.3}}) {
+    SimulatorParams p;
+    p.braking_fraction = c.fraction;
+    RobotSimulator sim(model, Ready(), p);
+    // Drive the joint at a constant speed towards its upper limit (1.6 s of
+    // ramp), stop after 1 s.
+    Eigen::VectorXd goal = Ready();
+    goal[c.joint] += c.speed * 1.6;
+    ASSERT_LT(goal[c.joint], model.UpperLimits()[c.joint]);
+    ASSERT_EQ(sim.SetTrajectory(0, sim.joint_names(), {0.0, 1.6}, Points(Ready(), goal)), std::nullopt);
+    const double dt = 0.001;
+    int k = 1;
+    for (; k <= 1000; ++k) sim.Step(static_cast<int64_t>(k * dt * kSec), dt);
+    ASSERT_NEAR(sim.qd()[c.joint], c.speed, 1e-3) << "fraction " << c.fraction;
+    sim.Stop();
+    EXPECT_NEAR(sim.last_stop_duration(), c.expected, 1e-3) << "fraction " << c.fraction;
+    const double decel = std::abs(sim.qd()[c.joint]) / sim.last_stop_duration();
+    const int stop_step = k;
+    double prev = sim.qd()[c.joint];
+    for (; sim.qd().norm() > 0 && k < stop_step + 1000; ++k) {
+      sim.Step(static_cast<int64_t>(k * dt * kSec), dt);
+      const double a = std::abs(sim.qd()[c.joint] - prev) / dt;
+      ASSERT_LE(a, decel + 1e-6) << "fraction " << c.fraction;  // uniform (the last step: what was left)
+      if (c.fraction > 0 && c.expected < 0.3) {  // within the fraction of the limit unless the stopping time binds
+        ASSERT_LE(a, c.fraction * (c.joint == 0 ? 15.0 : 7.5) + 1e-6);
+      }
+      prev = sim.qd()[c.joint];
+    }
+    EXPECT_NEAR((k - stop_step) * dt, c.expected, 2 * dt) << "fraction " << c.fraction;
+  }
+  SimulatorParams bad;
+  bad.braking_fraction = 1.5;
+  EXPECT_EQ(bad.Validate(), "braking_fraction must be in [0, 1]");
+}
+
 // Speed reduction: at half scale the path's time runs half as fast, so the
 // robot is where the trajectory is at half the elapsed time, moving at half
 // its speed; back at full scale it keeps that lag; a new trajectory starts on
