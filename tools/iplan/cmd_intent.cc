@@ -9,12 +9,14 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <sstream>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
 #include "command_registry.h"
+#include "dds_cell_model.h"
 #include "iplan/intent/evaluation.h"
 #include "iplan/intent/intent_model.h"
 #include "iplan/intent/model_io.h"
@@ -69,19 +71,24 @@ struct TrainOptions {
   // (FrameFeatureOptions, TrainParams), see docs/intent.md "Known limits".
   std::string sigma_factors, prefixes, belief_taus;
   std::string baseline_frames, baseline_taus, residual_weights;
-  bool no_calibration = false;
+  bool no_calibration = false, no_mirror = false;
   int forecast_cv_folds = 5;
   std::string lambdas = "1e-5,1e-4,1e-3";
   double rate = 15.0, noise = 0.01, max_gap = 0.6, torso_weight = 3.0;
   bool normalise_size = false;
   double ivm_tolerance = 1e-3;
   int window = 15, horizon = 15, pseudo_inputs = 20, band = 3, max_import = 80, velocity_frames = 2;
+  int history_samples = iplan::intent::IntentModelConfig{}.history_samples;
   int gp_iterations = 150, max_forecast_windows = 600, forecast_stride = 2;
   std::uint64_t seed = 1;
 };
 
 struct EvalOptions {
   std::string model, data, subjects;
+  // --synthetic: the cell's synthetic person (a perception.yaml) instead of --data.
+  std::string synthetic;
+  std::optional<std::uint64_t> synthetic_seed;
+  int synthetic_people = 12;
   bool json = false;
   int stride = 1;
 };
@@ -115,6 +122,7 @@ iplan::intent::IntentModelConfig MakeConfig(const TrainOptions& o,
   config.window = o.window;
   config.horizon = o.horizon;
   config.velocity_frames = o.velocity_frames;
+  config.history_samples = o.history_samples;
   config.dtw_band = o.band;
   config.sensor_noise_std = o.noise;
   config.features.torso_motion_weight = o.torso_weight;
@@ -139,6 +147,7 @@ iplan::intent::TrainParams MakeTrainParams(const TrainOptions& o) {
   if (!o.baseline_taus.empty()) params.baseline_damping_time_constants = ParseDoubles(o.baseline_taus, "--baseline-taus");
   if (!o.residual_weights.empty()) params.residual_weights = ParseDoubles(o.residual_weights, "--residual-weights");
   params.calibrate_covariance = !o.no_calibration;
+  if (o.no_mirror) params.mirror_augmentation = {false};
   params.forecast_cv_folds = o.forecast_cv_folds;
   params.ivm.max_import = o.max_import;
   params.ivm.stop_tolerance = o.ivm_tolerance;
@@ -166,12 +175,14 @@ void PrintClassifierReport(const iplan::intent::IntentModelConfig& config,
   for (const std::string& a : model.actions) std::cout << " " << a;
   std::cout << "\nclassifier: " << rep.num_classifier_samples << " windows, median DTW "
             << rep.median_dtw << " m\n  cross-validation (leave one subject out):\n"
-            << "    sigma_m  lambda   logloss  accuracy\n";
+            << "    mirrored  sigma_m  lambda   logloss  accuracy\n";
   for (const auto& row : rep.cv_table) {
-    std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
+    std::cout << "    " << (row[0] != 0.0 ? "yes" : "no ") << "  " << row[1] << "  " << row[2] << "  " << row[3]
+              << "  " << row[4] << "\n";
   }
   std::cout << "  chosen sigma " << rep.sigma << " m, lambda " << rep.lambda << ", "
-            << rep.num_import_vectors << " import vectors, " << rep.seconds_classifier << " s\n";
+            << (rep.mirror_augmentation ? "with" : "without") << " mirror images, " << rep.num_import_vectors
+            << " import vectors, " << rep.seconds_classifier << " s\n";
   if (!rep.belief_cv_table.empty()) {
     std::cout << "  belief filter over successive windows, cross-validation (leave one subject out):\n"
               << "    motion_weighted  tau_s  logloss  accuracy\n";
@@ -182,6 +193,10 @@ void PrintClassifierReport(const iplan::intent::IntentModelConfig& config,
   }
   std::cout << "  chosen belief filter: time constant " << rep.belief_time_constant << " s, "
             << (rep.belief_motion_weighted ? "motion weighted" : "not motion weighted");
+  if (!rep.belief_cv_accuracy_by_prefix.empty()) {
+    std::cout << "\n  its cross-validated accuracy at the training prefixes:";
+    for (double a : rep.belief_cv_accuracy_by_prefix) std::cout << " " << 100.0 * a << " %";
+  }
 }
 
 // Forecaster windows and the kinematic baseline table (best tau per L).
@@ -207,7 +222,8 @@ void PrintBaselineReport(const iplan::intent::TrainParams& params,
     std::cout << "    " << L << "  " << (L == 1 ? 0.0 : row[1]) << "  " << row[2] << "\n";
   }
   std::cout << "  (holding the last pose: " << rep.error_const_position << " m)\n  chosen L "
-            << rep.baseline.smoothing_frames << ", tau " << rep.baseline.damping_time_constant << " s\n";
+            << rep.baseline.smoothing_frames << ", tau " << rep.baseline.damping_time_constant
+            << " s (the best line only if it beats holding by more than one standard error across the folds)\n";
 }
 
 // The forecaster cross-validation: residual weight, activity offset, coverage.
@@ -223,7 +239,8 @@ void PrintForecastCvReport(const iplan::intent::TrainReport& rep) {
   for (const auto& row : rep.residual_cv_table) {
     std::cout << "    " << row[0] << "  " << row[1] << "  " << row[2] << "  " << row[3] << "\n";
   }
-  std::cout << "  chosen w " << rep.residual_weight << "\n";
+  std::cout << "  chosen w " << rep.residual_weight
+            << " (the smallest within one standard error, across the folds, of the lowest all_steps error)\n";
   if (!rep.motion_cv_table.empty()) {
     std::cout << "  covariance activity offset m0, held-out (after calibration):\n"
               << "    m0_m_per_s  nll  coverage\n";
@@ -263,16 +280,28 @@ void RunTrain(const TrainOptions& o) {
 void RunEval(const EvalOptions& o) {
   using namespace iplan::intent;
   const IntentModel model = LoadIntentModel(o.model);
-  const SkeletonDataset all = LoadSkeletonCsv(o.data);
-  const SkeletonDataset data = SelectSubjects(all, SplitList(o.subjects));
+  SkeletonDataset data;
+  std::string source;
+  if (!o.synthetic.empty()) {
+    if (!o.data.empty() || !o.subjects.empty()) throw std::invalid_argument("--synthetic replaces --data and --subjects");
+    if (o.synthetic_people < 1) throw std::invalid_argument("--people must be >= 1");
+    // Fresh people: not the training demonstrations' seed.
+    const std::uint64_t seed = o.synthetic_seed.value_or(CellPersonSeed(o.synthetic) + 1000);
+    data = RecordCellEpisodes(o.synthetic, seed, o.synthetic_people);
+    source = "the synthetic person of " + o.synthetic + " (" + std::to_string(o.synthetic_people) +
+             " people x 2 episodes of the script, seed " + std::to_string(seed) + ")";
+  } else {
+    if (o.data.empty() || o.subjects.empty()) throw std::invalid_argument("--data and --subjects are required (or --synthetic)");
+    data = SelectSubjects(LoadSkeletonCsv(o.data), SplitList(o.subjects));
+    source = o.data + " (subjects " + o.subjects + ")";
+  }
   EvalParams params;
   params.forecast_stride = o.stride;
   const EvalReport report = EvaluateIntentModel(model, data, params);
   if (o.json) {
     std::cout << EvalReportToJson(report) << "\n";
   } else {
-    std::cout << "model " << o.model << " on " << o.data << " (subjects " << o.subjects << ")\n"
-              << EvalReportToText(report);
+    std::cout << "model " << o.model << " on " << source << "\n" << EvalReportToText(report);
   }
 }
 
@@ -316,6 +345,9 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--horizon", t.horizon, "Forecast horizon, frames")->capture_default_str();
   train->add_option("--velocity-frames", t.velocity_frames,
                     "Forecaster input velocities: finite differences over this many frames")->capture_default_str();
+  train->add_option("--history-samples", t.history_samples,
+                    "Forecaster input: each joint's displacement since this many earlier frames of the window")
+      ->capture_default_str();
   train->add_option("--pseudo-inputs,-M", t.pseudo_inputs, "SPGP pseudo-inputs per action")->capture_default_str();
   train->add_option("--band", t.band, "DTW Sakoe-Chiba band, frames")->capture_default_str();
   train->add_option("--max-import", t.max_import, "Maximum IVM import vectors")->capture_default_str();
@@ -333,6 +365,9 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--residual-weights", t.residual_weights,
                     "CV weights of the SPGP residual over the baseline (default 0,0.25,0.5,0.75,1)");
   train->add_flag("--no-calibration", t.no_calibration, "Do not calibrate the forecast covariances");
+  train->add_flag("--no-mirror", t.no_mirror,
+                  "Do not try mirror images of the training windows (the other hand) in the classifier's "
+                  "cross-validation");
   train->add_option("--forecast-cv-folds", t.forecast_cv_folds,
                     "Forecaster CV folds (training subjects, or one subject's sequences)")->capture_default_str();
   train->add_option("--gp-iterations", t.gp_iterations, "L-BFGS iterations per action")->capture_default_str();
@@ -350,8 +385,13 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   CLI::App* eval = intent->add_subcommand("eval", "Evaluate an intent model on a skeleton CSV");
   EvalOptions& e = *eval_opts;
   eval->add_option("--model", e.model, "Model file")->required();
-  eval->add_option("--data", e.data, "Skeleton CSV (shared layout)")->required();
-  eval->add_option("--subjects", e.subjects, "Test subjects, comma separated")->required();
+  eval->add_option("--data", e.data, "Skeleton CSV (shared layout)");
+  eval->add_option("--subjects", e.subjects, "Test subjects, comma separated");
+  eval->add_option("--synthetic", e.synthetic,
+                   "Instead of --data: the synthetic person of this perception.yaml (the cell's) doing its script, "
+                   "fresh people; reaching phases are scored separately");
+  eval->add_option("--seed", e.synthetic_seed, "With --synthetic: generator seed (default: the person's seed + 1000)");
+  eval->add_option("--people", e.synthetic_people, "With --synthetic: simulated people")->capture_default_str();
   eval->add_option("--stride", e.stride, "Frames between evaluated forecast windows")->capture_default_str();
   eval->add_flag("--json", e.json, "Print the report as JSON");
   eval->callback([eval_opts] { Guarded([&] { RunEval(*eval_opts); }); });

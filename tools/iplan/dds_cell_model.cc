@@ -38,7 +38,7 @@ std::string ReadFile(const fs::path& p) {
 std::string ModelKey(const perception::SyntheticPersonParams& p, const std::vector<std::string>& joints, double rate) {
   std::ostringstream k;
   k.precision(17);
-  k << "iplan cell intent model v1\nformat " << intent::kIntentModelFormatVersion << "\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
+  k << "iplan cell intent model v2 (demonstrations and episodes)\nformat " << intent::kIntentModelFormatVersion << "\nsubjects " << kSubjects << " repetitions " << kRepetitions << " seconds "
     << kSeconds << "\nrate " << rate << "\njoints";
   for (const auto& j : joints) k << " " << j;
   k << "\ntorso " << p.torso_W.transpose() << " rest " << p.rest_left_P.transpose() << " yaw " << p.facing_yaw << " noise " << p.noise_stddev << " variation "
@@ -56,13 +56,29 @@ intent::SkeletonDataset RecordCellDemonstrations(const perception::SyntheticPers
   return perception::RecordDemonstrations(person, kSubjects, kRepetitions, kSeconds, 30.0);
 }
 
+namespace {
+
+perception::SyntheticPersonParams CellPerson(const std::string& perception_yaml) {
+  perception::PerceptionSettings psettings;
+  framework::ServiceFile(perception_yaml).ReadSection("perception", &psettings).Finish();
+  return psettings.synthetic.Person();
+}
+
+}  // namespace
+
+std::uint64_t CellPersonSeed(const std::string& perception_yaml) { return CellPerson(perception_yaml).seed; }
+
+intent::SkeletonDataset RecordCellEpisodes(const std::string& perception_yaml, std::uint64_t seed, int people) {
+  perception::SyntheticPersonParams person = CellPerson(perception_yaml);
+  person.seed = seed;
+  return perception::RecordEpisodes(person, people, kRepetitions, 2.0, 2.0, 30.0);
+}
+
 CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::string& intent_yaml,
                                 const std::string& fallback_dir, bool force) {
   // The person, as the perception service will simulate it.
   // Both files read and checked as their services read them.
-  perception::PerceptionSettings psettings;
-  framework::ServiceFile(perception_yaml).ReadSection("perception", &psettings).Finish();
-  const perception::SyntheticPersonParams person = psettings.synthetic.Person();
+  const perception::SyntheticPersonParams person = CellPerson(perception_yaml);
   // What the intent service expects.
   framework::ServiceFile iconf(intent_yaml);
   intent_service::IntentSettings isettings;
@@ -82,7 +98,13 @@ CellModelResult EnsureCellModel(const std::string& perception_yaml, const std::s
   }
 
   const auto t0 = std::chrono::steady_clock::now();
-  const intent::SkeletonDataset data = RecordCellDemonstrations(person);
+  // The actions one at a time, and the script as the cell plays it (its
+  // transitions teach the belief filter that actions change).
+  intent::SkeletonDataset data = RecordCellDemonstrations(person);
+  if (!person.script.empty()) {
+    intent::SkeletonDataset episodes = perception::RecordEpisodes(person, kSubjects, kRepetitions, 2.0, 2.0, 30.0);
+    for (auto& s : episodes.sequences) data.sequences.push_back(std::move(s));
+  }
   intent::IntentModelConfig config;
   // The configured joints, torso and hands defaulted among them (not among
   // the person's), so that any joint set of intent.yaml trains or is refused

@@ -3,6 +3,7 @@
 // configuration (with a key file, so that a changed person retrains it).
 #pragma once
 
+#include <cstdint>
 #include <string>
 
 #include "perception/core/synthetic_person.h"
@@ -14,6 +15,18 @@ namespace iplan::cli {
 /// person `person` doing every action (several simulated people, two
 /// recordings each, 30 Hz, with its sensor noise). Deterministic.
 intent::SkeletonDataset RecordCellDemonstrations(const perception::SyntheticPersonParams& person);
+
+/// The person of `perception_yaml` (perception.synthetic) as the cell sees
+/// them, for evaluating the cell's model: `people` simulated people (s01,
+/// s02, ...), two episodes each of the whole script (perception::RecordEpisodes:
+/// 2 s idle before it, 2 s after, 30 Hz), drawn with generator seed `seed` (the
+/// training demonstrations use the person's own seed), with each frame's
+/// action and reaching flags. Throws std::runtime_error for an unreadable or
+/// invalid file, std::invalid_argument for a person without a script.
+intent::SkeletonDataset RecordCellEpisodes(const std::string& perception_yaml, std::uint64_t seed, int people);
+
+/// The synthetic person's seed in `perception_yaml` (the training seed).
+std::uint64_t CellPersonSeed(const std::string& perception_yaml);
 
 struct CellModelResult {
   std::string path;     ///< model file to use

@@ -124,6 +124,46 @@ FeatureLayout::FeatureLayout(const JointConfig& config, const FrameFeatureOption
   objects_ = config.objects;
   shoulder_l_ = IndexOf(config.joints, "shoulder_l");
   shoulder_r_ = IndexOf(config.joints, "shoulder_r");
+  mirror_partner_.resize(num_joints_);
+  for (int j = 0; j < num_joints_; ++j) {
+    const std::string& n = config.joints[j];
+    mirror_partner_[j] = j;
+    if (n.size() < 2 || n[n.size() - 2] != '_' || (n.back() != 'l' && n.back() != 'r')) continue;
+    const int partner = IndexOf(config.joints, n.substr(0, n.size() - 1) + (n.back() == 'l' ? "r" : "l"));
+    if (partner >= 0) mirror_partner_[j] = partner;
+  }
+  if (objects_.empty()) {
+    for (const char* base : {"shoulder", "hip", "elbow", "wrist", "hand"}) {
+      const int l = IndexOf(config.joints, std::string(base) + "_l");
+      const int r = IndexOf(config.joints, std::string(base) + "_r");
+      if (l >= 0 && r >= 0) {
+        lateral_l_ = l;
+        lateral_r_ = r;
+        break;
+      }
+    }
+  }
+}
+
+Eigen::MatrixXd FeatureLayout::MirroredWindow(const Eigen::MatrixXd& window) const {
+  if (!CanMirror()) throw std::logic_error("FeatureLayout::MirroredWindow: the joint set has no left/right pair");
+  const Eigen::Index T = window.rows();
+  Eigen::Vector3d lateral = Eigen::Vector3d::Zero(), centre = Eigen::Vector3d::Zero();
+  for (Eigen::Index s = 0; s < T; ++s) {
+    lateral += (window.block<1, 3>(s, 3 * lateral_l_) - window.block<1, 3>(s, 3 * lateral_r_)).transpose();
+    for (int j = 0; j < num_joints_; ++j) centre += window.block<1, 3>(s, 3 * j).transpose();
+  }
+  centre /= static_cast<double>(T * num_joints_);
+  Eigen::MatrixXd out(T, window.cols());
+  if (!(lateral.norm() > 1e-9)) return window;  // the pair coincides: no side to mirror
+  const Eigen::Vector3d n = lateral.normalized();
+  for (Eigen::Index s = 0; s < T; ++s) {
+    for (int j = 0; j < num_joints_; ++j) {
+      const Eigen::Vector3d p = window.block<1, 3>(s, 3 * j).transpose();
+      out.block<1, 3>(s, 3 * mirror_partner_[j]) = (p - 2.0 * (p - centre).dot(n) * n).transpose();
+    }
+  }
+  return out;
 }
 
 Eigen::Vector3d FeatureLayout::Torso(
@@ -167,14 +207,14 @@ Eigen::MatrixXd FeatureLayout::FrameFeatures(const Eigen::MatrixXd& window) cons
 
 Eigen::VectorXd FeatureLayout::ForecastInput(const Eigen::MatrixXd& window,
                                              double rate,
-                                             int velocity_frames) const {
+                                             int velocity_frames, int history_samples) const {
   const int T = static_cast<int>(window.rows());
   const int J = num_joints_;
   const int k = std::max(1, std::min(velocity_frames, T - 1));
   const int now = T - 1;
   const int past = std::max(0, now - k);
   const double dt = (now - past) > 0 ? (now - past) / rate : 1.0 / rate;
-  Eigen::VectorXd x(forecast_input_size());
+  Eigen::VectorXd x(forecast_input_size(history_samples));
   const Eigen::Vector3d torso_now = Torso(window.row(now));
   const Eigen::Vector3d torso_past = Torso(window.row(past));
   const Eigen::Vector3d torso_first = Torso(window.row(0));
@@ -192,6 +232,12 @@ Eigen::VectorXd FeatureLayout::ForecastInput(const Eigen::MatrixXd& window,
   for (int h : hand_index_) {
     for (const Eigen::Vector3d& o : objects_) {
       x(c++) = (window.block<1, 3>(now, 3 * h).transpose() - o).norm();
+    }
+  }
+  for (int l = 1; l <= history_samples; ++l) {
+    const int back = std::max(0, now - (l * (T - 1)) / history_samples);
+    for (int j = 0; j < J; ++j, c += 3) {
+      x.segment<3>(c) = (window.block<1, 3>(now, 3 * j) - window.block<1, 3>(back, 3 * j)).transpose();
     }
   }
   return x;

@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
 #include <set>
 #include <vector>
 
@@ -20,33 +21,70 @@ struct ClassifierSamples {
   std::vector<Eigen::MatrixXd> windows;  // (F, T) each
   std::vector<int> labels;
   std::vector<int> subject;              // fold id
+  std::vector<bool> mirrored;            // a mirror image (after all the recorded windows)
+  int num_recorded = 0;                  // windows before the mirror images
 };
 
-// The rows of the windows ending at the prefix fractions of a track of n rows.
-std::set<int> PrefixEnds(int n, const std::vector<double>& fractions) {
-  std::set<int> ends;
-  for (double f : fractions) {
-    ends.insert(std::max(1, static_cast<int>(std::ceil(f * n - 1e-9))) - 1);
+// The rows of the windows ending at the prefix fractions of a track: of
+// the whole track, or with frame actions of each stretch of one action;
+// each with the index of its fraction.
+std::vector<std::pair<int, int>> PrefixEndList(const Track& t, const std::vector<double>& fractions) {
+  const int n = static_cast<int>(t.positions.rows());
+  std::vector<std::pair<int, int>> ends;
+  for (int begin = 0, end = 0; begin < n; begin = end) {
+    end = begin + 1;
+    while (end < n && ActionAt(t, end) == ActionAt(t, begin)) ++end;
+    for (size_t i = 0; i < fractions.size(); ++i) {
+      const int e = begin + std::max(1, static_cast<int>(std::ceil(fractions[i] * (end - begin) - 1e-9))) - 1;
+      ends.emplace_back(e, static_cast<int>(i));
+    }
   }
   return ends;
 }
 
+// The distinct rows of PrefixEndList.
+std::set<int> PrefixEnds(const Track& t, const std::vector<double>& fractions) {
+  std::set<int> ends;
+  for (const auto& [e, i] : PrefixEndList(t, fractions)) ends.insert(e);
+  return ends;
+}
+
 // ---- Classifier samples: windows ending at prefix fractions. ----
+// With `mirror`, their mirror images follow (FeatureLayout::MirroredWindow).
 ClassifierSamples MakeClassifierSamples(const TrainingGroups& g, const FeatureLayout& layout,
                                         const IntentModelConfig& config,
-                                        const TrainParams& params) {
+                                        const TrainParams& params, bool mirror) {
   ClassifierSamples cs;
+  std::vector<Eigen::MatrixXd> images;
   for (const Track& t : g.tracks) {
-    const int n = static_cast<int>(t.positions.rows());
-    const std::set<int> ends = PrefixEnds(n, params.prefix_fractions);
+    const std::set<int> ends = PrefixEnds(t, params.prefix_fractions);
     for (int e : ends) {
-      cs.windows.push_back(
-          layout.FrameFeatures(WindowEndingAt(t.positions, e, config.window)).transpose());
-      cs.labels.push_back(g.action_id.at(t.action));
+      const Eigen::MatrixXd window = WindowEndingAt(t.positions, e, config.window);
+      cs.windows.push_back(layout.FrameFeatures(window).transpose());
+      cs.labels.push_back(g.action_id.at(ActionAt(t, e)));
       cs.subject.push_back(g.subject_id.at(t.subject));
+      if (mirror) images.push_back(layout.FrameFeatures(layout.MirroredWindow(window)).transpose());
     }
   }
+  cs.num_recorded = static_cast<int>(cs.windows.size());
+  cs.mirrored.assign(cs.windows.size(), false);
+  for (size_t i = 0; i < images.size(); ++i) {
+    cs.windows.push_back(std::move(images[i]));
+    cs.labels.push_back(cs.labels[i]);
+    cs.subject.push_back(cs.subject[i]);
+    cs.mirrored.push_back(true);
+  }
   return cs;
+}
+
+// The rows a classifier is trained on: every subject but `held_out` (-1:
+// none), mirror images only with `mirror`.
+std::vector<int> TrainingRows(const ClassifierSamples& cs, int held_out, bool mirror) {
+  std::vector<int> rows;
+  for (int i = 0; i < static_cast<int>(cs.windows.size()); ++i) {
+    if (cs.subject[i] != held_out && (mirror || !cs.mirrored[i])) rows.push_back(i);
+  }
+  return rows;
 }
 
 Eigen::MatrixXd DtwMatrix(const std::vector<Eigen::MatrixXd>& w, int band) {
@@ -106,15 +144,17 @@ Eigen::MatrixXd PredictRows(const IvmModel& ivm, const Eigen::MatrixXd& K,
   return P;
 }
 
-// Leave-one-subject-out at (K, lambda): the held-out log-loss summed over
-// all samples and the number classified correctly.
+// Leave-one-subject-out at (K, lambda, mirror): the held-out log-loss summed
+// over the recorded samples and the number classified correctly.
 void LeaveOneSubjectOut(const Eigen::MatrixXd& K, const ClassifierSamples& cs, int num_subjects,
-                        int C, const TrainParams& params, double lambda, double* loss,
+                        int C, const TrainParams& params, double lambda, bool mirror, double* loss,
                         int* correct) {
-  const int N = static_cast<int>(cs.windows.size());
   for (int fold = 0; fold < num_subjects; ++fold) {
-    std::vector<int> tr, te;
-    for (int i = 0; i < N; ++i) (cs.subject[i] == fold ? te : tr).push_back(i);
+    const std::vector<int> tr = TrainingRows(cs, fold, mirror);
+    std::vector<int> te;
+    for (int i = 0; i < cs.num_recorded; ++i) {
+      if (cs.subject[i] == fold) te.push_back(i);
+    }
     if (te.empty() || tr.empty()) continue;
     const IvmModel ivm = FitIvmOnRows(K, cs, tr, C, params, lambda);
     const Eigen::MatrixXd P = PredictRows(ivm, K, tr, te);
@@ -132,33 +172,39 @@ void LeaveOneSubjectOut(const Eigen::MatrixXd& K, const ClassifierSamples& cs, i
 struct KernelChoice {
   double sigma = 0.0;
   double lambda = 0.0;
+  bool mirror = false;  // trained on the mirror images too
 };
 
-// ---- Cross-validation over (sigma, lambda), leave-one-subject-out. ----
-// Without two subjects or a grid, the middle of the grids.
+// ---- Cross-validation over (mirror, sigma, lambda), leave-one-subject-out. ----
+// Without two subjects or a grid, the middle of the grids and the first
+// mirror entry.
 KernelChoice ChooseKernel(const ClassifierSamples& cs, const Eigen::MatrixXd& Dm, double median,
-                          int num_subjects, int C, const TrainParams& params, TrainReport* rep) {
-  const int N = static_cast<int>(cs.windows.size());
+                          const std::vector<bool>& mirror_grid, int num_subjects, int C,
+                          const TrainParams& params, TrainReport* rep) {
+  const int N = cs.num_recorded;
   double best_loss = std::numeric_limits<double>::infinity();
   KernelChoice best;
   best.sigma = params.sigma_factors[params.sigma_factors.size() / 2] * median;
   best.lambda = params.lambdas[params.lambdas.size() / 2];
-  if (num_subjects < 2 || (params.sigma_factors.size() <= 1 && params.lambdas.size() <= 1)) {
+  best.mirror = mirror_grid.front();
+  if (num_subjects < 2 ||
+      (params.sigma_factors.size() <= 1 && params.lambdas.size() <= 1 && mirror_grid.size() <= 1)) {
     return best;
   }
-  for (double sf : params.sigma_factors) {
-    const double sigma = sf * median;
-    const Eigen::MatrixXd K = KernelFromDtw(Dm, sigma);
-    for (double lambda : params.lambdas) {
-      double loss = 0.0;
-      int correct = 0;
-      LeaveOneSubjectOut(K, cs, num_subjects, C, params, lambda, &loss, &correct);
-      loss /= N;
-      rep->cv_table.push_back({sigma, lambda, loss, static_cast<double>(correct) / N});
-      if (loss < best_loss) {
-        best_loss = loss;
-        best.sigma = sigma;
-        best.lambda = lambda;
+  for (const bool mirror : mirror_grid) {
+    for (double sf : params.sigma_factors) {
+      const double sigma = sf * median;
+      const Eigen::MatrixXd K = KernelFromDtw(Dm, sigma);
+      for (double lambda : params.lambdas) {
+        double loss = 0.0;
+        int correct = 0;
+        LeaveOneSubjectOut(K, cs, num_subjects, C, params, lambda, mirror, &loss, &correct);
+        loss /= N;
+        rep->cv_table.push_back({mirror ? 1.0 : 0.0, sigma, lambda, loss, static_cast<double>(correct) / N});
+        if (loss < best_loss) {
+          best_loss = loss;
+          best = {sigma, lambda, mirror};
+        }
       }
     }
   }
@@ -177,15 +223,13 @@ HeldOutFrames HeldOutFrameProbabilities(const TrainingGroups& g, const Classifie
                                         const FeatureLayout& layout,
                                         const IntentModelConfig& config,
                                         const TrainParams& params) {
-  const int N = static_cast<int>(cs.windows.size());
   const int C = g.num_actions;
   HeldOutFrames h;
   h.probs.resize(g.tracks.size());
   h.motion.resize(g.tracks.size());
   std::vector<double> ws;
   for (int fold = 0; fold < g.num_subjects; ++fold) {
-    std::vector<int> tr;
-    for (int i = 0; i < N; ++i) if (cs.subject[i] != fold) tr.push_back(i);
+    const std::vector<int> tr = TrainingRows(cs, fold, kc.mirror);
     if (tr.empty()) continue;
     const IvmModel ivm = FitIvmOnRows(K, cs, tr, C, params, kc.lambda);
     const Eigen::Index q = ivm.import_index.size();
@@ -217,6 +261,7 @@ HeldOutFrames HeldOutFrameProbabilities(const TrainingGroups& g, const Classifie
 struct CvScore {
   double loss = 0.0;
   double accuracy = 0.0;
+  std::vector<double> accuracy_by_prefix;  // per prefix fraction
 };
 
 // The belief filter (tau, motion_weighted) run over every frame of the
@@ -228,25 +273,35 @@ CvScore ScoreBeliefFilter(const TrainingGroups& g, const HeldOutFrames& h, doubl
                       BeliefFilterParams{tau, params.belief_min_probability, motion_weighted});
   double loss = 0.0;
   int correct = 0, count = 0;
+  const size_t F = params.prefix_fractions.size();
+  std::vector<double> prefix_correct(F, 0.0), prefix_count(F, 0.0);
   for (size_t ti = 0; ti < g.tracks.size(); ++ti) {
     const Eigen::MatrixXd& P = h.probs[ti];
     if (P.rows() == 0) continue;
-    const int n = static_cast<int>(P.rows());
-    const int truth = g.action_id.at(g.tracks[ti].action);
-    const std::set<int> ends = PrefixEnds(n, params.prefix_fractions);
+    std::map<int, std::vector<int>> ends;  // row -> its prefix fractions
+    for (const auto& [e, i] : PrefixEndList(g.tracks[ti], params.prefix_fractions)) ends[e].push_back(i);
     filter.Reset();
-    for (int e = 0; e <= *ends.rbegin(); ++e) {
+    for (int e = 0; e <= ends.rbegin()->first; ++e) {
       if (e + 1 < config.window) filter.Reset();  // partial window: see BeliefFilter
       filter.Update(P.row(e).transpose(), e / config.rate,
                     motion_weighted ? std::max(h.motion[ti](e), 1e-6) : 1.0);
-      if (ends.count(e) == 0) continue;
+      const auto it = ends.find(e);
+      if (it == ends.end()) continue;
+      const int truth = g.action_id.at(ActionAt(g.tracks[ti], e));
       loss -= std::log(std::max(filter.probabilities()(truth), 1e-12));
-      if (filter.MostLikely() == truth) ++correct;
+      const bool right = filter.MostLikely() == truth;
+      if (right) ++correct;
       ++count;
+      for (int i : it->second) {
+        prefix_correct[i] += right ? 1.0 : 0.0;
+        prefix_count[i] += 1.0;
+      }
     }
   }
   loss /= std::max(1, count);
-  return {loss, static_cast<double>(correct) / std::max(1, count)};
+  CvScore score{loss, static_cast<double>(correct) / std::max(1, count), {}};
+  for (size_t i = 0; i < F; ++i) score.accuracy_by_prefix.push_back(prefix_correct[i] / std::max(1.0, prefix_count[i]));
+  return score;
 }
 
 // ---- Belief filter time constant, leave-one-subject-out at (sigma, lambda). ----
@@ -272,6 +327,7 @@ void ChooseBeliefFilter(const TrainingGroups& g, const ClassifierSamples& cs,
       best_belief_loss = score.loss;
       belief->time_constant = tau;
       belief->motion_weighted = motion_weighted;
+      rep->belief_cv_accuracy_by_prefix = score.accuracy_by_prefix;
     }
   }
 }
@@ -281,26 +337,34 @@ void ChooseBeliefFilter(const TrainingGroups& g, const ClassifierSamples& cs,
 void TrainClassifier(const TrainingGroups& groups, const FeatureLayout& layout,
                      const IntentModelConfig& config, const TrainParams& params,
                      ActionClassifier* classifier, TrainReport* rep) {
-  const ClassifierSamples cs = MakeClassifierSamples(groups, layout, config, params);
+  // Mirror images are a candidate only when the joint set can be mirrored
+  // and there is a cross-validation to decide.
+  std::vector<bool> mirror_grid;
+  for (const bool m : params.mirror_augmentation) {
+    if (!m || (layout.CanMirror() && groups.num_subjects >= 2)) mirror_grid.push_back(m);
+  }
+  if (mirror_grid.empty()) mirror_grid.push_back(false);
+  const bool any_mirror = std::find(mirror_grid.begin(), mirror_grid.end(), true) != mirror_grid.end();
+  const ClassifierSamples cs = MakeClassifierSamples(groups, layout, config, params, any_mirror);
   const Eigen::MatrixXd Dm = DtwMatrix(cs.windows, config.dtw_band);
-  const double median = MedianDtw(Dm);
+  const double median = MedianDtw(Dm.topLeftCorner(cs.num_recorded, cs.num_recorded));
   rep->median_dtw = median;
-  rep->num_classifier_samples = static_cast<int>(cs.windows.size());
+  rep->num_classifier_samples = cs.num_recorded;
 
   const KernelChoice kc =
-      ChooseKernel(cs, Dm, median, groups.num_subjects, groups.num_actions, params, rep);
+      ChooseKernel(cs, Dm, median, mirror_grid, groups.num_subjects, groups.num_actions, params, rep);
   {
-    IvmParams ip = params.ivm;
-    ip.lambda = kc.lambda;
     const Eigen::MatrixXd K = KernelFromDtw(Dm, kc.sigma);
+    const std::vector<int> rows = TrainingRows(cs, -1, kc.mirror);
     classifier->sigma = kc.sigma;
-    classifier->ivm = FitIvm(K, cs.labels, groups.num_actions, ip);
+    classifier->ivm = FitIvmOnRows(K, cs, rows, groups.num_actions, params, kc.lambda);
     for (Eigen::Index s = 0; s < classifier->ivm.import_index.size(); ++s) {
-      classifier->import_windows.push_back(cs.windows[classifier->ivm.import_index(s)]);
+      classifier->import_windows.push_back(cs.windows[rows[classifier->ivm.import_index(s)]]);
     }
   }
   rep->sigma = kc.sigma;
   rep->lambda = kc.lambda;
+  rep->mirror_augmentation = kc.mirror;
 
   ChooseBeliefFilter(groups, cs, Dm, kc, layout, config, params, &classifier->belief, rep);
   rep->belief_time_constant = classifier->belief.time_constant;

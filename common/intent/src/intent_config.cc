@@ -14,6 +14,10 @@ std::string IntentModelConfig::Validate() const {
   if (window < 2) return "window " + std::to_string(window) + " must be >= 2";
   if (horizon < 1) return "horizon " + std::to_string(horizon) + " must be >= 1";
   if (velocity_frames < 1) return "velocity_frames " + std::to_string(velocity_frames) + " must be >= 1";
+  if (history_samples < 0 || history_samples >= window) {
+    return "history_samples " + std::to_string(history_samples) + " must be in [0, window - 1 = " +
+           std::to_string(window - 1) + "]";
+  }
   if (dtw_band < 0) return "dtw_band " + std::to_string(dtw_band) + " must be >= 0";
   if (!(sensor_noise_std >= 0.0)) return "sensor_noise_std must be >= 0";
   if (!(features.torso_motion_weight >= 0.0)) return "features.torso_motion_weight must be >= 0";
@@ -29,6 +33,7 @@ std::string TrainParams::Validate() const {
   if (sigma_factors.empty() || lambdas.empty()) return "sigma_factors and lambdas must not be empty";
   for (double s : sigma_factors) if (!(s > 0.0)) return "sigma factor " + std::to_string(s) + " must be > 0";
   for (double l : lambdas) if (!(l > 0.0)) return "lambda " + std::to_string(l) + " must be > 0";
+  if (mirror_augmentation.empty()) return "mirror_augmentation is empty";
   if (belief_time_constants.empty()) return "belief_time_constants is empty";
   if (belief_motion_weighting.empty()) return "belief_motion_weighting is empty";
   for (double t : belief_time_constants) {

@@ -15,6 +15,7 @@
 
 #include "intent_training.h"
 #include "iplan/intent/forecast_calibration.h"
+#include "iplan/intent/model_selection.h"
 
 namespace iplan::intent::detail {
 namespace {
@@ -59,7 +60,7 @@ void ForecastData(const std::vector<ForecastSample>& samples, const FeatureLayou
   const int N = static_cast<int>(samples.size());
   const int J = layout.num_joints();
   const int H = config.horizon;
-  X->resize(N, layout.forecast_input_size());
+  X->resize(N, layout.forecast_input_size(config.history_samples));
   Y->resize(N, H * 3 * J);
   if (speeds != nullptr) speeds->resize(N, J);
   Eigen::MatrixXd base;
@@ -67,7 +68,7 @@ void ForecastData(const std::vector<ForecastSample>& samples, const FeatureLayou
   for (int i = 0; i < N; ++i) {
     const Track& t = *samples[i].track;
     const Eigen::MatrixXd window = WindowEndingAt(t.positions, samples[i].end, config.window);
-    X->row(i) = layout.ForecastInput(window, config.rate, config.velocity_frames).transpose();
+    X->row(i) = layout.ForecastInput(window, config.rate, config.velocity_frames, config.history_samples).transpose();
     ExtrapolateKinematic(window, baseline, config.rate, H, &base);
     const Eigen::MatrixXd future = Future(t, samples[i].end, H);
     for (int k = 0; k < H; ++k) Y->block(i, k * 3 * J, 1, 3 * J) = future.row(k) - base.row(k);
@@ -86,14 +87,16 @@ ActionForecaster FitForecaster(const Eigen::MatrixXd& X, const Eigen::MatrixXd& 
   fc.input_mean = X.colwise().mean().transpose();
   fc.input_scale = ((X.rowwise() - fc.input_mean.transpose()).colwise().squaredNorm() / Ns)
                        .cwiseSqrt().transpose();
+  // One scale for every output (their overall standard deviation): the
+  // outputs share the SPGP's hyperparameters, and in common units the
+  // likelihood is fitted to the joints and steps that move most, not
+  // equally to the still ones, whose residual is sensor noise.
   fc.output_mean = Y.colwise().mean().transpose();
-  fc.output_scale = ((Y.rowwise() - fc.output_mean.transpose()).colwise().squaredNorm() / Ns)
-                        .cwiseSqrt().transpose();
+  const double spread = std::sqrt((Y.rowwise() - fc.output_mean.transpose()).squaredNorm() /
+                                  static_cast<double>(Ns * Y.cols()));
+  fc.output_scale = Eigen::VectorXd::Constant(Y.cols(), std::max(spread, 1e-9));
   for (Eigen::Index d = 0; d < fc.input_scale.size(); ++d) {
     if (!(fc.input_scale(d) > 1e-9)) fc.input_scale(d) = 1.0;
-  }
-  for (Eigen::Index d = 0; d < fc.output_scale.size(); ++d) {
-    if (!(fc.output_scale(d) > 1e-9)) fc.output_scale(d) = 1e-9;
   }
   const Eigen::MatrixXd Xs = (X.rowwise() - fc.input_mean.transpose()) *
                              fc.input_scale.cwiseInverse().asDiagonal();
@@ -162,63 +165,90 @@ void CalibrateForecast(const std::vector<Eigen::RowVectorXd>& r_true,
   rep->variance_scale_median = Quantile(sv, 0.5);
 }
 
-// The (L, tau) of the grids with the lowest mean joint error of the
-// extrapolation alone over all samples; fills the report's table.
-KinematicBaseline ChooseBaseline(const std::vector<std::vector<ForecastSample>>& samples,
-                                 const IntentModelConfig& config, const TrainParams& params,
-                                 TrainReport* rep) {
+// The per-fold mean joint error (options, folds; NaN where a fold has no
+// window) of holding the last pose (option 0) and of every (L, tau) of the
+// grids (option 1 + l * taus + t), over all samples.
+Eigen::MatrixXd BaselineFoldErrors(const std::vector<std::vector<ForecastSample>>& samples,
+                                   const std::vector<int>& frames, const std::vector<double>& taus,
+                                   int num_folds, const IntentModelConfig& config) {
   const int H = config.horizon;
   const int J = static_cast<int>(config.joints.joints.size());
+  const int nt = static_cast<int>(taus.size());
+  Eigen::MatrixXd sum = Eigen::MatrixXd::Zero(1 + frames.size() * taus.size(), std::max(1, num_folds));
+  Eigen::VectorXd count = Eigen::VectorXd::Zero(sum.cols());
+  Eigen::VectorXd g(H), p, v;
+  for (const std::vector<ForecastSample>& action : samples) {
+    for (const ForecastSample& smp : action) {
+      const int f = std::min(smp.fold, static_cast<int>(sum.cols()) - 1);
+      const Eigen::MatrixXd window = WindowEndingAt(smp.track->positions, smp.end, config.window);
+      const Eigen::MatrixXd future = Future(*smp.track, smp.end, H);
+      for (int k = 0; k < H; ++k) {
+        for (int j = 0; j < J; ++j) {
+          sum(0, f) += (future.block<1, 3>(k, 3 * j) - window.block<1, 3>(window.rows() - 1, 3 * j)).norm();
+        }
+      }
+      for (size_t l = 0; l < frames.size(); ++l) {
+        FitLine(window, frames[l], config.rate, &p, &v);
+        for (int ti = 0; ti < nt; ++ti) {
+          for (int k = 0; k < H; ++k) g(k) = DampedDisplacement((k + 1) / config.rate, taus[ti]);
+          double e = 0.0;
+          for (int k = 0; k < H; ++k) {
+            for (int j = 0; j < J; ++j) {
+              e += (future.row(k).segment<3>(3 * j).transpose() - p.segment<3>(3 * j) - g(k) * v.segment<3>(3 * j))
+                       .norm();
+            }
+          }
+          sum(1 + static_cast<Eigen::Index>(l) * nt + ti, f) += e;
+        }
+      }
+      count(f) += static_cast<double>(H) * J;
+    }
+  }
+  for (Eigen::Index f = 0; f < sum.cols(); ++f) {
+    sum.col(f) /= count(f) > 0 ? count(f) : std::numeric_limits<double>::quiet_NaN();
+  }
+  return sum;
+}
+
+// The (L, tau) of the grids for the extrapolation alone (nothing is fitted):
+// the lowest mean joint error over all samples, unless holding the last pose
+// is within one standard error of it across the folds (then L = 1); fills
+// the report's table.
+KinematicBaseline ChooseBaseline(const std::vector<std::vector<ForecastSample>>& samples, int num_folds,
+                                 const IntentModelConfig& config, const TrainParams& params,
+                                 TrainReport* rep) {
   std::vector<int> frames;
   for (int L : params.baseline_smoothing_frames) {
     if (L <= config.window) frames.push_back(L);
   }
   if (frames.empty()) frames.push_back(1);
   const std::vector<double>& taus = params.baseline_damping_time_constants;
-  Eigen::MatrixXd error = Eigen::MatrixXd::Zero(frames.size(), taus.size());
-  Eigen::VectorXd g(H), p, v;
-  long count = 0;
-  double hold = 0.0;
-  for (const std::vector<ForecastSample>& action : samples) {
-    for (const ForecastSample& smp : action) {
-      const Eigen::MatrixXd window = WindowEndingAt(smp.track->positions, smp.end, config.window);
-      const Eigen::MatrixXd future = Future(*smp.track, smp.end, H);
-      for (int k = 0; k < H; ++k) {
-        for (int j = 0; j < J; ++j) {
-          hold += (future.block<1, 3>(k, 3 * j) - window.block<1, 3>(window.rows() - 1, 3 * j)).norm();
-        }
-      }
-      for (size_t l = 0; l < frames.size(); ++l) {
-        FitLine(window, frames[l], config.rate, &p, &v);
-        for (size_t ti = 0; ti < taus.size(); ++ti) {
-          for (int k = 0; k < H; ++k) g(k) = DampedDisplacement((k + 1) / config.rate, taus[ti]);
-          double sum = 0.0;
-          for (int k = 0; k < H; ++k) {
-            for (int j = 0; j < J; ++j) {
-              sum += (future.row(k).segment<3>(3 * j).transpose() - p.segment<3>(3 * j) -
-                      g(k) * v.segment<3>(3 * j)).norm();
-            }
-          }
-          error(l, ti) += sum;
-        }
-      }
-      ++count;
-    }
+  const Eigen::MatrixXd fold_error = BaselineFoldErrors(samples, frames, taus, num_folds, config);
+  // Overall means (every window weighs the same).
+  Eigen::VectorXd weight = Eigen::VectorXd::Zero(fold_error.cols());
+  for (const auto& action : samples) {
+    for (const ForecastSample& smp : action) weight(std::min<Eigen::Index>(smp.fold, weight.size() - 1)) += 1.0;
   }
-  const double denom = static_cast<double>(std::max<long>(1, count)) * H * J;
-  error /= denom;
-  rep->error_const_position = hold / denom;
-  Eigen::Index bl = 0, bt = 0;
-  error.minCoeff(&bl, &bt);
+  const Eigen::VectorXd error = fold_error.unaryExpr([](double x) { return std::isfinite(x) ? x : 0.0; }) * weight /
+                                std::max(1.0, weight.sum());
+  rep->error_const_position = error(0);
+  const int nt = static_cast<int>(taus.size());
   for (size_t l = 0; l < frames.size(); ++l) {
-    for (size_t ti = 0; ti < taus.size(); ++ti) {
-      rep->baseline_table.push_back({static_cast<double>(frames[l]), taus[ti], error(l, ti)});
+    for (int ti = 0; ti < nt; ++ti) {
+      rep->baseline_table.push_back({static_cast<double>(frames[l]), taus[ti], error(1 + l * nt + ti)});
     }
   }
+  Eigen::Index best = 0;
+  error.tail(error.size() - 1).minCoeff(&best);
+  ++best;
+  Eigen::MatrixXd two(2, fold_error.cols());
+  two << fold_error.row(0), fold_error.row(best);
   KinematicBaseline b;
-  b.smoothing_frames = frames[bl];
-  // L = 1 has no velocity: any tau is the same; store 0.
-  b.damping_time_constant = frames[bl] == 1 ? 0.0 : taus[bt];
+  if (SimplestWithinOneStandardError(two) == 1) {
+    b.smoothing_frames = frames[(best - 1) / nt];
+    // L = 1 has no velocity: any tau is the same; store 0.
+    b.damping_time_constant = b.smoothing_frames == 1 ? 0.0 : taus[(best - 1) % nt];
+  }
   rep->baseline = b;
   return b;
 }
@@ -247,10 +277,10 @@ std::vector<std::vector<ForecastSample>> MakeForecastSamples(const TrainingGroup
   for (int c = 0; c < C; ++c) {
     std::vector<ForecastSample> full, padded;
     for (const Track& t : g.tracks) {
-      if (g.action_id.at(t.action) != c) continue;
       const int n = static_cast<int>(t.positions.rows());
       const int fold = group_id.at(num_subjects >= 2 ? t.subject : t.sequence_id) % std::max(1, *num_folds);
       for (int e = 0; e < n; e += params.forecast_stride) {
+        if (g.action_id.at(ActionAt(t, e)) != c) continue;  // the action being done at the window's end
         (e + H <= n - 1 ? full : padded).push_back({&t, e, fold});
       }
     }
@@ -291,6 +321,7 @@ Eigen::VectorXd ReferenceSpeeds(const std::vector<std::vector<ForecastSample>>& 
 // the window speeds.
 struct HeldOutResiduals {
   std::vector<Eigen::RowVectorXd> r_true, r_pred, r_var, r_speed;
+  std::vector<int> fold;
 };
 
 // Per action and fold an SPGP fitted without the fold predicts it.
@@ -316,39 +347,46 @@ HeldOutResiduals CrossValidateResiduals(const std::vector<std::vector<ForecastSa
         h.r_pred.push_back(mean.transpose());
         h.r_var.push_back(var.transpose());
         h.r_speed.push_back(Ut.row(i));
+        h.fold.push_back(f);
       }
     }
   }
   return h;
 }
 
-// The residual weight of the grid with the lowest held-out mean joint error
-// over all steps; fills the report's table. `h` is not empty.
+// The residual weight: of the grid's weights whose held-out mean joint error
+// over all steps is within one standard error (across the folds) of the
+// lowest, the smallest; fills the report's table. `h` is not empty.
 double ChooseResidualWeight(const HeldOutResiduals& h, const IntentModelConfig& config,
-                            const TrainParams& params, int J, TrainReport* rep) {
+                            const TrainParams& params, int num_folds, int J, TrainReport* rep) {
   const int H = config.horizon;
   const Eigen::Index Nh = static_cast<Eigen::Index>(h.r_true.size());
   const int k_half = std::clamp(static_cast<int>(std::lround(0.5 * config.rate)) - 1, 0, H - 1);
-  double best_error = std::numeric_limits<double>::infinity();
-  double best_w = 1.0;
-  for (double w : params.residual_weights) {
+  std::vector<double> weights = params.residual_weights;
+  std::sort(weights.begin(), weights.end());
+  Eigen::MatrixXd fold_error = Eigen::MatrixXd::Zero(weights.size(), num_folds);
+  Eigen::VectorXd fold_count = Eigen::VectorXd::Zero(num_folds);
+  for (int f : h.fold) fold_count(f) += static_cast<double>(H) * J;
+  for (size_t wi = 0; wi < weights.size(); ++wi) {
+    const double w = weights[wi];
     Eigen::VectorXd per_step = Eigen::VectorXd::Zero(H);
     for (Eigen::Index i = 0; i < Nh; ++i) {
       for (int k = 0; k < H; ++k) {
         for (int j = 0; j < J; ++j) {
           const int o = (k * J + j) * 3;
-          per_step(k) += (h.r_true[i].segment<3>(o) - w * h.r_pred[i].segment<3>(o)).norm();
+          const double e = (h.r_true[i].segment<3>(o) - w * h.r_pred[i].segment<3>(o)).norm();
+          per_step(k) += e;
+          fold_error(static_cast<Eigen::Index>(wi), h.fold[i]) += e;
         }
       }
     }
     per_step /= static_cast<double>(Nh * J);
     rep->residual_cv_table.push_back({w, per_step(k_half), per_step(H - 1), per_step.mean()});
-    if (per_step.mean() < best_error) {
-      best_error = per_step.mean();
-      best_w = w;
-    }
   }
-  return best_w;
+  for (int f = 0; f < num_folds; ++f) {
+    fold_error.col(f) /= fold_count(f) > 0 ? fold_count(f) : std::numeric_limits<double>::quiet_NaN();
+  }
+  return weights[SimplestWithinOneStandardError(fold_error)];
 }
 
 }  // namespace
@@ -362,7 +400,7 @@ void TrainForecasters(const TrainingGroups& groups, const FeatureLayout& layout,
   int num_folds = 0;
   const std::vector<std::vector<ForecastSample>> samples =
       MakeForecastSamples(groups, config, params, model->actions, &num_folds, rep);
-  model->forecast.baseline = ChooseBaseline(samples, config, params, rep);
+  model->forecast.baseline = ChooseBaseline(samples, num_folds, config, params, rep);
   model->forecast.reference_speed = ReferenceSpeeds(samples, config, J);
 
   model->forecast.residual_weight = 1.0;
@@ -372,7 +410,7 @@ void TrainForecasters(const TrainingGroups& groups, const FeatureLayout& layout,
         CrossValidateResiduals(samples, num_folds, layout, config, params, model->forecast.baseline);
     rep->forecast_cv_windows = static_cast<int>(h.r_true.size());
     if (!h.r_true.empty()) {
-      model->forecast.residual_weight = ChooseResidualWeight(h, config, params, J, rep);
+      model->forecast.residual_weight = ChooseResidualWeight(h, config, params, num_folds, J, rep);
       if (params.calibrate_covariance) {
         CalibrateForecast(h.r_true, h.r_pred, h.r_var, h.r_speed, config, params, &model->forecast, rep);
       }

@@ -52,7 +52,10 @@ IntentModel TrainIntentModel(const SkeletonDataset& data, const IntentModelConfi
   IntentModel model;
   model.config = config;
   std::set<std::string> action_set;
-  for (const Track& t : tracks) action_set.insert(t.action);
+  for (const Track& t : tracks) {
+    if (t.frame_actions.empty()) action_set.insert(t.action);
+    action_set.insert(t.frame_actions.begin(), t.frame_actions.end());
+  }
   model.actions.assign(action_set.begin(), action_set.end());
   if (model.actions.size() < 2) {
     throw std::invalid_argument("TrainIntentModel: need at least two actions, got " +

@@ -102,8 +102,8 @@ void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
   out->horizon = H;
   out->num_joints = J;
   out->actions.resize(C);
-  const Eigen::VectorXd x = layout.ForecastInput(padded, model.config.rate,
-                                                 model.config.velocity_frames);
+  const Eigen::VectorXd x = layout.ForecastInput(padded, model.config.rate, model.config.velocity_frames,
+                                                 model.config.history_samples);
   Eigen::MatrixXd base;
   ExtrapolateKinematic(padded, model.forecast.baseline, model.config.rate, H, &base);
   const double noise = model.config.sensor_noise_std * model.config.sensor_noise_std;

@@ -154,6 +154,7 @@ std::string SerializeIntentModel(const IntentModel& m) {
   w.F64(c.sensor_noise_std);
   w.F64(c.features.torso_motion_weight);
   w.I64(c.features.normalise_body_size ? 1 : 0);
+  w.I64(c.history_samples);  // version 4
   WriteStrings(&w, m.actions);
   w.F64(m.classifier.sigma);
   w.U64(m.classifier.import_windows.size());
@@ -225,7 +226,7 @@ std::uint32_t OpenPayload(const std::string& bytes, const std::string& source, s
   return version;
 }
 
-void ReadConfig(Reader* r, IntentModelConfig* c) {
+void ReadConfig(Reader* r, std::uint32_t version, IntentModelConfig* c) {
   c->joints.joints = ReadStrings(r);
   c->joints.torso = ReadStrings(r);
   c->joints.hands = ReadStrings(r);
@@ -244,6 +245,8 @@ void ReadConfig(Reader* r, IntentModelConfig* c) {
   c->sensor_noise_std = r->F64();
   c->features.torso_motion_weight = r->F64();
   c->features.normalise_body_size = r->I64() != 0;
+  // Before version 4 the forecaster had no history inputs.
+  c->history_samples = version >= 4 ? static_cast<int>(r->I64()) : 0;
   const std::string config_error = c->Validate();
   if (!config_error.empty()) r->Fail("configuration: " + config_error);
 }
@@ -277,7 +280,8 @@ std::uint64_t ReadClassifier(Reader* r, const FeatureLayout& layout, IntentModel
   return nf;
 }
 
-ActionForecaster ReadForecaster(Reader* r, const FeatureLayout& layout, Eigen::Index P, std::uint64_t i) {
+ActionForecaster ReadForecaster(Reader* r, const FeatureLayout& layout, int history_samples, Eigen::Index P,
+                                std::uint64_t i) {
   ActionForecaster f;
   f.input_mean = r->Vec();
   f.input_scale = r->Vec();
@@ -291,7 +295,7 @@ ActionForecaster ReadForecaster(Reader* r, const FeatureLayout& layout, Eigen::I
   h.log_noise_variance = r->F64();
   Eigen::MatrixXd alpha = r->Mat();
   Eigen::MatrixXd corr = r->Mat();
-  if (f.input_mean.size() != layout.forecast_input_size() || f.input_scale.size() != f.input_mean.size() ||
+  if (f.input_mean.size() != layout.forecast_input_size(history_samples) || f.input_scale.size() != f.input_mean.size() ||
       f.output_mean.size() != P || f.output_scale.size() != P || h.pseudo_inputs.cols() != f.input_mean.size() ||
       alpha.cols() != P) {
     r->Fail("forecaster " + std::to_string(i) + " sizes do not match the configuration");
@@ -329,12 +333,14 @@ IntentModel DeserializeIntentModel(const std::string& bytes, const std::string& 
   const std::uint32_t version = OpenPayload(bytes, source, &size);
   Reader r(bytes.data() + sizeof(kMagic) + 4 + 8, size, source);
   IntentModel m;
-  ReadConfig(&r, &m.config);
+  ReadConfig(&r, version, &m.config);
   const IntentModelConfig& c = m.config;
   const FeatureLayout layout(c.joints, c.features);
   const std::uint64_t nf = ReadClassifier(&r, layout, &m);
   const Eigen::Index P = static_cast<Eigen::Index>(c.horizon) * 3 * layout.num_joints();
-  for (std::uint64_t i = 0; i < nf; ++i) m.forecasters.push_back(ReadForecaster(&r, layout, P, i));
+  for (std::uint64_t i = 0; i < nf; ++i) {
+    m.forecasters.push_back(ReadForecaster(&r, layout, c.history_samples, P, i));
+  }
   ReadForecastSettings(&r, version, &m.forecast);
   if (const std::string why = m.forecast.Validate(c.horizon, layout.num_joints()); !why.empty()) {
     r.Fail("forecast settings: " + why);

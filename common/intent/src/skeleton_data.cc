@@ -240,6 +240,10 @@ std::vector<int> JointIndices(const std::vector<std::string>& joint_names,
   return index;
 }
 
+const std::string& ActionAt(const Track& track, int row) {
+  return track.frame_actions.empty() ? track.action : track.frame_actions.at(static_cast<size_t>(row));
+}
+
 std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
                                     const std::vector<int>& joint_index,
                                     double rate, double max_gap) {
@@ -249,6 +253,19 @@ std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
                                 std::to_string(max_gap) + " must be positive");
   }
   const int num_out = static_cast<int>(joint_index.size());
+  const bool has_reaching = sequence.reaching.size() > 0;
+  if (has_reaching && (sequence.reaching.rows() != sequence.time.size() ||
+                       sequence.reaching.cols() * 3 != sequence.positions.cols())) {
+    throw std::invalid_argument("ResampleSequence: sequence " + sequence.id + " has reaching flags of " +
+                                std::to_string(sequence.reaching.rows()) + " x " +
+                                std::to_string(sequence.reaching.cols()) + ", not frames x joints");
+  }
+  const bool has_actions = !sequence.frame_actions.empty();
+  if (has_actions && static_cast<Eigen::Index>(sequence.frame_actions.size()) != sequence.time.size()) {
+    throw std::invalid_argument("ResampleSequence: sequence " + sequence.id + " has " +
+                                std::to_string(sequence.frame_actions.size()) + " frame actions for " +
+                                std::to_string(sequence.time.size()) + " frames");
+  }
   // Frames where every selected joint was detected.
   std::vector<int> valid;
   for (int i = 0; i < sequence.time.size(); ++i) {
@@ -276,6 +293,8 @@ std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
     track.subject = sequence.subject;
     track.action = sequence.action;
     track.positions.resize(count, 3 * num_out);
+    if (has_reaching) track.reaching.resize(count, num_out);
+    if (has_actions) track.frame_actions.resize(count);
     int k = begin;
     for (int i = 0; i < count; ++i) {
       const double t = t0 + i / rate;
@@ -288,7 +307,9 @@ std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
         track.positions.block<1, 3>(i, 3 * j) =
             (1.0 - u) * sequence.positions.block<1, 3>(valid[k], c) +
             u * sequence.positions.block<1, 3>(valid[k1], c);
+        if (has_reaching) track.reaching(i, j) = sequence.reaching(valid[u < 0.5 ? k : k1], joint_index[j]);
       }
+      if (has_actions) track.frame_actions[i] = sequence.frame_actions[valid[u < 0.5 ? k : k1]];
     }
     tracks.push_back(std::move(track));
     begin = end;

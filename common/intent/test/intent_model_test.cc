@@ -168,10 +168,10 @@ TEST_F(IntentModelTest, CorruptAndMismatchedFilesAreRefused) {
   std::string other_version = good;
   other_version[8] = 99;  // version field follows the 8-byte magic
   write(Path("version.bin"), other_version);
-  ExpectLoadFails(Path("version.bin"), {}, "format version 99, but this build reads versions 2 to 3");
+  ExpectLoadFails(Path("version.bin"), {}, "format version 99, but this build reads versions 2 to 4");
   other_version[8] = 1;
   write(Path("version1.bin"), other_version);
-  ExpectLoadFails(Path("version1.bin"), {}, "format version 1, but this build reads versions 2 to 3");
+  ExpectLoadFails(Path("version1.bin"), {}, "format version 1, but this build reads versions 2 to 4");
 
   write(Path("good.bin"), good);
   ModelExpectation joints;
@@ -198,16 +198,29 @@ TEST_F(IntentModelTest, EvalJsonHasTheDocumentedKeys) {
   }
 }
 
-// The file a format-2 build wrote for `m`: format 3 without the forecast
+// Bytes of the configuration at the start of the payload up to and without
+// the history_samples field that format 4 added (model_io.cc, SerializeIntentModel).
+size_t ConfigBytesBeforeHistory(const IntentModel& m) {
+  size_t n = 0;
+  for (const auto* names : {&m.config.joints.joints, &m.config.joints.torso, &m.config.joints.hands}) {
+    n += 8;
+    for (const std::string& s : *names) n += 8 + s.size();
+  }
+  n += 8 + m.config.joints.objects.size() * (16 + 3 * 8);
+  return n + 8 * 8;  // rate, window, horizon, velocity_frames, band, noise, torso weight, normalise
+}
+
+// The file a format-2 or format-3 build wrote for `m` (history_samples 0):
+// format 4 without history_samples, format 2 also without the forecast
 // settings that close the payload (model_io.h), version and checksum redone.
-std::string AsFormat2(const IntentModel& m) {
-  const std::string v3 = SerializeIntentModel(m);
+std::string AsOldFormat(const IntentModel& m, std::uint32_t version) {
+  const std::string v4 = SerializeIntentModel(m);
   const size_t header = 8 + 4 + 8;
   const size_t settings = 8 + 8 + 8 + (16 + 8 * m.forecast.variance_scale.size()) + 8 +
                           (16 + 8 * m.forecast.reference_speed.size());
-  const std::string payload = v3.substr(header, v3.size() - header - 8 - settings);
-  std::string out = v3.substr(0, 8);
-  const std::uint32_t version = 2;
+  std::string payload = v4.substr(header, v4.size() - header - 8 - (version == 2 ? settings : 0));
+  payload.erase(ConfigBytesBeforeHistory(m), 8);
+  std::string out = v4.substr(0, 8);
   const std::uint64_t size = payload.size(), sum = core::Fnv1a64(payload, core::kIplanFnvSeed);
   out.append(reinterpret_cast<const char*>(&version), 4);
   out.append(reinterpret_cast<const char*>(&size), 8);
@@ -216,11 +229,13 @@ std::string AsFormat2(const IntentModel& m) {
   return out;
 }
 
-TEST_F(IntentModelTest, ForecastSettingsRoundTripAndFormat2FilesStillLoad) {
+TEST_F(IntentModelTest, ForecastSettingsRoundTripAndFormat2And3FilesStillLoad) {
   // The trained model uses the new settings (chosen on the training data).
   const IntentModel& m = *model_;
   ASSERT_EQ(m.forecast.variance_scale.size(), 5 * 6);
-  const IntentModel loaded = DeserializeIntentModel(SerializeIntentModel(m), "v3");
+  ASSERT_EQ(m.config.history_samples, 3);
+  const IntentModel loaded = DeserializeIntentModel(SerializeIntentModel(m), "v4");
+  EXPECT_EQ(loaded.config.history_samples, 3);
   EXPECT_EQ(loaded.forecast.baseline.smoothing_frames, m.forecast.baseline.smoothing_frames);
   EXPECT_EQ(loaded.forecast.baseline.damping_time_constant, m.forecast.baseline.damping_time_constant);
   EXPECT_EQ(loaded.forecast.residual_weight, m.forecast.residual_weight);
@@ -228,15 +243,24 @@ TEST_F(IntentModelTest, ForecastSettingsRoundTripAndFormat2FilesStillLoad) {
   EXPECT_EQ(loaded.forecast.motion_offset, m.forecast.motion_offset);
   EXPECT_EQ(loaded.forecast.reference_speed, m.forecast.reference_speed);
 
+  // Older builds trained forecasters without history inputs.
+  IntentModelConfig config0 = SmallConfig(*data_);
+  config0.history_samples = 0;
+  const IntentModel m0 = TrainIntentModel(*data_, config0, SmallParams());
+  // A format-3 file loads as it was written.
+  const IntentModel v3 = DeserializeIntentModel(AsOldFormat(m0, 3), "v3");
+  EXPECT_EQ(v3.config.history_samples, 0);
+  EXPECT_EQ(SerializeIntentModel(v3), SerializeIntentModel(m0));
   // A format-2 file is read as its forecasters meant: displacement from the
   // newest frame, weight 1, no calibration, no activity scaling.
-  const IntentModel old = DeserializeIntentModel(AsFormat2(m), "v2");
+  const IntentModel old = DeserializeIntentModel(AsOldFormat(m0, 2), "v2");
+  EXPECT_EQ(old.config.history_samples, 0);
   EXPECT_EQ(old.forecast.baseline.smoothing_frames, 1);
   EXPECT_EQ(old.forecast.baseline.damping_time_constant, 0.0);
   EXPECT_EQ(old.forecast.residual_weight, 1.0);
   EXPECT_EQ(old.forecast.variance_scale.size(), 0);
   EXPECT_TRUE(std::isinf(old.forecast.motion_offset));
-  IntentModel legacy = m;
+  IntentModel legacy = m0;
   legacy.forecast = old.forecast;
   MixturePrediction a, b;
   const Eigen::MatrixXd window = data_->sequences[2].positions.topRows(12);
@@ -248,7 +272,7 @@ TEST_F(IntentModelTest, ForecastSettingsRoundTripAndFormat2FilesStillLoad) {
       EXPECT_EQ(a.actions[c].joints[k].covariance, b.actions[c].joints[k].covariance);
     }
   }
-  // Re-saved, it becomes a format-3 file with the same predictions.
+  // Re-saved, it becomes a format-4 file with the same predictions.
   EXPECT_EQ(SerializeIntentModel(DeserializeIntentModel(SerializeIntentModel(old), "again")),
             SerializeIntentModel(old));
 

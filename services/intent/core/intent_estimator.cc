@@ -14,7 +14,14 @@ std::string IntentEstimatorParams::Validate() const {
   }
   if (!(max_gap > 0) || !std::isfinite(max_gap)) return "max_gap must be > 0 s, got " + std::to_string(max_gap);
   if (max_bodies < 1 || max_bodies > 1000) return "max_bodies must be in [1, 1000], got " + std::to_string(max_bodies);
+  if (const std::string why = CoverageParams().Validate(); !why.empty()) return "coverage_" + why;
   return "";
+}
+
+intent::CoverageAdapterParams IntentEstimatorParams::CoverageParams() const {
+  intent::CoverageAdapterParams p;
+  p.halving_time = coverage_halving_time;
+  return p;
 }
 
 const char* ToString(FrameStatus status) {
@@ -76,7 +83,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
                                                " bodies (max_bodies); body " + std::to_string(frame.body_id) +
                                                " ignored"};
     }
-    it = bodies_.emplace(frame.body_id, Body(*model_)).first;
+    it = bodies_.emplace(frame.body_id, Body(*model_, params_.CoverageParams())).first;
   }
   Body& body = it->second;
   if (!body.stamps.empty()) {
@@ -90,6 +97,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
       body.stamps.clear();
       body.positions.clear();
       body.belief.Reset();
+      body.coverage.Reset();
     }
   }
   body.stamps.push_back(frame.stamp);
@@ -109,6 +117,10 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
   for (std::size_t c = 0; c < out->actions.size(); ++c) {
     out->actions[c].probability = body.belief.probabilities()(static_cast<Eigen::Index>(c));
   }
+  // Score the body's earlier forecasts that mature now, then calibrate this one.
+  body.coverage.Observe(frame.stamp, scratch_);
+  body.coverage.Apply(out);
+  body.coverage.Record(frame.stamp, *out);
   DropStale(frame.stamp);
   return {};
 }

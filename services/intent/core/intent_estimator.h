@@ -33,6 +33,7 @@
 
 #include "iplan/core/name_value.h"
 #include "iplan/intent/belief_filter.h"
+#include "iplan/intent/coverage_adapter.h"
 #include "iplan/intent/intent_model.h"
 
 namespace iplan::intent_service {
@@ -59,15 +60,23 @@ struct IntentEstimatorParams {
   double max_gap = 0.6;
   /// Bodies tracked at once; frames of further bodies are rejected.
   int max_bodies = 8;
+  /// s: online calibration of each body's forecast ellipsoids
+  /// (intent::CoverageAdapterParams::halving_time); 0: the model's own.
+  double coverage_halving_time = intent::CoverageAdapterParams{}.halving_time;
 
   template <class Archive>
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(body_timeout, "s without a skeleton after which a body is forgotten, > 0"));
     a->Visit(IPLAN_NVP(max_gap, "s; a longer gap between two skeletons of a body restarts its history, > 0"));
     a->Visit(IPLAN_NVP(max_bodies, "bodies tracked at once; skeletons of more are rejected, in [1, 1000]"));
+    a->Visit(IPLAN_NVP(coverage_halving_time,
+                       "s; each body's forecast ellipsoids follow its own matured forecasts (95 % inside): "
+                       "with all inside their variance halves in this time; 0: the model's covariances, >= 0"));
   }
   /// Empty when valid, else the offending field and value.
   std::string Validate() const;
+  /// The coverage adapter's parameters these settings give.
+  intent::CoverageAdapterParams CoverageParams() const;
 };
 
 /// Why a frame was not used. The names (ToString) appear in diagnostics.
@@ -111,11 +120,14 @@ class IntentEstimator {
 
  private:
   struct Body {
-    explicit Body(const intent::IntentModel& model)
-        : belief(static_cast<int>(model.actions.size()), model.classifier.belief) {}
+    Body(const intent::IntentModel& model, const intent::CoverageAdapterParams& coverage_params)
+        : belief(static_cast<int>(model.actions.size()), model.classifier.belief),
+          coverage(static_cast<int>(model.config.joints.joints.size()), model.config.horizon, model.config.rate,
+                   coverage_params) {}
     std::deque<double> stamps;             // s, increasing
     std::deque<Eigen::VectorXd> positions; // (3 J) per frame, model joint order
     intent::BeliefFilter belief;           // over this body's windows since its history began
+    intent::CoverageAdapter coverage;      // this body's ellipsoid scales, restarted with the belief
   };
   /// Fills window_ from a body's history; returns the number of rows.
   void BuildWindow(const Body& body);

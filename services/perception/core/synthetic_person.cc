@@ -225,6 +225,54 @@ std::vector<JointSample> SyntheticPerson::Observe(double t) {
   return out;
 }
 
+std::vector<bool> SyntheticPerson::Reaching(double t) const {
+  std::vector<bool> out(UpperBodyJointNames().size(), false);
+  const Phase p = PhaseAt(t);
+  const ActionMotion& a = params_.actions[p.action];
+  if (a.kind != MotionKind::kReach || (p.previous >= 0 && p.since < params_.transition)) return out;
+  const double phase = std::fmod(p.since, a.period) / a.period;
+  out[a.right_hand ? 8 : 5] = phase < 0.4 || (phase >= 0.5 && phase < 0.9);
+  return out;
+}
+
+namespace {
+
+// Row k of `seq`: the person observed at time t, and its reaching flags.
+void RecordFrame(SyntheticPerson& person, double t, int k, intent::SkeletonSequence* seq) {
+  const auto pose = person.Observe(t);
+  const std::vector<bool> reaching = person.Reaching(t);
+  for (size_t j = 0; j < pose.size(); ++j) {
+    seq->positions.block<1, 3>(k, 3 * static_cast<Eigen::Index>(j)) = pose[j].position_W.transpose();
+    seq->reaching(k, static_cast<Eigen::Index>(j)) = reaching[j];
+  }
+}
+
+// The draws that make simulated people differ (kept across people: the
+// normal distribution caches its second value).
+struct PersonDraws {
+  std::mt19937_64 g;
+  std::normal_distribution<double> jitter{0.0, 1.0};
+  std::uniform_real_distribution<double> unit{0.0, 1.0};
+};
+
+// A simulated person of `params`: standing a little differently, moving at their own pace.
+SyntheticPersonParams Individual(const SyntheticPersonParams& params, PersonDraws& d, double* pace) {
+  SyntheticPersonParams p = params;
+  p.torso_W += Eigen::Vector3d(0.03 * d.jitter(d.g), 0.03 * d.jitter(d.g), 0.02 * d.jitter(d.g));
+  *pace = 0.85 + 0.3 * d.unit(d.g);
+  for (ActionMotion& a : p.actions) a.period *= *pace;
+  p.loop = false;
+  return p;
+}
+
+std::string SubjectName(int s) {
+  char subject[16];
+  std::snprintf(subject, sizeof(subject), "s%02d", s);
+  return subject;
+}
+
+}  // namespace
+
 intent::SkeletonDataset RecordDemonstrations(const SyntheticPersonParams& params, int subjects, int repetitions,
                                              double seconds, double rate_hz) {
   if (subjects < 1 || repetitions < 1 || !(seconds > 0) || !(rate_hz > 0)) {
@@ -233,18 +281,11 @@ intent::SkeletonDataset RecordDemonstrations(const SyntheticPersonParams& params
   intent::SkeletonDataset data;
   data.joint_names = UpperBodyJointNames();
   const int frames = std::max(2, static_cast<int>(std::floor(seconds * rate_hz)));
-  std::mt19937_64 g(Mix(params.seed * 7919 + 17));
-  std::normal_distribution<double> jitter(0.0, 1.0);
-  std::uniform_real_distribution<double> unit(0.0, 1.0);
+  PersonDraws d{std::mt19937_64(Mix(params.seed * 7919 + 17))};
   for (int s = 1; s <= subjects; ++s) {
-    // Each subject stands a little differently and moves at their own pace.
-    SyntheticPersonParams p = params;
-    p.torso_W += Eigen::Vector3d(0.03 * jitter(g), 0.03 * jitter(g), 0.02 * jitter(g));
-    const double pace = 0.85 + 0.3 * unit(g);
-    for (ActionMotion& a : p.actions) a.period *= pace;
-    p.loop = false;
-    char subject[16];
-    std::snprintf(subject, sizeof(subject), "s%02d", s);
+    double pace = 1.0;
+    const SyntheticPersonParams p = Individual(params, d, &pace);
+    const std::string subject = SubjectName(s);
     for (const ActionMotion& a : p.actions) {
       for (int r = 1; r <= repetitions; ++r) {
         SyntheticPersonParams q = p;
@@ -252,20 +293,60 @@ intent::SkeletonDataset RecordDemonstrations(const SyntheticPersonParams& params
         q.script = {ScriptStep{a.name, frames / rate_hz + 100.0}};
         SyntheticPerson person(q);
         person.StartScript(0.0);
-        const double t0 = unit(g) * a.period * pace;  // start anywhere in the motion
+        const double t0 = d.unit(d.g) * a.period * pace;  // start anywhere in the motion
         intent::SkeletonSequence seq;
         seq.id = "synthetic_" + a.name + "_" + subject + "_e" + std::to_string(r);
         seq.subject = subject;
         seq.action = a.name;
         seq.time.resize(frames);
         seq.positions.resize(frames, 3 * static_cast<Eigen::Index>(data.joint_names.size()));
+        seq.reaching.resize(frames, static_cast<Eigen::Index>(data.joint_names.size()));
         for (int k = 0; k < frames; ++k) {
           seq.time[k] = k / rate_hz;
-          const auto pose = person.Observe(t0 + k / rate_hz);
-          for (size_t j = 0; j < pose.size(); ++j) seq.positions.block<1, 3>(k, 3 * j) = pose[j].position_W.transpose();
+          RecordFrame(person, t0 + k / rate_hz, k, &seq);
         }
         data.sequences.push_back(std::move(seq));
       }
+    }
+  }
+  return data;
+}
+
+intent::SkeletonDataset RecordEpisodes(const SyntheticPersonParams& params, int people, int episodes, double lead,
+                                       double tail, double rate_hz) {
+  if (people < 1 || episodes < 1 || !(lead >= 0) || !(tail >= 0) || !(rate_hz > 0)) {
+    throw std::invalid_argument("RecordEpisodes: people, episodes and rate must be positive, lead and tail >= 0");
+  }
+  if (params.script.empty()) throw std::invalid_argument("RecordEpisodes: the person has no script");
+  intent::SkeletonDataset data;
+  data.joint_names = UpperBodyJointNames();
+  double script_length = 0;
+  for (const ScriptStep& step : params.script) script_length += step.duration;
+  const int frames = static_cast<int>(std::floor((lead + script_length + tail) * rate_hz)) + 1;
+  PersonDraws d{std::mt19937_64(Mix(params.seed * 7919 + 29))};
+  for (int s = 1; s <= people; ++s) {
+    double pace = 1.0;
+    const SyntheticPersonParams p = Individual(params, d, &pace);
+    const std::string subject = SubjectName(s);
+    for (int r = 1; r <= episodes; ++r) {
+      SyntheticPersonParams q = p;
+      q.seed = Mix(params.seed ^ Mix(static_cast<uint64_t>(s * 1000 + 500 + r)));
+      SyntheticPerson person(q);
+      person.StartScript(lead);
+      intent::SkeletonSequence seq;
+      seq.id = "synthetic_episode_" + subject + "_e" + std::to_string(r);
+      seq.subject = subject;
+      seq.action = params.script.front().action;
+      seq.time.resize(frames);
+      seq.positions.resize(frames, 3 * static_cast<Eigen::Index>(data.joint_names.size()));
+      seq.reaching.resize(frames, static_cast<Eigen::Index>(data.joint_names.size()));
+      seq.frame_actions.resize(frames);
+      for (int k = 0; k < frames; ++k) {
+        seq.time[k] = k / rate_hz;
+        RecordFrame(person, k / rate_hz, k, &seq);
+        seq.frame_actions[k] = person.ActionAt(k / rate_hz);
+      }
+      data.sequences.push_back(std::move(seq));
     }
   }
   return data;

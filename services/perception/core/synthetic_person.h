@@ -87,6 +87,11 @@ class SyntheticPerson {
   /// TruePose plus sensor noise; variance = noise_stddev^2. Advances the
   /// generator (not thread-safe).
   std::vector<JointSample> Observe(double t);
+  /// Per joint of UpperBodyJointNames() at time t (s): whether it is
+  /// reaching, i.e. moving towards a goal: the hand of a reach action while it
+  /// goes out to the target (the first 40 % of the period) or back to rest
+  /// (50 to 90 %), outside the blend from a previous action. Deterministic.
+  std::vector<bool> Reaching(double t) const;
 
  private:
   struct Phase {
@@ -112,8 +117,21 @@ class SyntheticPerson {
 /// of `subjects` simulated people (torso position, speed and targets varied
 /// by subject) and each action, `repetitions` sequences of `seconds` at
 /// `rate_hz`, observed with the params' sensor noise. Subjects are named
-/// s01, s02, ...; joints are UpperBodyJointNames(). Deterministic for a seed.
+/// s01, s02, ...; joints are UpperBodyJointNames(); every sequence carries
+/// its reaching flags (SyntheticPerson::Reaching). Deterministic for a seed.
 intent::SkeletonDataset RecordDemonstrations(const SyntheticPersonParams& params, int subjects, int repetitions,
                                              double seconds, double rate_hz);
+
+/// Episodes of the person's script as the cell plays it (perception.synthetic
+/// start: episodes): for each of `people` simulated people (varied as in
+/// RecordDemonstrations) `episodes` recordings at `rate_hz`, each `lead`
+/// seconds before the script starts (the person idles in the last step's
+/// action), the whole script and `tail` seconds after it. Every frame carries
+/// its action (SkeletonSequence::frame_actions, the script's) and reaching
+/// flags; the sequence's own label is the script's first action. Subjects s01,
+/// s02, ...; joints UpperBodyJointNames(). Deterministic for a seed. Throws
+/// std::invalid_argument for a person without a script or bad counts.
+intent::SkeletonDataset RecordEpisodes(const SyntheticPersonParams& params, int people, int episodes, double lead,
+                                       double tail, double rate_hz);
 
 }  // namespace iplan::perception

@@ -1,5 +1,8 @@
 #include "../core/synthetic_person.h"
 
+#include <algorithm>
+#include <map>
+
 #include <gtest/gtest.h>
 
 namespace iplan::perception {
@@ -145,6 +148,56 @@ TEST(SyntheticPerson, DemonstrationsCoverEveryActionPerSubject) {
   const intent::SkeletonDataset again = RecordDemonstrations(p, 3, 2, 2.0, 15.0);
   EXPECT_EQ(again.sequences[5].positions, d.sequences[5].positions);
   EXPECT_THROW(RecordDemonstrations(p, 0, 2, 2.0, 15.0), std::invalid_argument);
+}
+
+TEST(SyntheticPerson, ReachingIsTheReachingHandWhileItMovesToTheTargetOrBack) {
+  SyntheticPerson person(CellPerson());
+  person.StartScript(0.0);
+  // reach_parts: period 2 s, out 0-0.8 s, hold, back 1.0-1.8 s, hold; the right hand (index 8).
+  for (double t : {0.1, 0.7, 1.1, 1.7, 2.3}) {
+    const std::vector<bool> r = person.Reaching(t);
+    ASSERT_EQ(r.size(), 9u);
+    EXPECT_TRUE(r[8]) << "t=" << t;
+    EXPECT_EQ(std::count(r.begin(), r.end(), true), 1) << "t=" << t;
+  }
+  for (double t : {0.85, 1.9}) EXPECT_FALSE(person.Reaching(t)[8]) << "holding, t=" << t;
+  // Assembling and idling (after the 0.5 s blend) are not reaching.
+  for (double t : {4.2, 6.0, 11.0}) {
+    const std::vector<bool> r = person.Reaching(t);
+    EXPECT_EQ(std::count(r.begin(), r.end(), true), 0) << "t=" << t;
+  }
+}
+
+TEST(SyntheticPerson, EpisodesPlayTheScriptWithEachFramesActionAndReaching) {
+  SyntheticPersonParams p = CellPerson();
+  p.noise_stddev = 0.01;
+  const intent::SkeletonDataset d = RecordEpisodes(p, 2, 2, 1.0, 1.0, 10.0);
+  ASSERT_EQ(d.sequences.size(), 4u);
+  for (const auto& s : d.sequences) {
+    const int n = static_cast<int>(s.time.size());
+    EXPECT_EQ(n, 141);  // (1 + 12 + 1) s at 10 Hz, both ends
+    ASSERT_EQ(s.frame_actions.size(), static_cast<size_t>(n));
+    ASSERT_EQ(s.reaching.rows(), n);
+    ASSERT_EQ(s.reaching.cols(), 9);
+    EXPECT_EQ(s.action, "reach_parts");
+    EXPECT_EQ(s.frame_actions[5], "idle");          // 0.5 s: before the start
+    EXPECT_EQ(s.frame_actions[30], "reach_parts");  // 3 s
+    EXPECT_EQ(s.frame_actions[80], "assemble");     // 8 s
+    EXPECT_EQ(s.frame_actions[135], "idle");        // 13.5 s
+    int reaching = 0;
+    for (int k = 0; k < n; ++k) {
+      reaching += s.reaching.row(k).count();
+      if (s.reaching.row(k).any()) {
+        EXPECT_EQ(s.frame_actions[k], "reach_parts") << "frame " << k;
+      }
+    }
+    EXPECT_GT(reaching, 15);  // most of the 4 s of reaching (pace varies)
+  }
+  EXPECT_NE(d.sequences[0].positions, d.sequences[2].positions);  // two people
+  EXPECT_EQ(RecordEpisodes(p, 2, 2, 1.0, 1.0, 10.0).sequences[3].positions, d.sequences[3].positions);
+  SyntheticPersonParams no_script = p;
+  no_script.script.clear();
+  EXPECT_THROW(RecordEpisodes(no_script, 1, 1, 1.0, 1.0, 10.0), std::invalid_argument);
 }
 
 }  // namespace

@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "iplan/intent/coverage_adapter.h"
 #include "iplan/intent/intent_model.h"
 #include "iplan/intent/skeleton_data.h"
 
@@ -29,6 +30,40 @@ struct EvalParams {
   /// L (>= 1) tried for the least-squares baselines (constant velocity and
   /// the smoothed constant position); 2 is the last-frame velocity.
   std::vector<int> velocity_frames{2, 3, 4, 5, 6, 8, 10, 15};
+  /// s (> 0): horizons at which the hand and reaching errors are reported
+  /// (JointForecastErrors), interpolated linearly between the model's steps;
+  /// those outside [1 / rate, horizon / rate] are left out.
+  std::vector<double> report_horizons{0.5, 1.0};
+  /// The online calibration of each track's ellipsoids, as the intent
+  /// service does it per body (coverage_adapter.h); halving_time = 0 scores
+  /// the model's own covariances.
+  CoverageAdapterParams coverage;
+};
+
+/// Forecast errors of some joints at one reported horizon (m, mean
+/// Euclidean distance over the scored (window, joint) pairs). Prediction and
+/// truth are interpolated linearly between the two steps around the horizon;
+/// the constant-velocity line is evaluated at the horizon itself.
+struct HorizonError {
+  double horizon_s = 0.0;
+  double model = 0.0;           ///< the mixture mean
+  double const_position = 0.0;  ///< hold the newest recorded position
+  /// The least-squares line through the last L frames, the best L of
+  /// EvalParams::velocity_frames on these very pairs (favours the baseline).
+  double const_velocity = 0.0;
+  int const_velocity_frames = 0;  ///< that L
+  /// model / min(const_position, const_velocity); below 1: better than both.
+  double RatioToBestBaseline() const;
+};
+
+/// Forecasts of a subset of joints over the forecast windows.
+struct JointForecastErrors {
+  std::vector<std::string> joints;  ///< names of the joints that can be scored
+  long num_samples = 0;             ///< (window, joint) pairs scored
+  std::vector<HorizonError> at;     ///< per reported horizon
+  /// Share of their true future positions, every step, inside the 95 %
+  /// ellipsoid of the moment-matched mixture.
+  double coverage95 = 0.0;
 };
 
 struct EvalReport {
@@ -57,6 +92,12 @@ struct EvalReport {
   Eigen::MatrixXd error_smoothed_position_by_frames;  ///< (V, D) m, per L tried.
   double coverage95 = 0.0;           ///< Share of true future joints inside the
                                      ///< moment-matched mixture's 95 % ellipsoid.
+  /// The model's hand joints (JointConfig::hands; every model joint when it
+  /// names none) in every forecast window.
+  JointForecastErrors hand;
+  /// Reaching joints (Track::reaching at the window's newest frame, any model
+  /// joint): num_samples 0 when the data do not say which joints reach.
+  JointForecastErrors reaching;
   double inference_p50_ms = 0.0;     ///< Per PredictIntent call (one frame; accuracy
                                      ///< and forecast windows).
   double inference_p99_ms = 0.0;
@@ -68,9 +109,13 @@ struct EvalReport {
 /// the last T frames ending at every one of them are classified and combined
 /// by a BeliefFilter with model.classifier.belief (one update per model
 /// frame), as the intent service does online; the belief after frame
-/// ceil(f n) is scored.
+/// ceil(f n) is scored against the action of that frame (Track::frame_actions
+/// when the track has them, else its label).
 /// Forecasts: every window (stride `forecast_stride`) whose true future of
-/// `horizon` frames is recorded. The baselines see the recorded frames up to
+/// `horizon` frames is recorded, as the intent service publishes it: its
+/// mixture components weighted by the belief after that frame and their
+/// covariances scaled by the track's CoverageAdapter (both run over every
+/// frame of the track). The baselines see the recorded frames up to
 /// the window's end (no padding). Throws std::invalid_argument when the data
 /// lack a model joint, contain an action the model does not know, or when
 /// `velocity_frames` is empty or has an entry < 1.
@@ -83,7 +128,10 @@ EvalReport EvaluateIntentModel(const IntentModel& model, const SkeletonDataset& 
 /// "const_velocity_by_frames" and "smoothed_position_by_frames" ({"<L>":
 /// {"<horizon s>": error}}),
 /// "coverage95", "inference_ms" ({"p50", "p99"}), plus "confusion",
-/// "actions", "num_sequences", "num_forecast_windows".
+/// "actions", "num_sequences", "num_forecast_windows", and "hand" and
+/// "reaching" ({"joints", "samples", "coverage95", "error_m": {"<horizon s>":
+/// {"model", "const_position", "const_velocity", "const_velocity_frames",
+/// "ratio_to_best_baseline"}}}; "reaching" is null without reaching flags).
 std::string EvalReportToJson(const EvalReport& report);
 
 /// Human-readable multi-line report.

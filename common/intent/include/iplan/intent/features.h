@@ -112,8 +112,11 @@ class FeatureLayout {
   int frame_feature_size() const { return 3 * num_joints_ + 3 + num_object_features(); }
   /// Forecaster input size: 3 J (current pose relative to torso) + 3 J
   /// (joint velocity relative to torso) + 3 (torso velocity) + 3 (torso
-  /// displacement over the window) + hands x objects.
-  int forecast_input_size() const { return 6 * num_joints_ + 6 + num_object_features(); }
+  /// displacement over the window) + hands x objects + 3 J x
+  /// `history_samples` (each joint's displacement since earlier rows).
+  int forecast_input_size(int history_samples = 0) const {
+    return 6 * num_joints_ + 6 + num_object_features() + 3 * num_joints_ * history_samples;
+  }
   int num_object_features() const {
     return static_cast<int>(hand_index_.size() * objects_.size());
   }
@@ -130,11 +133,30 @@ class FeatureLayout {
   /// normalisation. Returns (T, frame_feature_size()), metres.
   Eigen::MatrixXd FrameFeatures(const Eigen::MatrixXd& window) const;
 
+  /// True when MirroredWindow() can mirror this joint set: the model joints
+  /// include a left/right pair <name>_l / <name>_r of shoulder, hip, elbow,
+  /// wrist or hand (the first found gives the lateral axis) and there are no
+  /// task objects (a mirrored hand would not be near the same object).
+  bool CanMirror() const { return lateral_l_ >= 0; }
+
+  /// The mirror image of a window (T, 3 J, frame W): the same motion done
+  /// with the other side of the body. Every row is reflected across the
+  /// plane through the window's mean joint position whose normal is the
+  /// window's mean lateral direction (pair joint _l minus _r), and every
+  /// <name>_l joint trades places with its <name>_r (a joint without a
+  /// partner stays). Used to train the classifier on both handednesses.
+  /// Requires CanMirror() (throws std::logic_error otherwise).
+  Eigen::MatrixXd MirroredWindow(const Eigen::MatrixXd& window) const;
+
   /// Forecaster input vector of a padded window (T, 3 J) at `rate` Hz (see
   /// forecast_input_size() for the layout); velocities (m/s) are finite
-  /// differences over `velocity_frames` frames (clamped to T - 1, >= 1).
+  /// differences over `velocity_frames` frames (clamped to T - 1, >= 1). The
+  /// history block (`history_samples` >= 0) holds, for l = 1..n, the
+  /// displacement p_now - p_back of every joint (m, frame W) since row
+  /// now - floor(l (T - 1) / n): the path of the motion so far, which tells
+  /// where in a movement the person is (its phase), back to the oldest row.
   Eigen::VectorXd ForecastInput(const Eigen::MatrixXd& window, double rate,
-                                int velocity_frames) const;
+                                int velocity_frames, int history_samples = 0) const;
 
  private:
   int num_joints_ = 0;
@@ -144,6 +166,8 @@ class FeatureLayout {
   FrameFeatureOptions options_;
   int shoulder_l_ = -1;
   int shoulder_r_ = -1;
+  int lateral_l_ = -1, lateral_r_ = -1;  // the pair giving the lateral axis, or -1
+  std::vector<int> mirror_partner_;       // joint -> its _l/_r partner (itself if none)
 };
 
 /// Returns the padded window of length T ending at row `end` (inclusive) of

@@ -32,6 +32,10 @@ struct IntentModelConfig {
   int window = 15;                ///< T: frames per window (>= 2).
   int horizon = 15;               ///< D: future frames predicted (>= 1).
   int velocity_frames = 2;        ///< Finite-difference span for velocities (>= 1).
+  /// Forecaster input: each joint's displacement since this many earlier rows
+  /// of the window, evenly spaced back to the oldest (FeatureLayout::
+  /// ForecastInput; 0 <= n < window). Model files before format 4: 0.
+  int history_samples = 3;
   int dtw_band = 3;               ///< Sakoe-Chiba band half-width, frames (>= 0).
   FrameFeatureOptions features;   ///< Classifier frame-feature options.
   double sensor_noise_std = 0.01; ///< m, isotropic, added to every predicted covariance.
@@ -52,6 +56,13 @@ struct TrainParams {
   /// IVM regularisers tried in cross-validation.
   std::vector<double> lambdas{1e-4, 1e-3, 1e-2};
   IvmParams ivm;  ///< IVM options; `lambda` is replaced by the CV choice.
+  /// Whether the classifier is also trained on the mirror images of the
+  /// training windows (FeatureLayout::MirroredWindow: the same motion with the
+  /// other hand), tried in the leave-one-subject-out cross-validation jointly
+  /// with (sigma, lambda). `true` is only tried when the joint set can be
+  /// mirrored (a left/right pair, no task objects) and there are two or more
+  /// subjects; without cross-validation the first entry is used.
+  std::vector<bool> mirror_augmentation{false, true};
   /// Belief-filter time constants tau (s, >= 0, may be +infinity) tried in
   /// leave-one-subject-out cross-validation at the chosen (sigma, lambda):
   /// per held-out training track the filter runs over the windows ending at
@@ -206,13 +217,18 @@ struct TrainReport {
   double median_dtw = 0.0;
   double sigma = 0.0;
   double lambda = 0.0;
-  /// One row per (sigma, lambda) tried: sigma, lambda, CV mean log-loss, CV accuracy.
-  std::vector<std::array<double, 4>> cv_table;
+  /// One row per (mirror, sigma, lambda) tried: mirror images used (0/1),
+  /// sigma, lambda, CV mean log-loss, CV accuracy.
+  std::vector<std::array<double, 5>> cv_table;
+  bool mirror_augmentation = false;  ///< The chosen: trained on mirror images too.
   double belief_time_constant = 0.0;
   bool belief_motion_weighted = false;
   /// One row per belief setting tried: motion weighted (0/1), tau (s), CV mean
   /// log-loss, CV accuracy.
   std::vector<std::array<double, 4>> belief_cv_table;
+  /// The chosen belief filter's cross-validated accuracy at each of
+  /// TrainParams::prefix_fractions (empty without cross-validation).
+  std::vector<double> belief_cv_accuracy_by_prefix;
   std::vector<int> forecast_windows;  ///< Per action.
   std::vector<bool> forecast_padded;  ///< Per action: held-last-pose futures used.
   /// Kinematic baseline choice: one row per (L, tau) tried: L, tau (s), mean

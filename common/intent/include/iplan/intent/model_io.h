@@ -21,7 +21,9 @@ namespace iplan::intent {
 /// 3: the forecast settings (kinematic baseline, residual weight, covariance
 ///    calibration and activity scaling) follow the forecasters at the end of
 ///    the payload.
-inline constexpr std::uint32_t kIntentModelFormatVersion = 3;
+/// 4: the configuration stores IntentModelConfig::history_samples (the
+///    forecaster's history inputs; read as 0 from older files).
+inline constexpr std::uint32_t kIntentModelFormatVersion = 4;
 /// The oldest version this build still reads: a version-2 file is read with
 /// the forecast settings that reproduce its predictions (ForecastSettings).
 inline constexpr std::uint32_t kOldestReadableIntentModelFormatVersion = 2;

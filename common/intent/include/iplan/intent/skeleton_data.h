@@ -22,6 +22,15 @@ struct SkeletonSequence {
   Eigen::VectorXd time;       ///< (n) seconds from the start, strictly increasing.
   Eigen::MatrixXd positions;  ///< (n, 3 J) metres; row i = frame i, joint j in
                               ///< columns 3j..3j+2 (x, y, z), frame S.
+  /// (n, J) or empty: whether joint j is reaching in frame i, i.e. moving
+  /// towards a goal (out to a target or back to rest). Only data whose
+  /// generator knows it (the synthetic person's demonstrations) carry it; the
+  /// CSV layout does not. The evaluation scores reaching joints separately.
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> reaching;
+  /// (n) or empty: the action of each frame when it changes within the
+  /// recording (the synthetic person's scripted episodes); empty: `action`
+  /// for every frame. Not part of the CSV layout.
+  std::vector<std::string> frame_actions;
 };
 
 /// A set of sequences sharing one joint list.
@@ -62,7 +71,16 @@ struct Track {
   std::string subject;
   std::string action;
   Eigen::MatrixXd positions;  ///< (n, 3 J_model) metres, frame S, uniform rate.
+  /// (n, J_model) or empty: SkeletonSequence::reaching of the model joints,
+  /// taken from the recorded frame nearest each resampled row.
+  Eigen::Array<bool, Eigen::Dynamic, Eigen::Dynamic> reaching;
+  /// (n) or empty: SkeletonSequence::frame_actions at the nearest recorded frame.
+  std::vector<std::string> frame_actions;
 };
+
+/// The action of row `row` of `track`: frame_actions[row] when the track has
+/// frame actions, else its label. Requires 0 <= row < rows when it has them.
+const std::string& ActionAt(const Track& track, int row);
 
 /// Resamples `sequence` to `rate` (Hz) on the grid t0, t0 + 1/rate, ... (t0 =
 /// first sample time) by linear interpolation between neighbouring recorded
@@ -73,6 +91,9 @@ struct Track {
 /// separate tracks (a track never interpolates across such a gap).
 /// Requires rate > 0 and max_gap > 0 (throws std::invalid_argument otherwise).
 /// A sequence without any frame in which all joints were detected yields no track.
+/// Reaching flags and frame actions, when the sequence has them (n rows, one
+/// column per data joint; n labels; otherwise std::invalid_argument), follow
+/// the nearest recorded frame.
 std::vector<Track> ResampleSequence(const SkeletonSequence& sequence,
                                     const std::vector<int>& joint_index,
                                     double rate, double max_gap);
