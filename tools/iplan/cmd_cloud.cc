@@ -28,13 +28,16 @@ struct ObstaclesOptions {
 };
 
 struct EvalOptions {
-  std::string dir, config;
+  std::string dir, config, cv;
+  std::vector<std::string> cv_folds;  // each "sceneA sceneB ..." (file stems)
 };
 
 // ordered_json: the keys in the documented order.
 using Json = nlohmann::ordered_json;
 
 Json Vec(const Eigen::Vector3f& v) { return Json::array({v.x(), v.y(), v.z()}); }
+// [x, y, z, w], as geometry_msgs/Quaternion orders them.
+Json Quat(const Eigen::Quaternionf& q) { return Json::array({q.x(), q.y(), q.z(), q.w()}); }
 
 std::string ResultJson(const Result& r, double seconds) {
   Json j;
@@ -44,7 +47,9 @@ std::string ResultJson(const Result& r, double seconds) {
     j["obstacles"].push_back({{"id", o.id},
                               {"centre", Vec(o.centre)},
                               {"half_extents", Vec(o.half_extents)},
-                              {"points", o.indices.size()}});
+                              {"points", o.indices.size()},
+                              {"orientation", Quat(o.orientation)},
+                              {"group", o.group}});
   j["time_s"] = seconds;
   return j.dump();
 }
@@ -56,10 +61,13 @@ void PrintText(const Result& r, double seconds) {
   else
     std::printf("table: none found\n");
   std::printf("%zu obstacles (sensor frame, m):\n", r.obstacles.size());
-  for (const auto& o : r.obstacles)
-    std::printf("  %d: centre [%.3f %.3f %.3f] half extents [%.3f %.3f %.3f], %zu points\n", o.id, o.centre.x(),
-                o.centre.y(), o.centre.z(), o.half_extents.x(), o.half_extents.y(), o.half_extents.z(),
-                o.indices.size());
+  for (const auto& o : r.obstacles) {
+    const Eigen::Quaternionf& q = o.orientation;
+    std::printf("  %d: centre [%.3f %.3f %.3f] half extents [%.3f %.3f %.3f] orientation (x y z w) [%.3f %.3f %.3f %.3f], "
+                "%zu points, group %d\n",
+                o.id, o.centre.x(), o.centre.y(), o.centre.z(), o.half_extents.x(), o.half_extents.y(),
+                o.half_extents.z(), q.x(), q.y(), q.z(), q.w(), o.indices.size(), o.group);
+  }
   std::printf("time: %.4f s\n", seconds);
 }
 
@@ -98,6 +106,67 @@ std::string Row(const std::string& name, const iplan::cloud::SceneScore& s) {
   return line;
 }
 
+std::string Percent(int found, int objects) {
+  char text[64];
+  std::snprintf(text, sizeof text, "%.1f %% (%d/%d)", 100.0 * found / std::max(1, objects), found, objects);
+  return text;
+}
+
+// Folds of scene indices from "stem stem ..." lists; every scene not named
+// is a fold of its own (all of them without --cv-fold: leave one scene out).
+std::vector<std::vector<int>> Folds(const std::vector<std::filesystem::path>& files,
+                                    const std::vector<std::string>& lists) {
+  std::vector<std::vector<int>> folds;
+  std::vector<char> named(files.size(), 0);
+  for (const std::string& list : lists) {
+    std::istringstream words(list);
+    std::vector<int> fold;
+    for (std::string stem; words >> stem;) {
+      const auto it = std::find_if(files.begin(), files.end(), [&](const auto& f) { return f.stem() == stem; });
+      if (it == files.end()) throw std::runtime_error("--cv-fold: no scene '" + stem + "' in the folder");
+      const int k = static_cast<int>(it - files.begin());
+      if (named[k]) throw std::runtime_error("--cv-fold: scene '" + stem + "' named twice");
+      named[k] = 1;
+      fold.push_back(k);
+    }
+    if (fold.empty()) throw std::runtime_error("--cv-fold: an empty fold");
+    folds.push_back(fold);
+  }
+  for (std::size_t k = 0; k < files.size(); ++k)
+    if (!named[k]) folds.push_back({static_cast<int>(k)});
+  return folds;
+}
+
+// Every setting of the grid on every scene, then the cross-validated choice.
+void CrossValidateGrid(const EvalOptions& o, const CloudParams& base, const std::vector<std::filesystem::path>& files) {
+  const auto grid = iplan::cloud::LoadCloudParamsGrid(o.cv, base);
+  const auto folds = Folds(files, o.cv_folds);
+  std::vector<std::vector<iplan::cloud::SceneScore>> scores(files.size());
+  for (std::size_t s = 0; s < files.size(); ++s) {
+    const iplan::cloud::Cloud cloud = iplan::cloud::LoadPcd(files[s].string());
+    for (const auto& [name, params] : grid) {
+      iplan::cloud::ObstaclePipeline pipeline(params);
+      scores[s].push_back(iplan::cloud::ScoreScene(cloud.label, pipeline.Process(cloud).labels));
+    }
+  }
+  const iplan::cloud::CrossValidation cv = iplan::cloud::CrossValidate(scores, folds);
+  std::printf("\ncross-validation: %zu settings (%s), %zu folds; each fold's setting chosen on the other scenes\n\n",
+              grid.size(), o.cv.c_str(), folds.size());
+  std::printf("| held out | chosen setting | objects | found | false |\n|---|---|---|---|---|\n");
+  for (const auto& f : cv.folds) {
+    std::string names;
+    for (const int s : f.scenes) names += (names.empty() ? "" : " ") + files[s].stem().string();
+    std::printf("| %s | %s | %d | %d | %d |\n", names.c_str(), grid[f.chosen].first.c_str(), f.score.objects,
+                f.score.found, f.score.false_obstacles);
+  }
+  std::printf("cross-validated: recall %s, false obstacles %.2f per scene\n",
+              Percent(cv.held_out.found, cv.held_out.objects).c_str(),
+              static_cast<double>(cv.held_out.false_obstacles) / files.size());
+  std::printf("chosen on all scenes (tuned on them): %s: recall %s, false obstacles %.2f per scene\n",
+              grid[cv.chosen_all].first.c_str(), Percent(cv.all.found, cv.all.objects).c_str(),
+              static_cast<double>(cv.all.false_obstacles) / files.size());
+}
+
 int RunEval(const EvalOptions& o) {
   try {
     const CloudParams params = Params(o.config);
@@ -130,6 +199,7 @@ int RunEval(const EvalOptions& o) {
     };
     summary("ours", total_ours);
     summary("textbook", total_textbook);
+    if (!o.cv.empty()) CrossValidateGrid(o, params, files);
     return 0;
   } catch (const std::exception& e) {
     std::cerr << "iplan cloud eval: " << e.what() << "\n";
@@ -146,7 +216,8 @@ const bool kRegistered = iplan::cli::RegisterCommand("cloud", [](CLI::App& app) 
       "obstacles",
       "Table plane and obstacles of one recorded cloud (sensor frame, metres).\n"
       "--json prints one line {\"table\":{\"normal\":[..],\"offset\":d,\"points\":n},\"obstacles\":"
-      "[{\"id\":k,\"centre\":[..],\"half_extents\":[..],\"points\":n},...],\"time_s\":t}.\n"
+      "[{\"id\":k,\"centre\":[..],\"half_extents\":[..],\"points\":n,\"orientation\":[x,y,z,w],\"group\":g},...],"
+      "\"time_s\":t}:\nan oriented box per obstacle (half extents along its own axes, z along the table normal).\n"
       "Exit code 0 on success, 2 on bad input (unreadable file, bad config).");
   obs->add_option("--pcd", o->pcd, "PCD file (x y z [rgb|rgba] [label])")->required();
   obs->add_flag("--json", o->json, "print one JSON line instead of text");
@@ -163,6 +234,13 @@ const bool kRegistered = iplan::cli::RegisterCommand("cloud", [](CLI::App& app) 
       "(mOSD labels) of every .pcd file in a folder; prints a Markdown table per scene and totals.");
   ev->add_option("--dir", e->dir, "folder of labelled PCD files")->required();
   ev->add_option("--config", e->config, "pipeline parameters YAML (default: built-in)");
+  ev->add_option("--cv", e->cv,
+                 "also cross-validate a grid of settings (YAML: key: [values...], applied to --config): "
+                 "each fold's setting chosen on the other scenes (objects found minus false obstacles)");
+  ev->add_option("--cv-fold", e->cv_folds,
+                 "scenes held out together, as file stems \"learn0 learn1\" (repeatable); every scene not "
+                 "named is a fold of its own (none named: leave one scene out)")
+      ->needs(ev->get_option("--cv"));
   ev->callback([e] { iplan::cli::SetExitCode(RunEval(*e)); });
 });
 

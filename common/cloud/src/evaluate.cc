@@ -57,4 +57,66 @@ SceneScore Add(const SceneScore& a, const SceneScore& b) {
   return s;
 }
 
+namespace {
+
+// Which of two totals is better: more found minus false, then fewer false.
+bool Better(const SceneScore& a, const SceneScore& b) {
+  const int ma = a.found - a.false_obstacles, mb = b.found - b.false_obstacles;
+  return ma != mb ? ma > mb : a.false_obstacles < b.false_obstacles;
+}
+
+// The best setting on the scenes not excluded, and its total there.
+int Choose(const std::vector<std::vector<SceneScore>>& scores, const std::vector<char>& excluded,
+           SceneScore* total) {
+  int best = -1;
+  SceneScore best_total;
+  for (std::size_t k = 0; k < scores[0].size(); ++k) {
+    SceneScore t;
+    for (std::size_t s = 0; s < scores.size(); ++s)
+      if (!excluded[s]) t = Add(t, scores[s][k]);
+    if (best < 0 || Better(t, best_total)) {
+      best = static_cast<int>(k);
+      best_total = t;
+    }
+  }
+  if (total) *total = best_total;
+  return best;
+}
+
+}  // namespace
+
+CrossValidation CrossValidate(const std::vector<std::vector<SceneScore>>& scores,
+                              const std::vector<std::vector<int>>& folds) {
+  if (scores.empty() || scores[0].empty()) throw std::invalid_argument("CrossValidate: no scenes or no settings");
+  for (const auto& row : scores)
+    if (row.size() != scores[0].size())
+      throw std::invalid_argument("CrossValidate: scenes scored on different numbers of settings");
+  std::vector<int> seen(scores.size(), 0);
+  for (const auto& fold : folds) {
+    if (fold.empty()) throw std::invalid_argument("CrossValidate: an empty fold");
+    for (const int s : fold) {
+      if (s < 0 || s >= static_cast<int>(scores.size()))
+        throw std::invalid_argument("CrossValidate: scene " + std::to_string(s) + " out of range");
+      ++seen[s];
+    }
+  }
+  for (std::size_t s = 0; s < seen.size(); ++s)
+    if (seen[s] != 1)
+      throw std::invalid_argument("CrossValidate: scene " + std::to_string(s) + " is in " + std::to_string(seen[s]) +
+                                  " folds, not 1");
+  CrossValidation cv;
+  for (const auto& scenes : folds) {
+    CrossValidation::Fold f;
+    f.scenes = scenes;
+    std::vector<char> excluded(scores.size(), 0);
+    for (const int s : scenes) excluded[s] = 1;
+    f.chosen = Choose(scores, excluded, nullptr);
+    for (const int s : scenes) f.score = Add(f.score, scores[s][f.chosen]);
+    cv.held_out = Add(cv.held_out, f.score);
+    cv.folds.push_back(f);
+  }
+  cv.chosen_all = Choose(scores, std::vector<char>(scores.size(), 0), &cv.all);
+  return cv;
+}
+
 }  // namespace iplan::cloud

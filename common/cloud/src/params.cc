@@ -68,13 +68,14 @@ const std::map<std::string, Setter>& Setters() {
       Field("cluster_distance", &CloudParams::cluster_distance),
       Field("cluster_distance_per_m2", &CloudParams::cluster_distance_per_m2),
       Field("min_obstacle_points", &CloudParams::min_obstacle_points),
-      Field("min_part_points", &CloudParams::min_part_points),
-      Field("flat_angle_deg", &CloudParams::flat_angle_deg),
-      Field("coplanar_distance", &CloudParams::coplanar_distance),
-      Field("convex_margin", &CloudParams::convex_margin),
+      Field("normal_window_px", &CloudParams::normal_window_px),
       Field("concave_margin", &CloudParams::concave_margin),
       Field("crease_offset_px", &CloudParams::crease_offset_px),
-      Field("normal_smoothing_px", &CloudParams::normal_smoothing_px),
+      Field("step_normal_deg", &CloudParams::step_normal_deg),
+      Field("step_angle_deg", &CloudParams::step_angle_deg),
+      Field("min_part_points", &CloudParams::min_part_points),
+      Field("concave_region_share", &CloudParams::concave_region_share),
+      Field("concave_region_depth_px", &CloudParams::concave_region_depth_px),
       Field("voxel_size", &CloudParams::voxel_size),
       Field("euclidean_tolerance", &CloudParams::euclidean_tolerance),
       Field("textbook_min_cluster", &CloudParams::textbook_min_cluster),
@@ -107,17 +108,20 @@ std::string CloudParams::Validate() const {
     return "cluster_distance_per_m2 must be >= 0, got " + Num(cluster_distance_per_m2);
   if (min_obstacle_points < 1)
     return "min_obstacle_points must be >= 1, got " + std::to_string(min_obstacle_points);
-  if (min_part_points < 1)
-    return "min_part_points must be >= 1, got " + std::to_string(min_part_points);
-  if (!(flat_angle_deg >= 0 && flat_angle_deg <= 90))
-    return "flat_angle_deg must be in 0..90, got " + Num(flat_angle_deg);
-  if (!positive(coplanar_distance)) return "coplanar_distance must be > 0, got " + Num(coplanar_distance);
-  if (!(convex_margin >= 0 && convex_margin < 2)) return "convex_margin must be in [0, 2), got " + Num(convex_margin);
+  if (normal_window_px < 1 || normal_window_px > 10)
+    return "normal_window_px must be in 1..10, got " + std::to_string(normal_window_px);
   if (!(concave_margin >= 0)) return "concave_margin must be >= 0, got " + Num(concave_margin);
   if (crease_offset_px < 1 || crease_offset_px > 10)
     return "crease_offset_px must be in 1..10, got " + std::to_string(crease_offset_px);
-  if (!(normal_smoothing_px >= 1 && normal_smoothing_px <= 50))
-    return "normal_smoothing_px must be in 1..50, got " + Num(normal_smoothing_px);
+  if (!(step_normal_deg >= 0 && step_normal_deg <= 90))
+    return "step_normal_deg must be in 0..90, got " + Num(step_normal_deg);
+  if (!(step_angle_deg >= 0 && step_angle_deg <= 90))
+    return "step_angle_deg must be in 0..90, got " + Num(step_angle_deg);
+  if (min_part_points < 1)
+    return "min_part_points must be >= 1, got " + std::to_string(min_part_points);
+  if (!(concave_region_share >= 0)) return "concave_region_share must be >= 0, got " + Num(concave_region_share);
+  if (concave_region_depth_px < 1 || concave_region_depth_px > 20)
+    return "concave_region_depth_px must be in 1..20, got " + std::to_string(concave_region_depth_px);
   if (!positive(voxel_size)) return "voxel_size must be > 0, got " + Num(voxel_size);
   if (!positive(euclidean_tolerance)) return "euclidean_tolerance must be > 0, got " + Num(euclidean_tolerance);
   if (textbook_min_cluster < 1)
@@ -143,6 +147,47 @@ CloudParams LoadCloudParams(const std::string& path) {
   }
   if (const std::string why = p.Validate(); !why.empty()) throw std::runtime_error(path + ": " + why);
   return p;
+}
+
+std::vector<std::pair<std::string, CloudParams>> LoadCloudParamsGrid(const std::string& path,
+                                                                     const CloudParams& base) {
+  YAML::Node root;
+  try {
+    root = core::LoadYamlFile(path);
+  } catch (const YAML::Exception& e) {
+    throw std::runtime_error(path + ": cannot read the parameter grid: " + e.what());
+  }
+  if (!root || !root.IsMap() || root.size() == 0)
+    throw std::runtime_error(path + ": the parameter grid must be a map of keys to lists of values");
+  std::vector<std::pair<std::string, CloudParams>> grid = {{"", base}};
+  for (const auto& kv : root) {
+    const std::string key = kv.first.as<std::string>();
+    const auto it = Setters().find(key);
+    if (it == Setters().end()) throw std::runtime_error(path + ": unknown key '" + key + "'");
+    std::vector<YAML::Node> values;
+    if (kv.second.IsSequence() && !kv.second.IsNull()) {
+      // [x, y, z] of a vector key is one value, a list of those is a list.
+      const bool vector_key = key == "crop_min" || key == "crop_max";
+      if (vector_key && kv.second.size() > 0 && kv.second[0].IsScalar()) values.push_back(kv.second);
+      else for (const auto& v : kv.second) values.push_back(v);
+    } else {
+      values.push_back(kv.second);
+    }
+    if (values.empty()) throw std::runtime_error(path + ": key '" + key + "' has no values");
+    std::vector<std::pair<std::string, CloudParams>> next;
+    for (const auto& [name, params] : grid)
+      for (const YAML::Node& v : values) {
+        CloudParams p = params;
+        it->second(&p, v, path);
+        YAML::Emitter text;
+        text << YAML::Flow << v;
+        next.emplace_back(name + (name.empty() ? "" : " ") + key + "=" + text.c_str(), p);
+      }
+    grid = std::move(next);
+  }
+  for (const auto& [name, p] : grid)
+    if (const std::string why = p.Validate(); !why.empty()) throw std::runtime_error(path + ": " + name + ": " + why);
+  return grid;
 }
 
 }  // namespace iplan::cloud

@@ -7,13 +7,14 @@
 //     strided by `stride`, neighbours joined when close in 3D (a depth
 //     discontinuity separates objects), PCL's
 //     OrganizedConnectedComponentSegmentation with our comparator;
-//  5. parts: the same components with concave creases (from PCL's
-//     integral-image normals) also cutting; large parts of one segment stay
-//     apart unless they meet convexly or are coplanar (LCCP's criterion on
-//     the parts), small ones join their neighbours;
+//  5. parts: normals by PCA in a window (never across a depth gap); a pixel
+//     between two neighbours whose normals meet concavely, or that step
+//     between parallel faces, is a crease; connected crease and non-crease
+//     pixels form fragments; fragments of at least min_part_points are the
+//     parts of their segment (a crease region deep enough is a concave
+//     surface, a part too), smaller ones join the part they border most;
 //  6. each full-resolution candidate takes the segment of the closest of the
 //     strided pixels around it.
-#include <pcl/features/integral_image_normal.h>
 #include <pcl/segmentation/comparator.h>
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
 
@@ -21,6 +22,8 @@
 #include <cmath>
 #include <limits>
 #include <stdexcept>
+
+#include <Eigen/Eigenvalues>
 
 #include "iplan/cloud/pipeline.h"
 #include "split_segments.h"
@@ -37,15 +40,12 @@ using PointCloud = pcl::PointCloud<pcl::PointXYZ>;
 
 /// Joins two neighbouring pixels when their points are closer than
 /// cluster_distance + cluster_distance_per_m2 * z^2 (z of the first point)
-/// and, when given creases, neither lies on a concave crease (where one
-/// object stands on or leans against another). Non-candidate pixels are NaN in the input, so they never join.
+/// and, when given classes, both have the same non-zero class (crease or
+/// not). Non-candidate pixels are NaN in the input, so they never join.
 class SegmentComparator : public pcl::Comparator<pcl::PointXYZ> {
  public:
-  struct Cues {
-    const std::vector<std::uint8_t>* crease = nullptr;  // null: no concavity cue
-  };
-  SegmentComparator(float distance, float per_m2, const Cues& cues)
-      : distance_(distance), per_m2_(per_m2), cues_(cues) {}
+  SegmentComparator(float distance, float per_m2, const std::vector<std::uint8_t>* classes)
+      : distance_(distance), per_m2_(per_m2), classes_(classes) {}
   bool compare(int a, int b) const override {
     const auto pa = (*input_)[a].getVector3fMap();
     const auto pb = (*input_)[b].getVector3fMap();
@@ -53,44 +53,38 @@ class SegmentComparator : public pcl::Comparator<pcl::PointXYZ> {
     const float limit = distance_ + per_m2_ * z * z;
     const float gap2 = (pa - pb).squaredNorm();
     if (!(gap2 < limit * limit)) return false;
-    if (cues_.crease && ((*cues_.crease)[a] || (*cues_.crease)[b])) return false;
-    return true;
+    return !classes_ || ((*classes_)[a] != 0 && (*classes_)[a] == (*classes_)[b]);
   }
 
  private:
   float distance_, per_m2_;
-  Cues cues_;
+  const std::vector<std::uint8_t>* classes_;
 };
-
-internal::ConvexityParams Convexity(const CloudParams& p) {
-  internal::ConvexityParams c;
-  c.flat_cos = std::cos(p.flat_angle_deg * static_cast<float>(M_PI / 180.0));
-  c.coplanar_distance = p.coplanar_distance;
-  c.convex_margin = p.convex_margin;
-  return c;
-}
 
 }  // namespace
 
 struct ObstaclePipeline::Impl {
   CloudParams params;
+  float step_cos = 1.0f, step_sin = 2.0f;  // from step_normal_deg, step_angle_deg
   std::vector<std::uint8_t> keep;
   std::vector<int> segment;
   PointCloud::Ptr sample{new PointCloud};
   PointCloud::Ptr small{new PointCloud};
   pcl::PointCloud<pcl::Label> small_labels;
   std::vector<pcl::PointIndices> small_segments;
-  std::vector<int> small_segment;  // strided pixel -> segment or kSegNone
-  std::vector<Eigen::Vector3f> small_points;  // the strided image's points
+  pcl::PointCloud<pcl::Normal>::Ptr small_normals{new pcl::PointCloud<pcl::Normal>};
+  std::vector<std::uint8_t> small_crease;  // strided pixel: 1 non-crease candidate, 2 crease, 0 none
+  std::vector<int> small_depth;            // strided crease pixel: chessboard distance to a non-crease one
+  std::vector<int> small_segment;          // strided pixel -> segment or kSegNone
+  std::vector<int> group_of;               // segment -> its geometric segment (depth-connected)
 
   bool FindTable(const Cloud& cloud, Eigen::Vector4f* plane);
   void MarkTableAndCandidates(const Cloud& cloud, const Eigen::Vector4f& plane, bool table_found);
-  pcl::PointCloud<pcl::Normal>::Ptr small_normals{new pcl::PointCloud<pcl::Normal>};
-  std::vector<int> Components(const SegmentComparator::Cues& cues);
-  std::vector<std::uint8_t> small_crease;  // strided pixel on a concave crease
+  std::vector<int> Components(const std::vector<std::uint8_t>* classes);
   void EstimateNormals();
+  bool Crease(int a, int b) const;
   void MarkCreases();
-  void FillCreases(const std::vector<int>& geometric);
+  void MeasureCreaseDepth();
   void FillSmall(const Cloud& cloud, int which);
   void SegmentCandidates(const Cloud& cloud);
   void AssignFullResolution(const Cloud& cloud);
@@ -128,9 +122,9 @@ void ObstaclePipeline::Impl::MarkTableAndCandidates(const Cloud& cloud, const Ei
 }
 
 // Connected components of the strided image (-1 = none), neighbours joined
-// by SegmentComparator with `cues`.
-std::vector<int> ObstaclePipeline::Impl::Components(const SegmentComparator::Cues& cues) {
-  auto comparator = std::make_shared<SegmentComparator>(params.cluster_distance, params.cluster_distance_per_m2, cues);
+// by SegmentComparator with `classes` (may be null).
+std::vector<int> ObstaclePipeline::Impl::Components(const std::vector<std::uint8_t>* classes) {
+  auto comparator = std::make_shared<SegmentComparator>(params.cluster_distance, params.cluster_distance_per_m2, classes);
   comparator->setInputCloud(small);
   pcl::OrganizedConnectedComponentSegmentation<pcl::PointXYZ, pcl::Label> occ(comparator);
   occ.setInputCloud(small);
@@ -145,72 +139,126 @@ std::vector<int> ObstaclePipeline::Impl::Components(const SegmentComparator::Cue
   return out;
 }
 
-// Normals of the strided image's candidates (PCL's integral-image
-// estimator; NaN where undefined).
+// Normals of the strided image's candidates: PCA of the candidates in a
+// window of normal_window_px strided pixels around each (every other
+// pixel of it), taking only
+// those reachable without a depth gap (within m * the joining distance, m
+// the window ring), so a normal never mixes two surfaces a depth
+// discontinuity separates. NaN where fewer than 5 points qualify.
 void ObstaclePipeline::Impl::EstimateNormals() {
-  pcl::IntegralImageNormalEstimation<pcl::PointXYZ, pcl::Normal> ne;
-  ne.setNormalEstimationMethod(ne.COVARIANCE_MATRIX);
-  ne.setNormalSmoothingSize(params.normal_smoothing_px);
-  ne.setDepthDependentSmoothing(false);
-  ne.setInputCloud(small);
-  ne.compute(*small_normals);
-  for (std::size_t j = 0; j < small->size(); ++j) {
-    pcl::Normal& n = (*small_normals)[j];
-    const auto p = (*small)[j].getVector3fMap();
-    if (std::isfinite(n.normal_x) && n.getNormalVector3fMap().dot(p) > 0) {
-      n.normal_x = -n.normal_x;  // towards the sensor
-      n.normal_y = -n.normal_y;
-      n.normal_z = -n.normal_z;
+  const int w = static_cast<int>(small->width), h = static_cast<int>(small->height);
+  const int m = params.normal_window_px;
+  small_normals->resize(small->size());
+  small_normals->width = small->width;
+  small_normals->height = small->height;
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (int r = 0; r < h; ++r)
+    for (int c = 0; c < w; ++c) {
+      const int i = r * w + c;
+      pcl::Normal& n = (*small_normals)[i];
+      n.normal_x = n.normal_y = n.normal_z = nan;
+      const Eigen::Vector3f pi = (*small)[i].getVector3fMap();
+      if (!std::isfinite(pi.x())) continue;
+      const float limit = params.cluster_distance + params.cluster_distance_per_m2 * pi.z() * pi.z();
+      // Every other pixel of the window (the normal barely changes, the
+      // cost is a quarter); coordinates relative to the centre, so float
+      // sums keep their precision.
+      float sx = 0, sy = 0, sz = 0, sxx = 0, sxy = 0, sxz = 0, syy = 0, syz = 0, szz = 0;
+      int count = 0;
+      const int step = m >= 2 ? 2 : 1;
+      for (int dr = -m; dr <= m; dr += step) {
+        const int rr = r + dr;
+        if (rr < 0 || rr >= h) continue;
+        for (int dc = -m; dc <= m; dc += step) {
+          const int cc = c + dc;
+          if (cc < 0 || cc >= w) continue;
+          const Eigen::Vector3f q = (*small)[rr * w + cc].getVector3fMap() - pi;
+          if (!std::isfinite(q.x())) continue;
+          const float ring = static_cast<float>(std::max(std::abs(dr), std::abs(dc)));
+          if (q.squaredNorm() > ring * ring * limit * limit) continue;
+          sx += q.x(), sy += q.y(), sz += q.z();
+          sxx += q.x() * q.x(), sxy += q.x() * q.y(), sxz += q.x() * q.z();
+          syy += q.y() * q.y(), syz += q.y() * q.z(), szz += q.z() * q.z();
+          ++count;
+        }
+      }
+      const Eigen::Vector3d sum(sx, sy, sz);
+      Eigen::Matrix3d outer;
+      outer << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
+      if (count < 5) continue;
+      const Eigen::Vector3d mean = sum / count;
+      const Eigen::Matrix3d cov = outer / count - mean * mean.transpose();
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
+      eig.computeDirect(cov);
+      Eigen::Vector3f v = eig.eigenvectors().col(0).cast<float>();
+      if (v.dot(pi) > 0) v = -v;  // towards the sensor
+      n.normal_x = v.x();
+      n.normal_y = v.y();
+      n.normal_z = v.z();
     }
-  }
 }
 
-// A candidate pixel lies on a concave crease when the pixels crease_offset
-// to either side of it (along a row or a column) have normals meeting
-// concavely: d . (n_b - n_a) < -concave_margin, d the unit vector from a to
-// b. A wide baseline sees the crease through the normals' smoothing.
+// Whether strided pixels a and b (2 crease_offset_px apart) have a crease
+// between them: their normals meet concavely, d . (n_b - n_a) <
+// -concave_margin |d| (d from a to b), or they are within step_normal_deg
+// of each other while d leaves their mean tangent plane by more than
+// step_angle_deg (a step between parallel faces). False where a normal is
+// undefined.
+bool ObstaclePipeline::Impl::Crease(int a, int b) const {
+  const auto na = (*small_normals)[a].getNormalVector3fMap();
+  const auto nb = (*small_normals)[b].getNormalVector3fMap();
+  if (!na.allFinite() || !nb.allFinite()) return false;
+  const Eigen::Vector3f d = (*small)[b].getVector3fMap() - (*small)[a].getVector3fMap();
+  const float len = d.norm();
+  if (!(len > 0)) return false;
+  if (d.dot(nb - na) < -params.concave_margin * len) return true;
+  return na.dot(nb) > step_cos && std::abs((na + nb).normalized().dot(d)) > step_sin * len;
+}
+
+// small_crease: 2 for a candidate pixel with a crease between the pixels
+// crease_offset_px to either side of it (along a row or a column; a wide
+// baseline sees the crease through the normals' window), 1 for the other
+// candidates, 0 elsewhere.
 void ObstaclePipeline::Impl::MarkCreases() {
   const int w = static_cast<int>(small->width), h = static_cast<int>(small->height);
   const int k = params.crease_offset_px;
   small_crease.assign(small->size(), 0);
-  auto concave = [&](int a, int b) {
-    const auto na = (*small_normals)[a].getNormalVector3fMap();
-    const auto nb = (*small_normals)[b].getNormalVector3fMap();
-    if (!na.allFinite() || !nb.allFinite()) return false;
-    const Eigen::Vector3f d = (*small)[b].getVector3fMap() - (*small)[a].getVector3fMap();
-    const float len = d.norm();
-    return len > 0 && d.dot(nb - na) < -params.concave_margin * len;
-  };
   for (int r = 0; r < h; ++r)
     for (int c = 0; c < w; ++c) {
       const int i = r * w + c;
       if (!std::isfinite((*small)[i].x)) continue;
-      small_crease[i] = (c >= k && c + k < w && concave(i - k, i + k)) ||
-                        (r >= k && r + k < h && concave(i - k * w, i + k * w));
+      const bool crease = (c >= k && c + k < w && Crease(i - k, i + k)) ||
+                          (r >= k && r + k < h && Crease(i - k * w, i + k * w));
+      small_crease[i] = crease ? 2 : 1;
     }
 }
 
-// Crease pixels (no segment after the split) take the segment of a
-// neighbour in the same geometric segment, growing inwards from both sides.
-void ObstaclePipeline::Impl::FillCreases(const std::vector<int>& geometric) {
+// small_depth: for a crease pixel, the chessboard distance to the nearest
+// non-crease candidate (two-pass chamfer; huge when there is none); 0 for
+// the others.
+void ObstaclePipeline::Impl::MeasureCreaseDepth() {
   const int w = static_cast<int>(small->width), h = static_cast<int>(small->height);
-  std::vector<int> next = small_segment;
-  for (int pass = 0; pass < 2 * params.crease_offset_px + 2; ++pass) {
-    bool changed = false;
-    for (int r = 0; r < h; ++r)
-      for (int c = 0; c < w; ++c) {
-        const int i = r * w + c;
-        if (small_segment[i] != kSegNone || geometric[i] < 0) continue;
-        const int nbr[4] = {c > 0 ? i - 1 : -1, c + 1 < w ? i + 1 : -1, r > 0 ? i - w : -1, r + 1 < h ? i + w : -1};
-        for (const int j : nbr)
-          if (j >= 0 && small_segment[j] != kSegNone && geometric[j] == geometric[i]) {
-            next[i] = small_segment[j];
-            changed = true;
-            break;
-          }
+  constexpr int kFar = 1 << 20;
+  small_depth.assign(small->size(), 0);
+  for (std::size_t j = 0; j < small->size(); ++j) small_depth[j] = small_crease[j] == 2 ? kFar : 0;
+  for (int pass = 0; pass < 2; ++pass) {
+    const int dir = pass == 0 ? -1 : 1;  // forward pass looks back, backward pass ahead
+    for (int t = 0; t < w * h; ++t) {
+      const int j = pass == 0 ? t : w * h - 1 - t;
+      if (!small_depth[j]) continue;
+      const int r = j / w, c = j % w, rr = r + dir;
+      int& d = small_depth[j];
+      auto relax = [&](int q) {
+        if (small_crease[q] == 1) d = 1;
+        else if (small_crease[q] == 2) d = std::min(d, small_depth[q] + 1);
+      };
+      if (c + dir >= 0 && c + dir < w) relax(j + dir);
+      if (rr >= 0 && rr < h) {
+        relax(j + dir * w);
+        if (c > 0) relax(j + dir * w - 1);
+        if (c + 1 < w) relax(j + dir * w + 1);
       }
-    if (!changed) break;
-    small_segment = next;
+    }
   }
 }
 
@@ -237,30 +285,67 @@ void ObstaclePipeline::Impl::SegmentCandidates(const Cloud& cloud) {
   const int s = params.stride;
   const int sw = (cloud.width + s - 1) / s, sh = (cloud.height + s - 1) / s;
   FillSmall(cloud, 0);
-  const std::vector<int> geometric = Components({});
-  // Creases need normals from an image: none for an unorganised cloud (one
-  // row) or an image too small for the integral-image window.
+  const std::vector<int> geometric = Components(nullptr);
+  // Creases need an image: none for an unorganised cloud (one row) or an
+  // image too small for the crease baseline.
   const bool image = sw > 2 * params.crease_offset_px && sh > 2 * params.crease_offset_px;
-  if (params.concave_margin >= 2.0f || !image) {
+  const bool cues = params.concave_margin < 2.0f || params.step_angle_deg < 90.0f;
+  if (!cues || !image) {
     small_segment = geometric;
+    group_of.resize(small->size());
+    for (std::size_t j = 0; j < group_of.size(); ++j) group_of[j] = static_cast<int>(j);
     return;
   }
   EstimateNormals();
-  if (small_normals->size() != small->size()) {  // PCL refused the input
-    small_segment = geometric;
-    return;
-  }
   MarkCreases();
-  SegmentComparator::Cues cues;
-  cues.crease = &small_crease;
-  const std::vector<int> fragments = Components(cues);
+  MeasureCreaseDepth();
+  // Fragments: connected pixels of one kind. A crease fragment is a band
+  // along a crease (joins its neighbours) unless enough of it lies deeper
+  // than concave_region_depth_px inside it and it borders at most one
+  // large other fragment: then it is a concave surface (the inside of a
+  // bowl or a mug, bordering its outside), a part of its own.
+  const std::vector<int> fragments = Components(&small_crease);
+  int nf = 0;
+  for (const int f : fragments) nf = std::max(nf, f + 1);
+  std::vector<int> interior(nf, 0);
+  std::vector<std::uint8_t> may_core(nf, 1);
+  for (std::size_t j = 0; j < small->size(); ++j) {
+    const int f = fragments[j];
+    if (f < 0 || small_crease[j] != 2) continue;
+    may_core[f] = 0;
+    if (small_depth[j] > params.concave_region_depth_px) ++interior[f];
+  }
   const int s2 = params.stride * params.stride;
-  small_points.resize(small->size());
-  for (std::size_t j = 0; j < small->size(); ++j) small_points[j] = (*small)[j].getVector3fMap();
-  small_segment = internal::SplitSegments(sw, sh, small_points, geometric, fragments,
-                                          (params.min_part_points + s2 - 1) / s2,
-                                          Convexity(params));
-  FillCreases(geometric);
+  const int min_core = (params.min_part_points + s2 - 1) / s2;
+  // How many large non-crease fragments each crease fragment borders: a
+  // band between two surfaces borders two, a concave surface at most one
+  // (the outside of its own container).
+  std::vector<int> size(nf, 0);
+  for (const int f : fragments)
+    if (f >= 0) ++size[f];
+  std::vector<std::pair<int, int>> touching;  // (crease fragment, large non-crease fragment)
+  for (int r = 0; r < sh; ++r)
+    for (int c = 0; c < sw; ++c) {
+      const int i = r * sw + c;
+      for (const int j : {c + 1 < sw ? i + 1 : -1, r + 1 < sh ? i + sw : -1}) {
+        if (j < 0 || fragments[i] < 0 || fragments[j] < 0 || geometric[i] != geometric[j]) continue;
+        const int a = fragments[i], b = fragments[j];
+        if (small_crease[i] == 2 && small_crease[j] == 1 && size[b] >= min_core) touching.emplace_back(a, b);
+        if (small_crease[j] == 2 && small_crease[i] == 1 && size[a] >= min_core) touching.emplace_back(b, a);
+      }
+    }
+  std::sort(touching.begin(), touching.end());
+  touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+  std::vector<int> neighbours(nf, 0);
+  for (const auto& t : touching) ++neighbours[t.first];
+  for (int f = 0; f < nf; ++f)
+    if (!may_core[f] && interior[f] >= params.concave_region_share * min_core &&
+        neighbours[f] <= 1)
+      may_core[f] = 1;
+  small_segment = internal::SplitSegments(sw, sh, geometric, fragments, min_core, may_core);
+  group_of.assign(static_cast<std::size_t>(std::max(nf, 1)), kSegNone);
+  for (std::size_t j = 0; j < small->size(); ++j)
+    if (small_segment[j] >= 0) group_of[static_cast<std::size_t>(small_segment[j])] = geometric[j];
 }
 
 // A candidate at full resolution joins the segment of the closest strided
@@ -298,6 +383,9 @@ ObstaclePipeline::ObstaclePipeline(const CloudParams& params) : impl_(std::make_
   if (const std::string why = params.Validate(); !why.empty())
     throw std::invalid_argument("ObstaclePipeline: " + why);
   impl_->params = params;
+  const float deg = static_cast<float>(M_PI / 180.0);
+  impl_->step_cos = std::cos(params.step_normal_deg * deg);
+  impl_->step_sin = params.step_angle_deg >= 90.0f ? 2.0f : std::sin(params.step_angle_deg * deg);
 }
 
 ObstaclePipeline::~ObstaclePipeline() = default;
@@ -325,7 +413,8 @@ Result ObstaclePipeline::Process(const Cloud& in, const std::vector<Sphere>& rob
     m.SegmentCandidates(in);
     m.AssignFullResolution(in);
   }
-  return internal::BuildResult(in, m.segment, m.params.min_obstacle_points, table_found, plane);
+  if (in.size() == 0) m.group_of.clear();
+  return internal::BuildResult(in, m.segment, m.params.min_obstacle_points, table_found, plane, &m.group_of);
 }
 
 }  // namespace iplan::cloud

@@ -7,7 +7,10 @@
 #include <pcl/segmentation/sac_segmentation.h>
 
 #include <algorithm>
+#include <map>
 #include <numeric>
+
+#include "iplan/cloud/oriented_box.h"
 
 namespace iplan::cloud::internal {
 
@@ -58,7 +61,7 @@ bool FitPlane(const pcl::PointCloud<pcl::PointXYZ>& sample, int max_iterations, 
 }
 
 Result BuildResult(const Cloud& cloud, const std::vector<int>& segment, int min_points, bool table_found,
-                   const Eigen::Vector4f& plane) {
+                   const Eigen::Vector4f& plane, const std::vector<int>* group_of) {
   Result result;
   result.labels.assign(cloud.size(), kLabelRemoved);
   int segments = 0;
@@ -93,15 +96,16 @@ Result BuildResult(const Cloud& cloud, const std::vector<int>& segment, int min_
     result.labels[i] = LabelOfObstacle(id_of[s]);
     result.obstacles[id_of[s] - 1].indices.push_back(static_cast<int>(i));
   }
-  for (Obstacle& o : result.obstacles) {
-    Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
-    Eigen::Vector3f hi = -lo;
-    for (const int i : o.indices) {
-      lo = lo.cwiseMin(cloud.points[i]);
-      hi = hi.cwiseMax(cloud.points[i]);
-    }
-    o.centre = 0.5f * (lo + hi);
-    o.half_extents = 0.5f * (hi - lo);
+  const Eigen::Vector3f up = plane.head<3>();
+  std::map<int, int> group_id;  // group_of's id -> 1, 2, ...
+  for (std::size_t k = 0; k < order.size(); ++k) {
+    Obstacle& o = result.obstacles[k];
+    const OrientedBox box = FitOrientedBox(cloud.points, o.indices, table_found ? &up : nullptr);
+    o.centre = box.centre;
+    o.orientation = box.orientation;
+    o.half_extents = box.half_extents;
+    const int g = group_of ? (*group_of)[static_cast<std::size_t>(order[k])] : -1 - static_cast<int>(k);
+    o.group = group_id.emplace(g, static_cast<int>(group_id.size()) + 1).first->second;
   }
   if (table_found) {
     result.table.found = true;

@@ -35,9 +35,11 @@ constexpr int kSegTable = -2;
 /// Turns per-point segment ids into a Result: segments with fewer than
 /// `min_points` points are removed; the others become obstacles numbered
 /// 1, 2, ... by decreasing size (ties by first index), each with the
-/// axis-aligned box of its points. `plane` is written to the table when
-/// `table_found`. Allocates.
+/// oriented box of its points (upright on the table when `table_found`)
+/// and its group: group_of[segment] (any ids; renumbered 1, 2, ... in the
+/// order of the obstacles), or each obstacle its own group when group_of
+/// is null. `plane` is written to the table when `table_found`. Allocates.
 Result BuildResult(const Cloud& cloud, const std::vector<int>& segment, int min_points, bool table_found,
-                   const Eigen::Vector4f& plane);
+                   const Eigen::Vector4f& plane, const std::vector<int>* group_of = nullptr);
 
 }  // namespace iplan::cloud::internal

@@ -8,12 +8,14 @@
 #include <cmath>
 #include <fstream>
 #include <random>
+#include <map>
 
 #include <Eigen/Geometry>
 
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/evaluate.h"
 #include "iplan/cloud/noise.h"
+#include "iplan/cloud/oriented_box.h"
 #include "iplan/cloud/pipeline.h"
 
 namespace iplan::cloud {
@@ -106,7 +108,8 @@ TEST(ObstaclePipeline, FindsTheTableAndTwoBoxes) {
     EXPECT_EQ(o.id, static_cast<int>(k) + 1);
     for (const int i : o.indices) {
       EXPECT_EQ(r.labels[i], LabelOfObstacle(o.id));
-      EXPECT_TRUE(((s.cloud.points[i] - o.centre).cwiseAbs().array() <= o.half_extents.array() + 1e-6f).all());
+      const Eigen::Vector3f p_B = o.orientation.conjugate() * (s.cloud.points[i] - o.centre);
+      EXPECT_TRUE((p_B.cwiseAbs().array() <= o.half_extents.array() + 1e-5f).all()) << p_B.transpose();
     }
   }
   EXPECT_GE(r.obstacles[0].indices.size(), r.obstacles[1].indices.size());
@@ -156,9 +159,11 @@ TEST(ObstaclePipeline, SplitsABoxStandingOnAnother) {
   EXPECT_EQ(ours.objects, 2);
   EXPECT_EQ(ours.found, 2);
   EXPECT_EQ(ours.false_obstacles, 0);
-  // Without the concavity cue they are one obstacle, which finds neither.
+  // Without the crease cues (concavity, steps) they are one obstacle,
+  // which finds neither.
   CloudParams no_concavity;
   no_concavity.concave_margin = 2.0f;
+  no_concavity.step_angle_deg = 90.0f;
   ObstaclePipeline plain(no_concavity);
   EXPECT_EQ(ScoreScene(s.truth, plain.Process(s.cloud).labels).found, 0);
 }
@@ -208,6 +213,69 @@ TEST(ObstaclePipeline, BadCloudsGiveEmptyResultsOrAClearError) {
   CloudParams bad;
   bad.stride = 0;
   EXPECT_THROW(ObstaclePipeline{bad}, std::invalid_argument);
+}
+
+// Points on the faces of a box (size, yaw about z, centre; W, z up) a
+// camera up and to the front-left sees: the top and two sides, 5 mm apart,
+// with 0.5 mm of seeded noise.
+std::vector<Eigen::Vector3f> VisibleFaces(const Eigen::Vector3f& size, float yaw, const Eigen::Vector3f& centre) {
+  std::mt19937 rng(7);
+  std::normal_distribution<float> noise(0.0f, 0.0005f);
+  const Eigen::Matrix3f R = Eigen::AngleAxisf(yaw, Eigen::Vector3f::UnitZ()).toRotationMatrix();
+  const Eigen::Vector3f h = 0.5f * size;
+  std::vector<Eigen::Vector3f> out;
+  auto face = [&](int axis, float sign) {
+    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
+    for (float u = -h[a]; u <= h[a]; u += 0.005f)
+      for (float v = -h[b]; v <= h[b]; v += 0.005f) {
+        Eigen::Vector3f p_B;
+        p_B[axis] = sign * h[axis];
+        p_B[a] = u;
+        p_B[b] = v;
+        out.push_back(centre + R * p_B + Eigen::Vector3f(noise(rng), noise(rng), noise(rng)));
+      }
+  };
+  face(2, 1.0f);   // top
+  face(0, -1.0f);  // the side facing -x_B
+  face(1, -1.0f);  // the side facing -y_B
+  return out;
+}
+
+TEST(FitOrientedBox, UprightBoxOfARotatedBoxIsTight) {
+  const Eigen::Vector3f size(0.30f, 0.12f, 0.10f), centre(0.2f, 0.1f, 0.05f);
+  const float yaw = 0.5f;
+  const std::vector<Eigen::Vector3f> points = VisibleFaces(size, yaw, centre);
+  std::vector<int> all(points.size());
+  for (std::size_t i = 0; i < all.size(); ++i) all[i] = static_cast<int>(i);
+  const Eigen::Vector3f up = Eigen::Vector3f::UnitZ();
+  const OrientedBox box = FitOrientedBox(points, all, &up);
+  // The true box, to the noise (its extremes reach about 2 mm beyond each
+  // face): edges within 5 mm, yaw within 1 degree (x along the long side,
+  // modulo 180 degrees), z up, centre within 3 mm.
+  EXPECT_LT((2.0f * box.half_extents - size).cwiseAbs().maxCoeff(), 0.005f) << box.half_extents.transpose();
+  const Eigen::Matrix3f R = box.orientation.toRotationMatrix();
+  EXPECT_GT(R.col(2).dot(up), 0.9999f);
+  const Eigen::Vector3f long_side(std::cos(yaw), std::sin(yaw), 0.0f);
+  EXPECT_GT(std::abs(R.col(0).dot(long_side)), std::cos(1.0f * static_cast<float>(M_PI) / 180.0f));
+  EXPECT_GE(R.col(0).x(), 0.0f);  // x_B . x_F >= 0
+  EXPECT_LT((box.centre - centre).norm(), 0.003f);
+  EXPECT_NEAR(R.determinant(), 1.0f, 1e-5f);
+  for (const Eigen::Vector3f& p : points)
+    EXPECT_TRUE(((R.transpose() * (p - box.centre)).cwiseAbs().array() <= box.half_extents.array() + 1e-5f).all());
+  // The axis-aligned box around the same points is 1.7 times the volume.
+  Eigen::Vector3f lo = Eigen::Vector3f::Constant(1e9f), hi = -lo;
+  for (const Eigen::Vector3f& p : points) lo = lo.cwiseMin(p), hi = hi.cwiseMax(p);
+  const float oriented = 8.0f * box.half_extents.prod(), aligned = (hi - lo).prod(), truth = size.prod();
+  EXPECT_LT(oriented, 1.1f * truth);
+  EXPECT_GT(aligned, 1.6f * truth);
+  // Without an up direction: the principal axes, still holding every point.
+  const OrientedBox pca = FitOrientedBox(points, all, nullptr);
+  const Eigen::Matrix3f Rp = pca.orientation.toRotationMatrix();
+  EXPECT_NEAR(Rp.determinant(), 1.0f, 1e-5f);
+  for (const Eigen::Vector3f& p : points)
+    EXPECT_TRUE(((Rp.transpose() * (p - pca.centre)).cwiseAbs().array() <= pca.half_extents.array() + 1e-5f).all());
+  // No points: a zero box.
+  EXPECT_EQ(FitOrientedBox(points, {}, &up).half_extents, Eigen::Vector3f::Zero());
 }
 
 TEST(TextbookPipeline, FindsTheTwoSeparateBoxes) {
@@ -382,13 +450,13 @@ TEST(CloudParams, DefaultsAreValidAndConfigFileWritesThemOut) {
   EXPECT_FLOAT_EQ(file.cluster_distance, d.cluster_distance);
   EXPECT_FLOAT_EQ(file.cluster_distance_per_m2, d.cluster_distance_per_m2);
   EXPECT_EQ(file.min_obstacle_points, d.min_obstacle_points);
+  EXPECT_EQ(file.normal_window_px, d.normal_window_px);
   EXPECT_FLOAT_EQ(file.concave_margin, d.concave_margin);
   EXPECT_EQ(file.crease_offset_px, d.crease_offset_px);
-  EXPECT_FLOAT_EQ(file.normal_smoothing_px, d.normal_smoothing_px);
+  EXPECT_FLOAT_EQ(file.step_normal_deg, d.step_normal_deg);
+  EXPECT_FLOAT_EQ(file.step_angle_deg, d.step_angle_deg);
   EXPECT_EQ(file.min_part_points, d.min_part_points);
-  EXPECT_FLOAT_EQ(file.flat_angle_deg, d.flat_angle_deg);
-  EXPECT_FLOAT_EQ(file.coplanar_distance, d.coplanar_distance);
-  EXPECT_FLOAT_EQ(file.convex_margin, d.convex_margin);
+  EXPECT_FLOAT_EQ(file.concave_region_share, d.concave_region_share);
   EXPECT_FLOAT_EQ(file.voxel_size, d.voxel_size);
   EXPECT_FLOAT_EQ(file.euclidean_tolerance, d.euclidean_tolerance);
   EXPECT_EQ(file.textbook_min_cluster, d.textbook_min_cluster);

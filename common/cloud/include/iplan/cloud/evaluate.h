@@ -39,4 +39,26 @@ SceneScore ScoreScene(const std::vector<std::uint32_t>& truth, const std::vector
 /// Sum of scenes (for totals).
 SceneScore Add(const SceneScore& a, const SceneScore& b);
 
+/// Cross-validated choice among parameter settings: in each fold the
+/// setting with the best score on the other scenes (most objects found
+/// minus false obstacles; ties: fewer false obstacles, then the earlier
+/// setting) is scored on the fold's scenes, which had no say in it.
+struct CrossValidation {
+  struct Fold {
+    std::vector<int> scenes;  ///< held out
+    int chosen = -1;          ///< setting chosen on the other scenes
+    SceneScore score;         ///< its score on the held-out scenes
+  };
+  std::vector<Fold> folds;
+  SceneScore held_out;  ///< the folds' held-out scores, summed: the cross-validated figure
+  int chosen_all = -1;  ///< the setting the same rule chooses on all scenes
+  SceneScore all;       ///< its score on all scenes (tuned on them: optimistic)
+};
+
+/// scores[scene][setting] (every scene the same number of settings, at
+/// least one); folds: lists of scene indices, every scene in exactly one,
+/// none empty. Throws std::invalid_argument otherwise.
+CrossValidation CrossValidate(const std::vector<std::vector<SceneScore>>& scores,
+                              const std::vector<std::vector<int>>& folds);
+
 }  // namespace iplan::cloud

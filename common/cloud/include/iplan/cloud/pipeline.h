@@ -15,9 +15,11 @@
 
 #include <memory>
 #include <string>
+#include <utility>
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "iplan/cloud/cloud.h"
 
@@ -43,12 +45,20 @@ struct Table {
   int points = 0;                                    ///< input points labelled table
 };
 
-/// One segmented obstacle: an axis-aligned box in S around its points.
+/// One segmented obstacle (a part of an object, as the creases cut it) and
+/// the oriented box B around its points in S (FitOrientedBox: upright on
+/// the table with the smallest footprint when a table was found, else
+/// along the points' principal axes).
 struct Obstacle {
-  int id = 0;                                              ///< 1, 2, ... by decreasing size
-  Eigen::Vector3f centre = Eigen::Vector3f::Zero();        ///< box centre, metres
-  Eigen::Vector3f half_extents = Eigen::Vector3f::Zero();  ///< metres, >= 0
-  std::vector<int> indices;                                ///< input point indices, ascending
+  int id = 0;  ///< 1, 2, ... by decreasing size
+  /// Obstacles of one group form one surface connected in depth (parts of
+  /// one object cut at creases, or objects touching); 1, 2, ... in the
+  /// order of their first obstacle.
+  int group = 0;
+  Eigen::Vector3f centre = Eigen::Vector3f::Zero();                 ///< p_SB, box centre, metres
+  Eigen::Quaternionf orientation = Eigen::Quaternionf::Identity();  ///< R_SB (z_B along the table normal)
+  Eigen::Vector3f half_extents = Eigen::Vector3f::Zero();           ///< along B's axes, metres, >= 0
+  std::vector<int> indices;                                         ///< input point indices, ascending
 };
 
 struct Result {
@@ -81,25 +91,34 @@ struct CloudParams {
   float cluster_distance = 0.015f;     ///< metres between neighbouring pixels at 1 m depth
   float cluster_distance_per_m2 = 0.0f;  ///< metres per m^2 of depth added
   int min_obstacle_points = 400;       ///< input points; smaller segments are removed
-  /// Concave creases split segments: a pixel whose neighbours
-  /// crease_offset_px to either side (strided pixels, along a row or a
-  /// column) have normals meeting with d . (n_b - n_a) < -concave_margin
-  /// (d the unit vector between them) is a crease; >= 2 switches it off.
+  /// Normals: PCA of the candidates within normal_window_px strided
+  /// pixels (a (2m+1)^2 window) reachable without a depth gap.
+  int normal_window_px = 4;
+  /// Creases split segments into parts: a pixel is on a crease when the
+  /// pixels crease_offset_px (strided) to either side of it, along a row or
+  /// a column, have normals meeting concavely, d . (n_b - n_a) <
+  /// -concave_margin (d the unit vector from a to b; >= 2 switches it off),
+  /// or normals within step_normal_deg (degrees) of each other while d
+  /// leaves their mean tangent plane by more than step_angle_deg (a step
+  /// between parallel faces: a box on a flat one, its side seen at a
+  /// grazing angle; >= 90 switches it off).
   float concave_margin = 0.1f;
   int crease_offset_px = 2;
-  float normal_smoothing_px = 5.0f;  ///< normal window, strided pixels
-  /// A segment is split along concave creases only into parts of at least
-  /// this many input points (smaller parts join the neighbour they border
-  /// most).
+  float step_normal_deg = 20.0f;
+  float step_angle_deg = 30.0f;
+  /// Connected crease pixels and connected other pixels form fragments; a
+  /// segment is split into its fragments of at least min_part_points input
+  /// points (smaller ones join the part they border most). A crease
+  /// fragment counts only when at least concave_region_share *
+  /// min_part_points of it lie deeper than concave_region_depth_px
+  /// (strided, chessboard distance to the nearest non-crease pixel) inside
+  /// it and it borders at most one non-crease fragment of min_part_points:
+  /// a concave surface (the inside of a bowl, bordering its outside), not a
+  /// band along a crease between two surfaces; concave_region_share > 1
+  /// switches concave parts off.
   int min_part_points = 800;
-  /// Parts of one segment are merged back (faces of one object)
-  /// when coplanar: normals within flat_angle_deg (degrees) and each
-  /// centroid within coplanar_distance (metres) of the other's plane; or
-  /// when they meet convexly: d . (n_a - n_b) > convex_margin (d the unit
-  /// vector between their centroids, n their normals).
-  float flat_angle_deg = 20.0f;
-  float coplanar_distance = 0.01f;
-  float convex_margin = 0.1f;
+  float concave_region_share = 0.1f;
+  int concave_region_depth_px = 3;
 
   // Textbook pipeline.
   float voxel_size = 0.01f;            ///< metres
@@ -115,6 +134,16 @@ struct CloudParams {
 /// Validate() throws std::runtime_error "<path>: <what>" naming the key.
 /// Keys left out keep their defaults; an empty file gives the defaults.
 CloudParams LoadCloudParams(const std::string& path);
+
+/// A grid of parameter settings for cross-validation: a YAML map of
+/// CloudParams keys to lists of values (a single value is a list of one),
+/// e.g. `{min_part_points: [400, 800], concave_margin: [0.05, 0.1]}`.
+/// Returns every combination applied to `base`, in the file's order (the
+/// last key varying fastest), each with its name "key=value key=value".
+/// Throws std::runtime_error "<path>: ..." for an unknown key, a wrong type,
+/// an empty list or a combination that fails Validate().
+std::vector<std::pair<std::string, CloudParams>> LoadCloudParamsGrid(const std::string& path,
+                                                                     const CloudParams& base);
 
 /// Our pipeline. Holds its work buffers, so a second call on a cloud of the
 /// same size does not grow them. Not thread-safe (one per thread).
