@@ -108,6 +108,10 @@ class CloudService : public framework::Service {
     node.SetDiagnosticValue("clouds", std::to_string(processed_));
     node.SetDiagnosticValue("obstacles", std::to_string(out.obstacles.size()));
     node.SetDiagnosticValue("human_points", std::to_string(out.human.size()));
+    std::size_t tracked = 0;
+    for (const HumanPoint& h : out.human) tracked += h.motion >= 0;
+    node.SetDiagnosticValue("tracked_human_points", std::to_string(tracked));
+    node.SetDiagnosticValue("motions", std::to_string(out.motions.size()));
     node.SetDiagnosticValue("clusters", std::to_string(out.clusters));
     node.SetDiagnosticValue("table", out.table_found ? std::to_string(out.table_points) + " points" : "not found");
     node.SetDiagnosticValue("clouds_without_self_filter", std::to_string(unfiltered_));
@@ -142,7 +146,22 @@ class CloudService : public framework::Service {
       g.mean.z = h.mean.z();
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) g.covariance[static_cast<std::size_t>(3 * r + c)] = h.covariance(r, c);
+      g.motion = h.motion >= 0 && static_cast<std::size_t>(h.motion) < msg::Limits::kPointMotions
+                     ? static_cast<uint32_t>(h.motion + 1)
+                     : 0;
       human_.points.push_back(g);
+    }
+    human_.motions.clear();
+    for (const PointMotionEstimate& e : out.motions) {
+      if (human_.motions.size() >= msg::Limits::kPointMotions) break;
+      msg::PointMotion m;
+      m.id = e.id;
+      m.velocity.x = e.velocity.x();
+      m.velocity.y = e.velocity.y();
+      m.velocity.z = e.velocity.z();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m.velocity_covariance[static_cast<std::size_t>(3 * r + c)] = e.velocity_covariance(r, c);
+      human_.motions.push_back(m);
     }
     std::string err;
     if (!obstacles_writer_->Write(obstacles_, &err)) node.log().warn("obstacles not published: {}", err);
