@@ -32,6 +32,7 @@
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
 #include "robot_distance.h"
+#include "service_cell.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -52,34 +53,8 @@ std::string List(const Eigen::Vector3d& v) { return List(std::vector<double>{v.x
 
 collision::RobotModel Panda() { return collision::LoadRobotModelFromYaml(kConfig + "/robots/panda.yaml"); }
 
-struct Cell {
-  explicit Cell(const std::string& tag, int domain) : domain(domain) {
-    dir = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-  }
-  ~Cell() {
-    for (auto& [name, p] : procs) p->Signal(SIGTERM);
-    for (auto& [name, p] : procs) p->Wait(10s);
-    if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
-    else std::cout << "service logs kept in " << dir.string() << "\n";
-  }
-  void Start(const std::string& exe, const std::string& cfg, std::vector<std::string> extra) {
-    std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", "cyclonedds", "--domain",
-                                     std::to_string(domain)};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    procs[exe] = std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, (dir / exe).string());
-  }
-  // Every service exits 0 on SIGTERM.
-  void Stop() {
-    for (auto& [name, p] : procs) p->Signal(SIGTERM);
-    for (auto& [name, p] : procs) EXPECT_EQ(p->Wait(10s), 0) << name << ":\n" << p->Stderr();
-    procs.clear();
-  }
-  int domain;
-  std::filesystem::path dir;
-  std::map<std::string, std::unique_ptr<Process>> procs;
-};
+// The services under test (tests/support/service_cell.h), on Cyclone DDS.
+using Cell = ServiceCell;
 
 // The depth path's perception: the simulated camera (10 Hz, the shipped rate) and the person's truth.
 std::vector<std::string> DepthPerception(std::vector<std::string> more) {
