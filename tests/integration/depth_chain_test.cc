@@ -219,6 +219,16 @@ TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
             << stop->r.min_separation << " m, S_p " << stop->r.protective_separation << " m: " << stop->r.reason
             << "\njoint 2 speed before the stop " << moved << " rad/s; closest executed arm vs true body " << closest
             << " m; joint speed from 0.6 s after the stop " << late_speed << " rad/s\n";
+  // What collision risk said after the stop (a verdict change or every 0.5 s): why the arm moved again, if it did.
+  double shown = -1;
+  int last_verdict = -1;
+  for (const auto& r : run.risks) {
+    if (r.t < stop->t || (r.r.verdict == last_verdict && r.t < shown + 0.5)) continue;
+    std::cout << "  +" << r.t << " s: verdict " << static_cast<int>(r.r.verdict) << ", separation " << r.r.min_separation
+              << " m, S_p " << r.r.protective_separation << " m: " << r.r.reason << "\n";
+    shown = r.t;
+    last_verdict = r.r.verdict;
+  }
   EXPECT_GT(moved, 0.1) << "the arm never moved: the stop proves nothing";
   EXPECT_GT(closest, 0.0) << "contact with the true body";
   EXPECT_LT(late_speed, 1e-6) << "not at rest after the stop";

@@ -42,6 +42,14 @@ struct PointsParams {
   double time_step = 0.1;          ///< s between the configurations checked
   double min_point_radius = 0.005; ///< m; r_p is max(this, voxel_size / 2)
   double block_size = 0.1;         ///< m; grid of the culling blocks
+  /// Whether the separation and the bound use the cloud service's measured
+  /// point velocities (issue 29). Off: every point at the ISO default speed,
+  /// not moved by the bound (as before issue 29), whatever motions arrive.
+  /// Off by default: with them, depth_chain_test's person (a hand reaching
+  /// from rest into the arm's path) was touched, -0.03 m; a constant-velocity
+  /// estimate of a hand at rest does not bound the speed it reaches within
+  /// T_r + T_s (docs/perception-clouds.md, "Not done").
+  bool tracked_speeds = false;
   double speed_sigmas = 2.0;       ///< standard deviations of a tracked point's velocity added to its directed speed
   /// s; the bound's prediction moves a tracked point at its velocity for at
   /// most this long (its covariance grows by t^2 C all along the horizon).
@@ -53,6 +61,7 @@ struct PointsParams {
     a->Visit(IPLAN_NVP(time_step, "s between the configurations bounded, in (0, horizon]"));
     a->Visit(IPLAN_NVP(min_point_radius, "m; a point's sphere radius is max(this, voxel_size / 2), > 0"));
     a->Visit(IPLAN_NVP(block_size, "m; grid of the blocks points are culled by, > 0"));
+    a->Visit(IPLAN_NVP(tracked_speeds, "use the points' measured velocities (speed towards the robot, the bound's motion); false: the ISO default speed for every point"));
     a->Visit(IPLAN_NVP(speed_sigmas, "standard deviations of a tracked point's velocity added to its speed towards the robot, >= 0"));
     a->Visit(IPLAN_NVP(motion_horizon, "s; the bound moves tracked points at their velocity for at most this long (covariance grows all along), >= 0"));
   }

@@ -24,6 +24,10 @@ std::optional<std::string> RiskMonitor::UpdateHumanPoints(cell::HumanPoints seen
   if (!(seen.voxel_size >= 0)) return std::string("human points: voxel_size is negative or not finite");
   if (auto why = seen.Check()) return "human points: " + *why;
   const PointsParams& pp = params_.human_points;
+  if (!pp.tracked_speeds) {  // every point untracked: the ISO default speed, where seen
+    seen.motion_of.clear();
+    seen.motions.clear();
+  }
   const double radius = std::max(pp.min_point_radius, 0.5 * seen.voxel_size);
   // A floor of 1 mm standard deviation: noise-free points (a simulator's, a
   // zero covariance the boundary accepts as semi-definite) still have a

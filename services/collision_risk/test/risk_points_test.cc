@@ -15,11 +15,19 @@ const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "
                                                "panda_joint5", "panda_joint6", "panda_joint7"};
 const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
 
+// The measured speeds switched on (human_points.tracked_speeds; off by
+// default, see ShippedDefaultJudgesATrackedPointAtTheIsoSpeed).
+RiskParams WithTrackedSpeeds(bool on = true) {
+  RiskParams p;
+  p.human_points.tracked_speeds = on;
+  return p;
+}
+
 class RiskPointsTest : public ::testing::Test {
  protected:
-  RiskPointsTest()
+  explicit RiskPointsTest(const RiskParams& params = WithTrackedSpeeds())
       : robot_(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml")),
-        monitor_(robot_, collision::HumanBodyParams::DefaultUpperBody(), RiskParams{}) {
+        monitor_(robot_, collision::HumanBodyParams::DefaultUpperBody(), params) {
     collision::RobotData d(robot_);
     Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(kReady.data(), 7);
     collision::CalcForwardKinematics(robot_, q, &d);
@@ -181,6 +189,25 @@ TEST_F(RiskPointsTest, ATrackedSlowPersonGivesASmallSpAnUntrackedOneTheDefault) 
   const RiskReport r = monitor_.Evaluate(t + kSec / 100);
   EXPECT_DOUBLE_EQ(r.human_speed, 1.6);
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+}
+
+// Shipped default (tracked_speeds false): a tracked slow point counts as
+// untracked, at the ISO default speed, and the bound does not move it.
+class RiskPointsDefaultTest : public RiskPointsTest {
+ protected:
+  RiskPointsDefaultTest() : RiskPointsTest(RiskParams{}) {}
+};
+TEST_F(RiskPointsDefaultTest, ShippedDefaultJudgesATrackedPointAtTheIsoSpeed) {
+  EXPECT_FALSE(RiskParams{}.human_points.tracked_speeds);
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  SeeTrackedPoint(t, 0.4, Eigen::Vector3d::Zero(), 0.1);
+  const RiskReport r = monitor_.Evaluate(t + kSec / 100);
+  ASSERT_TRUE(r.min_separation.has_value()) << r.reason;
+  EXPECT_DOUBLE_EQ(r.human_speed, 1.6);
+  EXPECT_NEAR(r.protective_separation, 0.4 * 1.6 + 0.17, 1e-9);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+  EXPECT_NE(r.max_action, "as seen, moving");
 }
 
 // A robot sphere moving at 0.5 m/s towards a point 0.28 m away: a tracked
