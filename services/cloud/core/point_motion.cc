@@ -22,9 +22,10 @@ std::string MotionParams::Validate() const {
   if (!Positive(part_radius)) return "part_radius must be > 0 m";
   if (min_points < 1) return "min_points must be >= 1, got " + std::to_string(min_points);
   if (!Positive(measurement_sigma)) return "measurement_sigma must be > 0 m";
-  if (!Positive(acceleration_sigma)) return "acceleration_sigma must be > 0 m/s^2";
+  if (!Positive(acceleration_density)) return "acceleration_density must be > 0 m^2/s^3";
   if (!Positive(initial_speed_sigma)) return "initial_speed_sigma must be > 0 m/s";
   if (!Positive(tracked_speed_sigma)) return "tracked_speed_sigma must be > 0 m/s";
+  if (!(neighbour_speed_sigma >= 0 && std::isfinite(neighbour_speed_sigma))) return "neighbour_speed_sigma must be >= 0 m/s";
   if (!(visibility_sigma >= 0 && std::isfinite(visibility_sigma))) return "visibility_sigma must be >= 0 m";
   if (!Positive(gate)) return "gate must be > 0";
   if (lost_frames < 0) return "lost_frames must be >= 0, got " + std::to_string(lost_frames);
@@ -46,17 +47,22 @@ bool MotionTracker::Tracked(const MotionPart& part) const {
   return max_variance <= params_.tracked_speed_sigma * params_.tracked_speed_sigma;
 }
 
-// Constant velocity, white-noise (piecewise constant) acceleration per axis:
-// x' = F x, P' = F P F^T + G q G^T with G = [dt^2 / 2; dt].
+// Constant velocity, continuous white-noise acceleration per axis (spectral
+// density q = acceleration_density): x' = F x, P' = F P F^T + Q with
+//   Q = q [dt^3/3  dt^2/2; dt^2/2  dt]
+// per axis, so the velocity variance grows linearly with the time since the
+// last frame: a gap of three frames costs what three frames do (the
+// piecewise-constant model grew it with dt^2, and a dropped frame or two on
+// a loaded host made every part untrusted).
 void MotionTracker::Predict(double dt) {
   Matrix6d F = Matrix6d::Identity();
   F.topRightCorner<3, 3>() = dt * Eigen::Matrix3d::Identity();
-  const double q = params_.acceleration_sigma * params_.acceleration_sigma;
+  const double q = params_.acceleration_density;
   Matrix6d Q = Matrix6d::Zero();
-  Q.topLeftCorner<3, 3>() = q * std::pow(dt, 4) / 4 * Eigen::Matrix3d::Identity();
-  Q.topRightCorner<3, 3>() = q * std::pow(dt, 3) / 2 * Eigen::Matrix3d::Identity();
+  Q.topLeftCorner<3, 3>() = q * std::pow(dt, 3) / 3 * Eigen::Matrix3d::Identity();
+  Q.topRightCorner<3, 3>() = q * dt * dt / 2 * Eigen::Matrix3d::Identity();
   Q.bottomLeftCorner<3, 3>() = Q.topRightCorner<3, 3>();
-  Q.bottomRightCorner<3, 3>() = q * dt * dt * Eigen::Matrix3d::Identity();
+  Q.bottomRightCorner<3, 3>() = q * dt * Eigen::Matrix3d::Identity();
   for (MotionPart& p : parts_) {
     p.x = F * p.x;
     p.P = F * p.P * F.transpose() + Q;
@@ -160,6 +166,23 @@ void MotionTracker::Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<in
     part.P.bottomRightCorner<3, 3>() =
         params_.initial_speed_sigma * params_.initial_speed_sigma * Eigen::Matrix3d::Identity();
     part.measured = 1;
+    // Next to a tracked part (within two part radii: the same body, its
+    // visible region grown), the new part starts from that part's velocity,
+    // its covariance grown by neighbour_speed_sigma per axis (what a part of
+    // a body may move relative to the next), and counts as tracked when that
+    // is within tracked_speed_sigma.
+    const MotionPart* neighbour = nullptr;
+    double nearest = 4 * r2;
+    for (const MotionPart& other : parts_) {
+      const double d = (other.centre() - centre).squaredNorm();
+      if (d <= nearest && other.measured >= 2 && Tracked(other)) nearest = d, neighbour = &other;
+    }
+    if (neighbour) {
+      part.x.tail<3>() = neighbour->velocity();
+      part.P.bottomRightCorner<3, 3>() = neighbour->velocity_covariance() +
+                                         params_.neighbour_speed_sigma * params_.neighbour_speed_sigma * Eigen::Matrix3d::Identity();
+      part.measured = 2;
+    }
     const int index = static_cast<int>(parts_.size());
     for (std::size_t i = s; i < p_W.size(); ++i) {
       if (of[i] < 0 && (p_W[i] - centre).squaredNorm() <= r2) {

@@ -7,8 +7,9 @@
 // the hand's part moves at the hand's speed.
 //
 // Per frame (stamps in ns, wall clock; positions in the cell frame W, m):
-//  1. every part is predicted to the frame's stamp (white-noise
-//     acceleration, acceleration_sigma);
+//  1. every part is predicted to the frame's stamp (continuous white-noise
+//     acceleration of spectral density acceleration_density: the velocity
+//     variance grows by it per second);
 //  2. its measurement: the centroid m of the points within part_radius of
 //     its predicted position, less the offset o = m' - x the part had from
 //     the centroid of its ball in the frame before. The ball moves with the
@@ -34,8 +35,12 @@
 //     frames;
 //  4. each point belongs to the part whose position is nearest, if within
 //     part_radius; points no part is that near seed new parts (greedily,
-//     part_radius around the first point left), at rest with
-//     initial_speed_sigma per axis;
+//     part_radius around the first point left): at rest with
+//     initial_speed_sigma per axis, or, within two part radii of a tracked
+//     part (the same body, its visible region grown: an arm reaching out,
+//     a hand coming out from behind the robot), at that part's velocity
+//     with its covariance grown by neighbour_speed_sigma per axis (what one
+//     part of a body may move relative to the next);
 //  5. parts unmeasured for more than lost_frames frames are dropped; of two
 //     parts closer than merge_distance the younger is dropped.
 // Pure algorithm, no DDS types. Not thread-safe; allocates.
@@ -54,10 +59,11 @@ namespace iplan::cloud_service {
 struct MotionParams {
   double part_radius = 0.2;           ///< m; a point joins the nearest part within this
   int min_points = 5;                 ///< points a part needs in a frame to be measured
-  double measurement_sigma = 0.02;    ///< m per axis, the centroid's measurement noise
-  double acceleration_sigma = 2.0;    ///< m/s^2 per axis, white-noise acceleration of the model
+  double measurement_sigma = 0.005;   ///< m per axis, the centroid's measurement noise (motion_eval: cross-validated)
+  double acceleration_density = 0.9;  ///< m^2/s^3 per axis, white-noise acceleration (motion_eval: cross-validated)
   double initial_speed_sigma = 1.0;   ///< m/s per axis, velocity uncertainty of a new part
-  double tracked_speed_sigma = 0.3;   ///< m/s; largest velocity std of a tracked part
+  double tracked_speed_sigma = 0.5;   ///< m/s; largest velocity std of a tracked part
+  double neighbour_speed_sigma = 0.4; ///< m/s per axis a new part next to a tracked one may move relative to it
   double visibility_sigma = 0.2;      ///< m per unit relative change of a ball's point count, added to measurement_sigma
   double gate = 11.34;                ///< normalised innovation square above which a measurement is down-weighted (chi^2, 3 dof, 99 %)
   int lost_frames = 3;                ///< frames a part outlives its last measurement
@@ -69,9 +75,10 @@ struct MotionParams {
     a->Visit(IPLAN_NVP(part_radius, "m; a point joins the nearest part whose predicted centre is within this, > 0"));
     a->Visit(IPLAN_NVP(min_points, "points a part needs in a frame to be measured, >= 1"));
     a->Visit(IPLAN_NVP(measurement_sigma, "m per axis, noise of a part's centroid, > 0"));
-    a->Visit(IPLAN_NVP(acceleration_sigma, "m/s^2 per axis, white-noise acceleration of the constant-velocity model, > 0"));
+    a->Visit(IPLAN_NVP(acceleration_density, "m^2/s^3 per axis, spectral density of the white-noise acceleration (velocity variance per second), > 0"));
     a->Visit(IPLAN_NVP(initial_speed_sigma, "m/s per axis, velocity uncertainty of a new part, > 0"));
     a->Visit(IPLAN_NVP(tracked_speed_sigma, "m/s; a part's velocity is trusted once its largest std is at most this, > 0"));
+    a->Visit(IPLAN_NVP(neighbour_speed_sigma, "m/s per axis; a new part next to a tracked one starts from its velocity with this much more uncertainty, >= 0"));
     a->Visit(IPLAN_NVP(visibility_sigma, "m; a centroid's std grows by this times the relative change of its ball's point count, >= 0"));
     a->Visit(IPLAN_NVP(gate, "normalised innovation square above which a centroid is down-weighted, > 0"));
     a->Visit(IPLAN_NVP(lost_frames, "frames a part outlives its last measurement, >= 0"));
