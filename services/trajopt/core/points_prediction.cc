@@ -6,6 +6,8 @@
 #include <tuple>
 #include <vector>
 
+#include <Eigen/Eigenvalues>
+
 namespace iplan::trajopt {
 namespace {
 
@@ -44,11 +46,13 @@ std::string PointsPredictionParams::Validate() const {
   if (!(horizon >= time_step && std::isfinite(horizon))) return "human_points.horizon must be >= time_step";
   if (!(motion_horizon >= 0 && std::isfinite(motion_horizon))) return "human_points.motion_horizon must be >= 0 s";
   if (max_spheres < 1) return "human_points.max_spheres must be >= 1, got " + std::to_string(max_spheres);
+  if (!(speed_sigmas >= 0 && std::isfinite(speed_sigmas))) return "human_points.speed_sigmas must be >= 0";
   return "";
 }
 
 std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPredictionParams& params,
-                                                                const cell::HumanPoints& seen) {
+                                                                const cell::HumanPoints& seen,
+                                                                const cell::SsmParams& ssm) {
   if (seen.size() == 0) return std::nullopt;
   double size = params.sphere_size;
   std::map<std::tuple<int, long, long, long>, Cell> cells = Coarsen(seen, size);
@@ -66,10 +70,18 @@ std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPred
     const Eigen::Vector3d centre = c.sum / n;
     double r = 0;
     for (int i : c.points) r = std::max(r, (seen.means.col(i) - centre).norm());
-    radii.push_back(r + point_radius);
+    const cell::PointMotion* m =
+        params.tracked_speeds && c.motion >= 0 ? &seen.motions[static_cast<std::size_t>(c.motion)] : nullptr;
+    const double uncertain_speed =
+        m ? params.speed_sigmas *
+                std::sqrt(std::max(0.0, Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(m->covariance, Eigen::EigenvaluesOnly)
+                                            .eigenvalues()
+                                            .maxCoeff()))
+          : ssm.default_human_speed;
+    radii.push_back(r + point_radius + (ssm.reaction_time + ssm.stopping_time) * uncertain_speed);
     centres.push_back(centre);
     noise.push_back(c.noise / n + kMinVariance * Eigen::Matrix3d::Identity());
-    motions.push_back(c.motion >= 0 ? &seen.motions[static_cast<std::size_t>(c.motion)] : nullptr);
+    motions.push_back(m);
   }
   const int steps = std::max(1, static_cast<int>(std::floor(params.horizon / params.time_step + 1e-9)));
   collision::HumanPrediction out(1, steps, radii);

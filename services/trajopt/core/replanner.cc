@@ -68,7 +68,7 @@ std::optional<std::string> Replanner::UpdatePrediction(cell::BodyId body_id, con
 std::optional<std::string> Replanner::UpdateHumanPoints(const cell::HumanPoints& seen) {
   if (auto why = seen.Check()) return "human points: " + *why;
   if (seen.stamp_ns < points_stamp_ns_) return std::string("human points: older than the last ones");
-  points_prediction_ = BuildPointsPrediction(params_.human_points, seen);
+  points_prediction_ = BuildPointsPrediction(params_.human_points, seen, planner_.params().ssm);
   points_stamp_ns_ = seen.stamp_ns;
   return std::nullopt;
 }

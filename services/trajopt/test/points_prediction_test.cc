@@ -41,8 +41,18 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
   AddBall(&seen, {1.0, 0.0, 1.0}, 0.06, 0);    // a hand, tracked, coming at -x
   AddBall(&seen, {1.4, 0.3, 1.0}, 0.06, -1);   // something not tracked
   ASSERT_EQ(seen.Check(), std::nullopt);
-  const PointsPredictionParams params;  // 0.2 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
-  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen);
+  PointsPredictionParams params;  // 0.2 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
+  const cell::SsmParams ssm;  // T_r + T_s = 0.4 s, 1.6 m/s default
+  // The shipped default (as collision risk's): the tracked hand too stays where seen, grown by 1.6 m/s x 0.4 s.
+  EXPECT_FALSE(params.tracked_speeds);
+  const std::optional<collision::HumanPrediction> untracked = BuildPointsPrediction(params, seen, ssm);
+  ASSERT_TRUE(untracked.has_value());
+  for (int l = 0; l < untracked->num_spheres(); ++l) {
+    EXPECT_GE(untracked->radius(l), 0.64);
+    EXPECT_NEAR((untracked->sphere(0, untracked->num_steps() - 1, l).mean - untracked->sphere(0, 0, l).mean).norm(), 0.0, 1e-12);
+  }
+  params.tracked_speeds = true;
+  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen, ssm);
   ASSERT_TRUE(hp.has_value());
   EXPECT_EQ(hp->num_actions(), 1);
   EXPECT_DOUBLE_EQ(hp->action_probability(0), 1.0);
@@ -66,16 +76,20 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
       EXPECT_NEAR((step4 - step0).x(), -0.4 * 0.4, 1e-9);
       EXPECT_NEAR((last - step4).norm(), 0.0, 1e-9);
       EXPECT_NEAR(var14 - var0, (1.5 * 1.5 - 0.1 * 0.1) * 0.01, 1e-9);
-    } else {  // not tracked: where seen, the noise only
+      // Grown by the monitor's 2 sigma (0.1 m/s) over T_r + T_s: 0.08 m.
+      EXPECT_GE(hp->radius(l), 0.08);
+      EXPECT_LE(hp->radius(l), 0.08 + 0.2 * std::sqrt(3.0) + 0.015);
+    } else {  // not tracked: where seen, the noise only; grown by 1.6 m/s x 0.4 s
       EXPECT_NEAR((last - step0).norm(), 0.0, 1e-12);
       EXPECT_NEAR(var14, var0, 1e-15);
       EXPECT_LT(var0, 1e-5);
+      EXPECT_GE(hp->radius(l), 0.64);
     }
   }
   seen.means.resize(3, 0);
   seen.covariances.clear();
   seen.motion_of.clear();
-  EXPECT_FALSE(BuildPointsPrediction(params, seen).has_value());  // nobody seen
+  EXPECT_FALSE(BuildPointsPrediction(params, seen, ssm).has_value());  // nobody seen
 }
 
 TEST(PointsPrediction, ManySpheresCoarsenTheGrid) {
@@ -84,11 +98,11 @@ TEST(PointsPrediction, ManySpheresCoarsenTheGrid) {
   AddBall(&seen, {1.2, 0.0, 0.9}, 0.45, -1);  // a person-sized ball: ~30 cells of 0.2 m on its surface
   PointsPredictionParams params;
   params.max_spheres = 10;
-  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen);
+  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen, cell::SsmParams{});
   ASSERT_TRUE(hp.has_value());
   EXPECT_LE(hp->num_spheres(), 10);
   params.max_spheres = 48;
-  EXPECT_GT(BuildPointsPrediction(params, seen)->num_spheres(), 10);
+  EXPECT_GT(BuildPointsPrediction(params, seen, cell::SsmParams{})->num_spheres(), 10);
   params.sphere_size = 0;
   EXPECT_EQ(params.Validate(), "human_points.sphere_size must be > 0 m");
 }
