@@ -83,14 +83,28 @@ class CloudService : public framework::Service {
     while (history_.size() > 1 && history_.back().first - history_.front().first > kHistoryNs) history_.pop_front();
   }
 
-  // The joint state nearest the cloud's stamp, if within joint_state_timeout.
+  // The robot's pose at the cloud's stamp: interpolated between the joint
+  // states just before and just after it when they are at most kBracketNs
+  // apart (a busy executor receives joint states in bursts: the nearest one
+  // can be 0.1 s or more away, the arm moving centimetres meanwhile, while
+  // its path around the stamp is known on both sides); else the nearest
+  // state, if within joint_state_timeout.
   std::optional<Eigen::VectorXd> PoseAt(int64_t stamp) const {
     const std::pair<int64_t, Eigen::VectorXd>* best = nullptr;
+    const std::pair<int64_t, Eigen::VectorXd>*before = nullptr, *after = nullptr;
     for (const auto& h : history_) {
       if (!best || std::llabs(h.first - stamp) < std::llabs(best->first - stamp)) best = &h;
+      if (h.first <= stamp && (!before || h.first > before->first)) before = &h;
+      if (h.first >= stamp && (!after || h.first < after->first)) after = &h;
     }
-    if (!best || static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) return std::nullopt;
-    return best->second;
+    if (!best) return std::nullopt;
+    if (before && after && after->first > before->first && after->first - before->first <= kBracketNs) {
+      const double u = static_cast<double>(stamp - before->first) / static_cast<double>(after->first - before->first);
+      if (static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) ++interpolated_;
+      return Eigen::VectorXd((1 - u) * before->second + u * after->second);
+    }
+    if (static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 <= joint_state_timeout_) return best->second;
+    return std::nullopt;
   }
 
   void OnCloud(Node& node, const msg::PointCloud2& m) {
@@ -101,16 +115,31 @@ class CloudService : public framework::Service {
     // near enough; otherwise no self-filter (the robot's own points then
     // count as a person: cautious, and reported).
     const std::optional<Eigen::VectorXd> q = PoseAt(stamp);
-    if (!joint_names_.empty() && !q) ++unfiltered_;
+    const bool unfiltered = !joint_names_.empty() && !q;
+    if (unfiltered) {
+      ++unfiltered_;
+      // What the history held: the newest joint state against the cloud's stamp.
+      node.SetDiagnosticValue("last_without_self_filter",
+                              history_.empty() ? std::string("no joint state in the last second")
+                                               : "newest joint state " +
+                                                     std::to_string((history_.back().first - stamp) * 1e-9) +
+                                                     " s from the cloud's stamp, " + std::to_string(history_.size()) +
+                                                     " in the last second");
+    }
     const StageOutput out = stage_->Process(&cloud_, q, stamp);
     Publish(node, m.header.stamp, out);
     ++processed_;
     node.SetDiagnosticValue("clouds", std::to_string(processed_));
     node.SetDiagnosticValue("obstacles", std::to_string(out.obstacles.size()));
     node.SetDiagnosticValue("human_points", std::to_string(out.human.size()));
+    std::size_t tracked = 0;
+    for (const HumanPoint& h : out.human) tracked += h.motion >= 0;
+    node.SetDiagnosticValue("tracked_human_points", std::to_string(tracked));
+    node.SetDiagnosticValue("motions", std::to_string(out.motions.size()));
     node.SetDiagnosticValue("clusters", std::to_string(out.clusters));
     node.SetDiagnosticValue("table", out.table_found ? std::to_string(out.table_points) + " points" : "not found");
     node.SetDiagnosticValue("clouds_without_self_filter", std::to_string(unfiltered_));
+    node.SetDiagnosticValue("clouds_pose_interpolated", std::to_string(interpolated_));
     if (!joint_names_.empty()) node.SetDiagnosticValue("self_filter", out.self_filtered ? "on" : "off (no recent joint state)");
     node.RecordCycleTime(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
   }
@@ -142,7 +171,22 @@ class CloudService : public framework::Service {
       g.mean.z = h.mean.z();
       for (int r = 0; r < 3; ++r)
         for (int c = 0; c < 3; ++c) g.covariance[static_cast<std::size_t>(3 * r + c)] = h.covariance(r, c);
+      g.motion = h.motion >= 0 && static_cast<std::size_t>(h.motion) < msg::Limits::kPointMotions
+                     ? static_cast<uint32_t>(h.motion + 1)
+                     : 0;
       human_.points.push_back(g);
+    }
+    human_.motions.clear();
+    for (const PointMotionEstimate& e : out.motions) {
+      if (human_.motions.size() >= msg::Limits::kPointMotions) break;
+      msg::PointMotion m;
+      m.id = e.id;
+      m.velocity.x = e.velocity.x();
+      m.velocity.y = e.velocity.y();
+      m.velocity.z = e.velocity.z();
+      for (int r = 0; r < 3; ++r)
+        for (int c = 0; c < 3; ++c) m.velocity_covariance[static_cast<std::size_t>(3 * r + c)] = e.velocity_covariance(r, c);
+      human_.motions.push_back(m);
     }
     std::string err;
     if (!obstacles_writer_->Write(obstacles_, &err)) node.log().warn("obstacles not published: {}", err);
@@ -152,6 +196,7 @@ class CloudService : public framework::Service {
   std::unique_ptr<CloudStage> stage_;
   std::vector<std::string> joint_names_;
   static constexpr int64_t kHistoryNs = 1000000000;           // 1 s of joint states
+  static constexpr int64_t kBracketNs = 600000000;            // 0.6 s: the widest gap interpolated across
   std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
   double joint_state_timeout_ = 0.2;
   double human_voxel_ = 0.03;
@@ -162,6 +207,7 @@ class CloudService : public framework::Service {
   dds::Writer<msg::ObstacleArray>* obstacles_writer_ = nullptr;
   dds::Writer<msg::HumanPoints>* human_writer_ = nullptr;
   uint64_t processed_ = 0, unfiltered_ = 0;
+  mutable uint64_t interpolated_ = 0;  // clouds whose pose was interpolated across a gap of joint states
 };
 
 }  // namespace

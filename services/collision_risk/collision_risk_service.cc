@@ -89,15 +89,7 @@ class CollisionRiskService : public framework::Service {
   // The depth camera's view of the person (stands in for the skeleton and
   // the prediction while they are missing: core/risk_points.cc).
   void OnHumanPoints(Node& node, const msg::HumanPoints& m) {
-    Eigen::Matrix3Xd means(3, static_cast<Eigen::Index>(m.points.size()));
-    std::vector<Eigen::Matrix3d> covariances(m.points.size());
-    for (std::size_t i = 0; i < m.points.size(); ++i) {
-      const auto& p = m.points[i];
-      means.col(static_cast<Eigen::Index>(i)) = Eigen::Vector3d(p.mean.x, p.mean.y, p.mean.z);
-      covariances[i] = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(p.covariance.data());
-    }
-    node.CountRejection("human_points",
-                        monitor_->UpdateHumanPoints(msg::ToNanoseconds(m.header.stamp), m.voxel_size, means, covariances));
+    node.CountRejection("human_points", monitor_->UpdateHumanPoints(services::FromHumanPoints(m)));
   }
 
   void OnPrediction(Node& node, const msg::HumanPrediction& m) {

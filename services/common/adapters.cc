@@ -30,6 +30,31 @@ collision::JointMixture ToJointMixture(const msg::HumanPrediction& m) {
   return in;
 }
 
+cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
+  using RowMajor = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
+  cell::HumanPoints p;
+  p.stamp_ns = msg::ToNanoseconds(m.header.stamp);
+  p.voxel_size = m.voxel_size;
+  p.means.resize(3, static_cast<Eigen::Index>(m.points.size()));
+  p.covariances.resize(m.points.size());
+  bool tracked = false;
+  for (std::size_t i = 0; i < m.points.size(); ++i) {
+    const msg::PointGaussian& g = m.points[i];
+    p.means.col(static_cast<Eigen::Index>(i)) = Eigen::Vector3d(g.mean.x, g.mean.y, g.mean.z);
+    p.covariances[i] = Eigen::Map<const RowMajor>(g.covariance.data());
+    tracked = tracked || g.motion > 0;
+  }
+  if (tracked) {
+    p.motion_of.resize(m.points.size());
+    for (std::size_t i = 0; i < m.points.size(); ++i) p.motion_of[i] = static_cast<int>(m.points[i].motion) - 1;
+  }
+  for (const msg::PointMotion& pm : m.motions) {
+    p.motions.push_back({Eigen::Vector3d(pm.velocity.x, pm.velocity.y, pm.velocity.z),
+                         Eigen::Map<const RowMajor>(pm.velocity_covariance.data())});
+  }
+  return p;
+}
+
 void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,
                     std::vector<std::vector<double>>* positions) {
   times->clear();

@@ -9,6 +9,7 @@
 
 #include <Eigen/Core>
 
+#include "iplan/cell/human_points.h"
 #include "iplan/cell/ssm.h"
 #include "iplan/core/name_value.h"
 #include "iplan/cell/status.h"
@@ -19,6 +20,11 @@ namespace iplan::services {
 
 /// The joint-level mixture of a prediction message (covariances row-major).
 collision::JointMixture ToJointMixture(const msg::HumanPrediction& m);
+
+/// The people the depth camera sees (covariances row-major; a point's
+/// `motion` k >= 1 is motions[k - 1], 0 not tracked). The boundary has
+/// checked the message (finite, covariances PSD, motion indices in range).
+cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m);
 
 /// Trajectory points as (times in s from header.stamp, positions per point).
 void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,

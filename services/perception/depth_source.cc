@@ -10,6 +10,7 @@
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
+#include "iplan/msg/time.h"
 #include "iplan/collision/scene.h"
 
 namespace iplan::perception {
@@ -47,6 +48,9 @@ struct DepthSource::Impl {
   framework::Result ConfigureSimulated(const framework::ConfigSection& config, const SimulatedDepthSettings& sim);
   framework::Result ConfigurePcd(const framework::ConfigSection& config, const PcdSettings& pcd);
   void OnJointState(framework::Node& node, const msg::JointState& m);
+  Eigen::VectorXd RobotNow() const;
+  Eigen::VectorXd q_velocity;  // rad/s, of the latest joint state (zero when it carries none)
+  int64_t q_stamp_ns = 0;
   bool Produce(framework::Node& node);
   void Tick(framework::Node& node);
 };
@@ -137,8 +141,26 @@ void DepthSource::Impl::OnJointState(framework::Node& node, const msg::JointStat
   if (node.CountRejection("joint_states", cell::MapJointNames(m.name, robot_joints, &index))) return;
   if (m.position.size() != m.name.size()) return;
   Eigen::VectorXd v(static_cast<Eigen::Index>(index.size()));
-  for (std::size_t k = 0; k < index.size(); ++k) v[static_cast<Eigen::Index>(k)] = m.position[static_cast<std::size_t>(index[k])];
+  Eigen::VectorXd qd = Eigen::VectorXd::Zero(v.size());
+  for (std::size_t k = 0; k < index.size(); ++k) {
+    v[static_cast<Eigen::Index>(k)] = m.position[static_cast<std::size_t>(index[k])];
+    if (m.velocity.size() == m.name.size()) qd[static_cast<Eigen::Index>(k)] = m.velocity[static_cast<std::size_t>(index[k])];
+  }
   q = v;
+  q_velocity = qd;
+  q_stamp_ns = msg::ToNanoseconds(m.header.stamp);
+}
+
+// The robot where it is now, as a camera would capture it: the latest joint
+// state moved on at its velocity for the time since its stamp (at most
+// kMaxExtrapolation: a late joint state is not a trajectory). Rendering the
+// latest state as it is put the robot where it was up to a few hundred ms
+// ago on a loaded host, and the cloud service's self-filter, at the pose of
+// the cloud's stamp, then left slivers of the arm as "human" points.
+Eigen::VectorXd DepthSource::Impl::RobotNow() const {
+  constexpr double kMaxExtrapolation = 0.3;  // s
+  const double age = std::clamp((msg::ToNanoseconds(msg::Now()) - q_stamp_ns) * 1e-9, 0.0, kMaxExtrapolation);
+  return *q + age * q_velocity;
 }
 
 // One frame into `cloud`; false when there is nothing (more) to publish.
@@ -179,7 +201,7 @@ bool DepthSource::Impl::Produce(framework::Node& node) {
     }
   }
   if (robot && q && q->size() == robot->nq) {
-    collision::CalcForwardKinematics(*robot, *q, robot_data.get());
+    collision::CalcForwardKinematics(*robot, RobotNow(), robot_data.get());
     for (std::size_t k = 0; k < robot->spheres.size(); ++k) {
       scene.spheres.push_back({robot_data->p_WS.col(static_cast<Eigen::Index>(k)), robot->spheres[k].radius});
     }

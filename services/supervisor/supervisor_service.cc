@@ -84,8 +84,10 @@ class SupervisorService : public framework::Service {
       else if (w == "robot_trajectory") Watch(node, framework::topics::RobotTrajectory(), &names);
       else if (w == "collision_risk") Watch(node, framework::topics::CollisionRisk(), &names);
       else if (w == "action_belief") Watch(node, framework::topics::ActionBelief(), &names);
+      else if (w == "human_points") Watch(node, framework::topics::HumanPoints(), &names);
       else return Result::Fail(config.file() + ": key 'supervisor.watch': unknown topic '" + w +
-                               "' (human_skeleton, human_prediction, action_belief, joint_states, robot_trajectory, collision_risk)");
+                               "' (human_skeleton, human_prediction, action_belief, human_points, joint_states, "
+                               "robot_trajectory, collision_risk)");
     }
     monitor_ = std::make_unique<SafetyMonitor>(names);
     monitor_->SetResumeDelay(resume_delay);

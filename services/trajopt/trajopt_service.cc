@@ -57,6 +57,20 @@ class TrajoptService : public framework::Service {
                      const auto now = std::chrono::steady_clock::now();
                      if (replan_on_prediction_ && active_ && now - last_cycle_ >= MinCycleGap()) Step(node);
                    }));
+    // The people the depth camera alone sees (camera-only cell): planned
+    // against while no skeleton prediction is fresh, a cycle at once as for
+    // a prediction.
+    node.Subscribe(framework::topics::HumanPoints(),
+                   std::function<void(const msg::HumanPoints&, SI)>([this, &node](const msg::HumanPoints& m, SI) {
+                     if (!use_prediction_) return;
+                     const auto why = replanner_->UpdateHumanPoints(services::FromHumanPoints(m));
+                     node.CountRejection("human_points", why);
+                     const int64_t now_ns = msg::ToNanoseconds(msg::Now());
+                     if (why || !replanner_->PlansOnPoints(now_ns)) return;
+                     latest_prediction_ = {msg::ToNanoseconds(m.header.stamp), now_ns};
+                     const auto now = std::chrono::steady_clock::now();
+                     if (replan_on_prediction_ && active_ && now - last_cycle_ >= MinCycleGap()) Step(node);
+                   }));
     node.Subscribe(framework::topics::Obstacles(),
                    std::function<void(const msg::ObstacleArray&, SI)>([this, &node](const msg::ObstacleArray& m, SI) {
                      OnObstacles(node, m);

@@ -32,6 +32,7 @@
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
 #include "robot_distance.h"
+#include "service_cell.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -52,34 +53,8 @@ std::string List(const Eigen::Vector3d& v) { return List(std::vector<double>{v.x
 
 collision::RobotModel Panda() { return collision::LoadRobotModelFromYaml(kConfig + "/robots/panda.yaml"); }
 
-struct Cell {
-  explicit Cell(const std::string& tag, int domain) : domain(domain) {
-    dir = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
-    std::filesystem::remove_all(dir);
-    std::filesystem::create_directories(dir);
-  }
-  ~Cell() {
-    for (auto& [name, p] : procs) p->Signal(SIGTERM);
-    for (auto& [name, p] : procs) p->Wait(10s);
-    if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
-    else std::cout << "service logs kept in " << dir.string() << "\n";
-  }
-  void Start(const std::string& exe, const std::string& cfg, std::vector<std::string> extra) {
-    std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", "cyclonedds", "--domain",
-                                     std::to_string(domain)};
-    argv.insert(argv.end(), extra.begin(), extra.end());
-    procs[exe] = std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, (dir / exe).string());
-  }
-  // Every service exits 0 on SIGTERM.
-  void Stop() {
-    for (auto& [name, p] : procs) p->Signal(SIGTERM);
-    for (auto& [name, p] : procs) EXPECT_EQ(p->Wait(10s), 0) << name << ":\n" << p->Stderr();
-    procs.clear();
-  }
-  int domain;
-  std::filesystem::path dir;
-  std::map<std::string, std::unique_ptr<Process>> procs;
-};
+// The services under test (tests/support/service_cell.h), on Cyclone DDS.
+using Cell = ServiceCell;
 
 // The depth path's perception: the simulated camera (10 Hz, the shipped rate) and the person's truth.
 std::vector<std::string> DepthPerception(std::vector<std::string> more) {
@@ -244,6 +219,16 @@ TEST(DepthChain, APersonSeenOnlyByTheDepthCameraStopsTheRobotBeforeContact) {
             << stop->r.min_separation << " m, S_p " << stop->r.protective_separation << " m: " << stop->r.reason
             << "\njoint 2 speed before the stop " << moved << " rad/s; closest executed arm vs true body " << closest
             << " m; joint speed from 0.6 s after the stop " << late_speed << " rad/s\n";
+  // What collision risk said after the stop (a verdict change or every 0.5 s): why the arm moved again, if it did.
+  double shown = -1;
+  int last_verdict = -1;
+  for (const auto& r : run.risks) {
+    if (r.t < stop->t || (r.r.verdict == last_verdict && r.t < shown + 0.5)) continue;
+    std::cout << "  +" << r.t << " s: verdict " << static_cast<int>(r.r.verdict) << ", separation " << r.r.min_separation
+              << " m, S_p " << r.r.protective_separation << " m: " << r.r.reason << "\n";
+    shown = r.t;
+    last_verdict = r.r.verdict;
+  }
   EXPECT_GT(moved, 0.1) << "the arm never moved: the stop proves nothing";
   EXPECT_GT(closest, 0.0) << "contact with the true body";
   EXPECT_LT(late_speed, 1e-6) << "not at rest after the stop";

@@ -63,7 +63,9 @@ struct DemoOptions {
   /// risk still gets the model's prediction).
   std::string predictor = "model";
   /// "skeleton": the skeleton stream only; "depth": also the simulated depth
-  /// camera (perception) and the cloud service.
+  /// camera (perception) and the cloud service; "depth-only": the camera
+  /// and the cloud service instead of the skeleton (no skeleton, no intent:
+  /// trajopt and collision risk work from the cloud's outputs alone).
   std::string sensor = "skeleton";
   /// Another arm for the whole cell (docs/robots.md); empty: the configured.
   std::string robot;
@@ -73,8 +75,12 @@ struct DemoOptions {
 const std::vector<std::pair<std::string, std::string>> kServices = {
     {"robot-sim", "robot_sim"},           {"perception", "perception"}, {"intent", "intent"},
     {"collision-risk", "collision_risk"}, {"trajopt", "trajopt"},       {"supervisor", "supervisor"}};
-// --sensor depth adds the cloud service (after perception, its source).
+// --sensor depth adds the cloud service (after perception, its source);
+// depth-only also drops intent (there is no skeleton to predict from).
 const std::pair<std::string, std::string> kCloudService = {"cloud", "cloud"};
+// What the supervisor watches in a camera-only cell: the depth camera's
+// person instead of the skeleton and its prediction.
+const char* const kDepthOnlyWatch = "[human_points, joint_states, robot_trajectory, collision_risk]";
 
 // One run of the demo: the processes, their vendors and what came of it.
 class DemoRun {
@@ -141,14 +147,25 @@ class DemoRun {
     std::cout << "iplan demo: the collaborative cell on loopback DDS, domain " << domain_ << "\n"
               << "  configuration " << config_dir_ << "\n  state and service logs (<service>.err) " << state_dir_ << "\n";
     if (o_.predictor != "model") std::cout << "  predictor: " << o_.predictor << " (ablation)\n";
+    if (o_.sensor == "depth-only") {
+      std::cout << "  sensor: depth camera only (no skeleton, no intent; the planner and collision risk work from "
+                   "the cloud service's boxes and human points)\n";
+      if (o_.predictor != "model" && o_.predictor != "none") {
+        std::cerr << "iplan demo: --predictor " << o_.predictor
+                  << " predicts from skeletons; --sensor depth-only has none (model or none)\n";
+        return 2;
+      }
+    }
     const std::string view_args = o_.robot.empty() ? "" : " --robot " + fs::absolute(o_.robot).string();
     if (!o_.prepare_only && !(security_ = SecureDemoOrExplain(o_.insecure, o_.security, o_.mixed, domain_, view_args)))
       return 2;
     try {
       if (!fs::exists(fs::path(config_dir_) / "intent.yaml")) throw std::runtime_error("no intent.yaml in " + config_dir_);
-      std::cout << "  intent model: checking ..." << std::flush;
-      model_ = EnsureCellModel(Cfg("perception"), Cfg("intent"), state_dir_, o_.retrain);
-      std::cout << "\r  " << model_.summary << "\n";
+      if (o_.sensor != "depth-only" || o_.prepare_only) {  // a camera-only cell runs no intent service
+        std::cout << "  intent model: checking ..." << std::flush;
+        model_ = EnsureCellModel(Cfg("perception"), Cfg("intent"), state_dir_, o_.retrain);
+        std::cout << "\r  " << model_.summary << "\n";
+      }
       if (o_.prepare_only) {
         std::cout << "  model path: " << model_.path << "\n";
         return 0;
@@ -194,8 +211,14 @@ class DemoRun {
     if (name == "trajopt" && o_.predictor == "none") argv.insert(argv.end(), {"--set", "trajopt.use_prediction=false"});
     if (name == "perception") argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set",
                                                        "perception.publish_truth=true"});
-    if (name == "perception" && o_.sensor == "depth") {
+    if (name == "perception" && o_.sensor != "skeleton") {
       argv.insert(argv.end(), {"--set", "perception.depth.provider=simulated"});
+    }
+    if (name == "perception" && o_.sensor == "depth-only") {
+      argv.insert(argv.end(), {"--set", "perception.publish_skeleton=false"});
+    }
+    if (name == "supervisor" && o_.sensor == "depth-only") {
+      argv.insert(argv.end(), {"--set", std::string("supervisor.watch=") + kDepthOnlyWatch});
     }
     if (!robot_file_.empty()) {
       if (name == "perception") argv.insert(argv.end(), {"--set", "perception.depth.simulated.robot=" + robot_file_});
@@ -224,7 +247,11 @@ class DemoRun {
     t0_ = Clock::now();
     std::cout << "  services:";
     services_ = kServices;
-    if (o_.sensor == "depth") services_.insert(services_.begin() + 2, kCloudService);
+    if (o_.sensor != "skeleton") services_.insert(services_.begin() + 2, kCloudService);
+    if (o_.sensor == "depth-only") {
+      services_.erase(std::remove_if(services_.begin(), services_.end(), [](const auto& s) { return s.second == "intent"; }),
+                      services_.end());
+    }
     for (const auto& [exe, name] : services_) {
       try {
         procs_.push_back(std::make_unique<core::Process>(ServiceArguments(exe, name), security_->env, false,
@@ -317,18 +344,22 @@ class DemoRun {
               << "  security                      " << security_->summary << "\n"
               << "  true contacts                 " << (contacts >= 0 ? Fixed(contacts, 0) : "unknown") << "\n"
               << "  end-to-end latency            p50 " << Fixed(lat.p50, 1) << " ms, p99 " << Fixed(lat.p99, 1)
-              << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; skeleton stamp to trajectory)\n";
+              << " ms, max " << Fixed(lat.max, 1) << " ms (" << lat.count << " trajectories; "
+              << (o_.sensor == "depth-only" ? "cloud" : "skeleton") << " stamp to trajectory)\n";
     const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
                planning_lat = core::Summarize(mon.planning_ms_);
-    std::cout << "    stages p50/p99: intent " << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
+    std::cout << "    stages p50/p99: " << (o_.sensor == "depth-only" ? "cloud to trajopt " : "intent ")
+              << Fixed(intent_lat.p50, 1) << "/" << Fixed(intent_lat.p99, 1)
               << " ms, prediction to planning " << Fixed(queue_lat.p50, 1) << "/" << Fixed(queue_lat.p99, 1)
               << " ms, planning " << Fixed(planning_lat.p50, 1) << "/" << Fixed(planning_lat.p99, 1) << " ms\n";
-    if (o_.sensor == "depth") {
+    if (o_.sensor != "skeleton") {
       std::cout << "  depth path                    " << Fixed(mon.DiagNumber("cloud", "clouds", 0), 0)
                 << " clouds processed (p50 " << Fixed(1e3 * mon.DiagNumber("cloud", "cycle_time_p50_s", 0), 1) << " ms, p99 "
                 << Fixed(1e3 * mon.DiagNumber("cloud", "cycle_time_p99_s", 0), 1) << " ms per cloud), last: "
                 << Fixed(mon.DiagNumber("cloud", "obstacles", 0), 0) << " static obstacles, "
-                << Fixed(mon.DiagNumber("cloud", "human_points", 0), 0) << " human points; "
+                << Fixed(mon.DiagNumber("cloud", "human_points", 0), 0) << " human points ("
+                << Fixed(mon.DiagNumber("cloud", "tracked_human_points", 0), 0) << " tracked, "
+                << Fixed(mon.DiagNumber("cloud", "motions", 0), 0) << " moving parts); "
                 << Fixed(mon.DiagNumber("cloud", "clouds_without_self_filter", 0), 0) << " clouds without self-filter\n";
     }
     for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
@@ -355,6 +386,7 @@ class DemoRun {
     nlohmann::json j;
     j["domain"] = domain_;
     j["predictor"] = o_.predictor;
+    j["sensor"] = o_.sensor;
     j["vendors"] = nlohmann::json::object();
     for (const std::string& name : names_) j["vendors"][name] = dds::ToString(VendorOf(name));
     j["monitor_vendor"] = dds::ToString(vendor_a_);
@@ -442,9 +474,10 @@ void Register(CLI::App& app) {
   AddDemoSecurityOptions(d, &o.insecure, &o.security);
   d->add_option("--sensor", o.sensor,
                  "skeleton: the skeleton stream; depth: also the simulated depth camera and the cloud service "
-                 "(obstacles and human points, docs/perception-clouds.md)")
+                 "(obstacles and human points, docs/perception-clouds.md); depth-only: the camera and the cloud "
+                 "service alone, no skeleton anywhere (no intent; planner and collision risk on the cloud's outputs)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"skeleton", "depth"}));
+      ->check(CLI::IsMember({"skeleton", "depth", "depth-only"}));
   d->add_option("--robot", o.robot,
                  "run the whole cell with another arm: a URDF (collision meshes are covered by spheres) or a "
                  "URDF overlay, mounted where the configured robot stands; task poses are solved for it "

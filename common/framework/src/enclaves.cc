@@ -30,14 +30,15 @@ std::vector<dds::EnclaveGrant> CellEnclaves() {
         HumanPoints().name}},
       {EnclaveName("trajopt"),
        {RobotTrajectory().name, TaskOutcome().name, PlanStatus().name, diag},
-       {JointStates().name, HumanPrediction().name, SupervisorPermit().name, TaskCommand().name, Obstacles().name}},
+       {JointStates().name, HumanPrediction().name, SupervisorPermit().name, TaskCommand().name, Obstacles().name,
+        HumanPoints().name}},
       {EnclaveName("robot_sim"),
        {JointStates().name, TfStatic().name, diag},
        {RobotTrajectory().name, SupervisorPermit().name, CollisionRiskPermit().name, HumanTruth().name}},
       {EnclaveName("supervisor"),
        {TaskCommand().name, SupervisorPermit().name, diag},
        {HumanSkeleton().name, HumanPrediction().name, ActionBelief().name, JointStates().name,
-        RobotTrajectory().name, CollisionRisk().name, TaskOutcome().name}},
+        RobotTrajectory().name, CollisionRisk().name, TaskOutcome().name, HumanPoints().name}},
   };
   dds::EnclaveGrant observer{kObserverEnclave, {}, {}};
   for (const auto& t : All()) observer.subscribe.push_back(t.name);

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <cstdio>
 #include <utility>
+#include <vector>
 
 namespace iplan::msg {
 namespace {
@@ -199,6 +200,7 @@ std::optional<std::string> CheckSizes(const ObstacleArray& m) {
 std::optional<std::string> CheckSizes(const HumanPoints& m) {
   if (auto e = CheckSizes(m.header)) return e;
   if (m.points.size() > Limits::kHumanPoints) return Over("points", m.points.size(), Limits::kHumanPoints);
+  if (m.motions.size() > Limits::kPointMotions) return Over("motions", m.motions.size(), Limits::kPointMotions);
   return std::nullopt;
 }
 
@@ -420,7 +422,21 @@ std::optional<std::string> CheckSemantics(const HumanPoints& m) {
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     auto path = [i] { return "points[" + std::to_string(i) + "].covariance"; };
     if (auto e = CheckCovariance(m.points[i].covariance, path)) return e;
+    if (m.points[i].motion > m.motions.size()) {
+      return "points[" + std::to_string(i) + "].motion " + std::to_string(m.points[i].motion) + " names no motion (" +
+             std::to_string(m.motions.size()) + " motions)";
+    }
   }
+  std::vector<uint32_t> ids;
+  ids.reserve(m.motions.size());
+  for (std::size_t k = 0; k < m.motions.size(); ++k) {
+    auto path = [k] { return "motions[" + std::to_string(k) + "].velocity_covariance"; };
+    if (auto e = CheckCovariance(m.motions[k].velocity_covariance, path)) return e;
+    if (m.motions[k].id == 0) return "motions[" + std::to_string(k) + "].id is 0";
+    ids.push_back(m.motions[k].id);
+  }
+  std::sort(ids.begin(), ids.end());
+  if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) return std::string("motions has a repeated id");
   return std::nullopt;
 }
 

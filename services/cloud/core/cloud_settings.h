@@ -26,6 +26,7 @@ struct CloudSettings {
   double human_voxel = 0.03;
   double joint_state_timeout = 0.2;
   TrackerParams tracking;
+  MotionParams motion;
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -39,6 +40,7 @@ struct CloudSettings {
     a->Visit(IPLAN_NVP(human_voxel, "m, grid the human points are reduced on (0: every point), >= 0"));
     a->Visit(IPLAN_NVP(joint_state_timeout, "s between a cloud's stamp and the joint state used to filter the robot out, > 0"));
     a->Visit(IPLAN_NVP(tracking, "the cluster tracker"));
+    a->Visit(IPLAN_NVP(motion, "the human points' velocities: parts followed by constant-velocity Kalman filters"));
   }
   /// Empty when valid, else the reason.
   std::string Validate() const {
@@ -50,6 +52,7 @@ struct CloudSettings {
     if (!(human_voxel >= 0 && std::isfinite(human_voxel))) return "human_voxel must be >= 0 m";
     if (!(joint_state_timeout > 0 && std::isfinite(joint_state_timeout))) return "joint_state_timeout must be > 0 s";
     if (std::string why = tracking.Validate(); !why.empty()) return "tracking: " + why;
+    if (std::string why = motion.Validate(); !why.empty()) return "motion: " + why;
     return "";
   }
   /// The stage's parameters from these (the pipeline left as default: the
@@ -62,6 +65,7 @@ struct CloudSettings {
     p.workspace_max = Eigen::Vector3d(workspace_max[0], workspace_max[1], workspace_max[2]);
     p.human_voxel = human_voxel;
     p.tracking = tracking;
+    p.motion = motion;
     return p;
   }
 };

@@ -12,6 +12,7 @@ std::string CloudStageParams::Validate() const {
   if (auto why = pipeline.Validate(); !why.empty()) return "pipeline: " + why;
   if (auto why = noise.Validate(); !why.empty()) return "noise: " + why;
   if (auto why = tracking.Validate(); !why.empty()) return "tracking: " + why;
+  if (auto why = motion.Validate(); !why.empty()) return "motion: " + why;
   if (!X_WS.matrix().allFinite()) return "camera pose must be finite";
   for (int k = 0; k < 3; ++k) {
     if (!(workspace_min[k] < workspace_max[k])) return "workspace_min must be below workspace_max on every axis";
@@ -24,7 +25,8 @@ CloudStage::CloudStage(const CloudStageParams& params, const collision::RobotMod
     : params_(params),
       X_SW_(params.X_WS.inverse()),
       pipeline_(params.pipeline),
-      tracker_(params.tracking) {
+      tracker_(params.tracking),
+      motion_(params.motion) {
   if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument(why);
   if (robot) {
     robot_ = std::make_unique<collision::RobotModel>(*robot);
@@ -65,7 +67,8 @@ std::vector<cloud::Sphere> CloudStage::RobotSpheres(const Eigen::VectorXd& q) {
   return spheres;
 }
 
-void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& indices, StageOutput* out) const {
+void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& indices, bool track, int64_t stamp_ns,
+                             StageOutput* out) {
   std::vector<Eigen::Vector3f> p_W;
   p_W.reserve(indices.size());
   const Eigen::Isometry3f X_WS = params_.X_WS.cast<float>();
@@ -80,6 +83,24 @@ void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& 
     h.mean = p.cast<double>();
     h.covariance = R_WS * cloud::PointCovariance(params_.noise, p_S) * R_WS.transpose();
     out->human.push_back(h);
+  }
+  // Their motion: without a self-filter the robot's points are among them
+  // (and would make parts of their own): the parts are left alone (the next
+  // frame predicts them over the longer gap), this frame's points are not
+  // tracked.
+  if (!track) return;
+  std::vector<Eigen::Vector3d> means(out->human.size());
+  for (std::size_t i = 0; i < means.size(); ++i) means[i] = out->human[i].mean;
+  const std::vector<int> part_of = motion_.Update(means, stamp_ns);
+  std::vector<int> motion_of(motion_.parts().size(), -1);
+  for (std::size_t k = 0; k < motion_.parts().size(); ++k) {
+    const MotionPart& part = motion_.parts()[k];
+    if (!motion_.Tracked(part)) continue;
+    motion_of[k] = static_cast<int>(out->motions.size());
+    out->motions.push_back({part.id, part.velocity(), part.velocity_covariance()});
+  }
+  for (std::size_t i = 0; i < part_of.size(); ++i) {
+    if (part_of[i] >= 0) out->human[i].motion = motion_of[static_cast<std::size_t>(part_of[i])];
   }
 }
 
@@ -123,7 +144,7 @@ StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::
       human.insert(human.end(), r.obstacles[c].indices.begin(), r.obstacles[c].indices.end());
     }
   }
-  HumanPoints(*cloud, human, &out);
+  HumanPoints(*cloud, human, track, stamp_ns, &out);
   for (const Track& t : tracker_.tracks()) {
     if (t.cls != TrackClass::kStatic) continue;
     StaticObstacle s;

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include "core/cluster_tracker.h"
+#include "core/point_motion.h"
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/noise.h"
 #include "iplan/cloud/pipeline.h"
@@ -34,6 +35,7 @@ struct CloudStageParams {
   cloud::DepthNoiseParams noise;                               ///< the camera's noise model
   double human_voxel = 0.03;                                   ///< m, grid the human points are reduced on
   TrackerParams tracking;
+  MotionParams motion;                                         ///< the human points' velocities
 
   /// Empty when valid, else the first problem.
   std::string Validate() const;
@@ -52,11 +54,20 @@ struct StaticObstacle {
 struct HumanPoint {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();          ///< m
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();    ///< m^2
+  int motion = -1;  ///< index into StageOutput::motions of its tracked part; -1: not tracked (speed unknown)
+};
+
+/// The velocity of a tracked part of a person (point_motion.h), in W.
+struct PointMotionEstimate {
+  uint32_t id = 0;                                                  ///< the part's, >= 1, stable
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();               ///< m/s
+  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();    ///< (m/s)^2
 };
 
 struct StageOutput {
   std::vector<StaticObstacle> obstacles;
   std::vector<HumanPoint> human;
+  std::vector<PointMotionEstimate> motions;  ///< the tracked parts the human points name
   bool table_found = false;
   int table_points = 0;
   int clusters = 0;           ///< segments of this frame
@@ -84,7 +95,10 @@ class CloudStage {
  private:
   void Crop(cloud::Cloud* cloud, StageOutput* out) const;
   std::vector<cloud::Sphere> RobotSpheres(const Eigen::VectorXd& q);
-  void HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& indices, StageOutput* out) const;
+  /// The human points, voxel-reduced, with noise covariances; `track`: their
+  /// parts' motions are updated from them (else they are all not tracked).
+  void HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& indices, bool track, int64_t stamp_ns,
+                   StageOutput* out);
 
   CloudStageParams params_;
   Eigen::Isometry3d X_SW_;
@@ -92,6 +106,7 @@ class CloudStage {
   std::unique_ptr<collision::RobotData> robot_data_;
   cloud::ObstaclePipeline pipeline_;
   ClusterTracker tracker_;
+  MotionTracker motion_;
 };
 
 }  // namespace iplan::cloud_service

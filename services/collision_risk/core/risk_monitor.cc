@@ -423,7 +423,7 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
   } else {
     r.verdict = Verdict::kOk;
     r.reason = !seen         ? "no person seen"
-               : !in.person   ? (r.binding_separation ? "clear (depth points only; separation at the default human speed)"
+               : !in.person   ? (r.binding_separation ? "clear (depth points only)"
                                                       : "no person seen (depth: no points)")
                : in.predicted ? "clear"
                : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"

@@ -181,9 +181,13 @@ class RiskMonitor {
   /// 3 x n (m, W), covariances (m^2), voxel_size (m, 0: not reduced). Fresh
   /// points stand for the person while no fresh skeleton does (separation),
   /// and for the prediction while none is usable (bound); an empty fresh set
-  /// means the camera sees nobody.
+  /// means the camera sees nobody. These points are not tracked.
   std::optional<std::string> UpdateHumanPoints(int64_t stamp_ns, double voxel_size, const Eigen::Matrix3Xd& means,
                                                const std::vector<Eigen::Matrix3d>& covariances);
+  /// The same with the points' tracked velocities (point_risk.h): a point
+  /// of a tracked part is judged at its measured, directed speed and moves
+  /// in the bound's prediction; the others at the ISO default speed, still.
+  std::optional<std::string> UpdateHumanPoints(cell::HumanPoints points);
 
   /// Evaluates both layers at `now_ns`. Allocates (report vectors).
   RiskReport Evaluate(int64_t now_ns);
@@ -246,6 +250,7 @@ class RiskMonitor {
   std::vector<collision::WaypointBound> bounds_;
   // Latest human points and their stamp (0: none yet).
   collision::GaussianPoints points_;
+  cell::HumanPoints seen_points_;  // as received (their motions; means and covariances as points_)
   int64_t points_stamp_ns_ = 0;
 };
 

@@ -3,6 +3,8 @@
 // numbers, the bound's growth, and what counts as a tracked person.
 #include <gtest/gtest.h>
 
+#include <iostream>
+
 #include "core/risk_monitor.h"
 
 namespace iplan::collision_risk {
@@ -13,11 +15,19 @@ const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "
                                                "panda_joint5", "panda_joint6", "panda_joint7"};
 const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
 
+// The measured speeds switched on (human_points.tracked_speeds; off by
+// default, see ShippedDefaultJudgesATrackedPointAtTheIsoSpeed).
+RiskParams WithTrackedSpeeds(bool on = true) {
+  RiskParams p;
+  p.human_points.tracked_speeds = on;
+  return p;
+}
+
 class RiskPointsTest : public ::testing::Test {
  protected:
-  RiskPointsTest()
+  explicit RiskPointsTest(const RiskParams& params = WithTrackedSpeeds())
       : robot_(collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml")),
-        monitor_(robot_, collision::HumanBodyParams::DefaultUpperBody(), RiskParams{}) {
+        monitor_(robot_, collision::HumanBodyParams::DefaultUpperBody(), params) {
     collision::RobotData d(robot_);
     Eigen::VectorXd q = Eigen::Map<const Eigen::VectorXd>(kReady.data(), 7);
     collision::CalcForwardKinematics(robot_, q, &d);
@@ -39,6 +49,19 @@ class RiskPointsTest : public ::testing::Test {
       mu.col(i) = mu.col(0) + Eigen::Vector3d(1.0, 0.4 * (i % 10) / 9.0 - 0.2, 0.4 * (i / 10 % 10) / 9.0 - 0.2);
     ASSERT_EQ(monitor_.UpdateHumanPoints(t, 0.01, mu, std::vector<Eigen::Matrix3d>(n, sigma * sigma * Eigen::Matrix3d::Identity())),
               std::nullopt);
+  }
+  // One point `gap` m in front of the front sphere (sigma 5 mm), tracked
+  // with velocity v (m/s) and isotropic velocity std sigma_v (m/s).
+  void SeeTrackedPoint(int64_t t, double gap, const Eigen::Vector3d& v, double sigma_v) {
+    cell::HumanPoints p;
+    p.stamp_ns = t;
+    p.voxel_size = 0.01;
+    p.means.resize(3, 1);
+    p.means.col(0) = spheres_.col(front_) + Eigen::Vector3d(robot_.spheres[front_].radius + 0.005 + gap, 0, 0);
+    p.covariances = {2.5e-5 * Eigen::Matrix3d::Identity()};
+    p.motion_of = {0};
+    p.motions.push_back({v, sigma_v * sigma_v * Eigen::Matrix3d::Identity()});
+    ASSERT_EQ(monitor_.UpdateHumanPoints(p), std::nullopt);
   }
   collision::RobotModel robot_;
   RiskMonitor monitor_;
@@ -124,6 +147,131 @@ TEST_F(RiskPointsTest, BadPointsAreRefusedAndLeaveTheLastGoodOnes) {
   EXPECT_EQ(monitor_.UpdateHumanPoints(t, 0.01, mu, {Eigen::Matrix3d::Zero()}), std::nullopt);
   r = monitor_.Evaluate(t);
   EXPECT_GT(*r.min_separation, 4.0);
+}
+
+// Issue 29: a tracked point is judged at its measured speed towards the
+// robot plus speed_sigmas (2) standard deviations; an untracked one at the
+// ISO default. Still robot (S_s = 0): S_p = v_h 0.4 + 0.17 m.
+TEST_F(RiskPointsTest, ATrackedSlowPersonGivesASmallSpAnUntrackedOneTheDefault) {
+  const int64_t t = 100 * kSec;
+  struct Case {
+    const char* what;
+    Eigen::Vector3d v;  // the point's velocity; +x is away from the robot
+    double sigma_v;
+    double v_h;
+    Verdict verdict;
+  };
+  const Case cases[] = {
+      {"still, tracked", Eigen::Vector3d::Zero(), 0.1, 0.2, Verdict::kSlowDown},  // S_p 0.25: within the 0.2 m margin
+      {"walking away", Eigen::Vector3d(0.5, 0, 0), 0.1, 0.0, Verdict::kOk},       // S_p 0.17
+      {"coming at 1 m/s", Eigen::Vector3d(-1.0, 0, 0), 0.1, 1.2, Verdict::kProtectiveStop},  // S_p 0.65
+  };
+  for (const Case& c : cases) {
+    SCOPED_TRACE(c.what);
+    RobotAtReady(t);
+    SeeTrackedPoint(t, 0.4, c.v, c.sigma_v);
+    const RiskReport r = monitor_.Evaluate(t + kSec / 100);
+    ASSERT_TRUE(r.min_separation.has_value()) << r.reason;
+    EXPECT_NEAR(*r.min_separation, 0.4, 1e-9);
+    EXPECT_NEAR(r.human_speed, c.v_h, 1e-9);
+    EXPECT_NEAR(r.protective_separation, 0.4 * c.v_h + 0.17, 1e-9);
+    EXPECT_EQ(r.verdict, c.verdict) << r.reason;
+  }
+  // Sideways at 1 m/s: towards the front sphere only its 2 sigma; towards
+  // spheres beside it, part of the 1 m/s (the pair with the smallest margin binds).
+  RobotAtReady(t);
+  SeeTrackedPoint(t, 0.4, Eigen::Vector3d(0, 1.0, 0), 0.1);
+  const RiskReport side = monitor_.Evaluate(t + kSec / 100);
+  EXPECT_GE(side.human_speed, 0.2);
+  EXPECT_LT(side.human_speed, 1.2);
+  RobotAtReady(t);
+  SeePoints(t, 0.4);  // the same point, not tracked: 1.6 m/s, S_p 0.81
+  const RiskReport r = monitor_.Evaluate(t + kSec / 100);
+  EXPECT_DOUBLE_EQ(r.human_speed, 1.6);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+}
+
+// Shipped default (tracked_speeds false): a tracked slow point counts as
+// untracked, at the ISO default speed, and the bound does not move it.
+class RiskPointsDefaultTest : public RiskPointsTest {
+ protected:
+  RiskPointsDefaultTest() : RiskPointsTest(RiskParams{}) {}
+};
+TEST_F(RiskPointsDefaultTest, ShippedDefaultJudgesATrackedPointAtTheIsoSpeed) {
+  EXPECT_FALSE(RiskParams{}.human_points.tracked_speeds);
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  SeeTrackedPoint(t, 0.4, Eigen::Vector3d::Zero(), 0.1);
+  const RiskReport r = monitor_.Evaluate(t + kSec / 100);
+  ASSERT_TRUE(r.min_separation.has_value()) << r.reason;
+  EXPECT_DOUBLE_EQ(r.human_speed, 1.6);
+  EXPECT_NEAR(r.protective_separation, 0.4 * 1.6 + 0.17, 1e-9);
+  EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+  EXPECT_NE(r.max_action, "as seen, moving");
+}
+
+// A robot sphere moving at 0.5 m/s towards a point 0.28 m away: a tracked
+// still point (v_h 0.02 m/s) leaves room to slow down (ISO/TS 15066 speed
+// reduction), an untracked one (1.6 m/s) does not.
+TEST(PointsSeparation, ATrackedPointLetsTheRobotSlowDownAnUntrackedOneStopsIt) {
+  cell::HumanPoints seen;
+  seen.means.resize(3, 1);
+  seen.means.col(0) = Eigen::Vector3d(0.28 + 0.1 + 0.005, 0, 0);
+  seen.covariances = {1e-6 * Eigen::Matrix3d::Identity()};
+  collision::GaussianPoints points;
+  ASSERT_EQ(points.Set(seen.means, seen.covariances, 0.005), std::nullopt);
+  const Eigen::Matrix3Xd p_WS = Eigen::Matrix3Xd::Zero(3, 1);
+  Eigen::Matrix3Xd v_WS(3, 1);
+  v_WS.col(0) = Eigen::Vector3d(0.5, 0, 0);
+  const cell::SsmParams ssm;
+  cell::HumanPoints tracked = seen;
+  tracked.motion_of = {0};
+  tracked.motions.push_back({Eigen::Vector3d::Zero(), 1e-4 * Eigen::Matrix3d::Identity()});
+  const PointsSeparation a = EvaluatePointsSeparation(points, tracked, p_WS, {0.1}, v_WS, ssm, 2.0);
+  EXPECT_NEAR(a.binding_separation, 0.28, 1e-12);
+  EXPECT_NEAR(a.human_speed, 0.02, 1e-12);
+  EXPECT_NEAR(a.robot_speed, 0.5, 1e-12);
+  EXPECT_TRUE(a.binding_tracked);
+  EXPECT_LT(a.margin(), 0.0);
+  // S_p grows by 0.25 s per m/s of robot speed: room (0.28 - 0.178) / 0.25 = 0.408 m/s.
+  EXPECT_NEAR(a.stop_scale, 0.408 / 0.5, 1e-9);
+  EXPECT_NEAR(a.slow_scale, (0.28 - 0.05 - 0.178) / 0.25 / 0.5, 1e-9);
+  const PointsSeparation b = EvaluatePointsSeparation(points, seen, p_WS, {0.1}, v_WS, ssm, 2.0);
+  EXPECT_DOUBLE_EQ(b.human_speed, 1.6);
+  EXPECT_FALSE(b.binding_tracked);
+  EXPECT_DOUBLE_EQ(b.stop_scale, 0.0);
+}
+
+// The bound's prediction moves a tracked point at its velocity: one coming
+// at the robot raises the bound of later waypoints, one going away lowers it.
+TEST_F(RiskPointsTest, TheBoundMovesTrackedPointsWithTheirVelocity) {
+  const int64_t t = 100 * kSec;
+  auto bound = [&](const Eigen::Vector3d& v) {
+    RobotAtReady(t);
+    SeeTrackedPoint(t, 0.15, v, 0.05);
+    const RiskReport r = monitor_.Evaluate(t);
+    EXPECT_EQ(r.max_action, "as seen, moving");
+    return r.max_bound;
+  };
+  const double coming = bound(Eigen::Vector3d(-0.5, 0, 0)), still = bound(Eigen::Vector3d::Zero()),
+               going = bound(Eigen::Vector3d(0.5, 0, 0));
+  std::cout << "bound, point 0.15 m away: coming at 0.5 m/s " << coming << ", still " << still << ", going " << going
+            << "\n";
+  EXPECT_GT(coming, 0.05);  // it reaches the robot within motion_horizon (0.5 s)
+  EXPECT_GT(coming, 10 * still);
+  EXPECT_LE(going, still);
+}
+
+TEST_F(RiskPointsTest, MotionsThatDoNotFitThePointsAreRefused) {
+  cell::HumanPoints p;
+  p.stamp_ns = 100 * kSec;
+  p.means = Eigen::Matrix3Xd::Constant(3, 2, 1.0);
+  p.covariances.assign(2, 1e-4 * Eigen::Matrix3d::Identity());
+  p.motion_of = {0, 1};
+  p.motions.push_back({Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity()});
+  EXPECT_EQ(monitor_.UpdateHumanPoints(p), "human points: point 1 names motion 1 of 1");
+  p.motion_of = {0, -1};
+  EXPECT_EQ(monitor_.UpdateHumanPoints(p), std::nullopt);
 }
 
 }  // namespace

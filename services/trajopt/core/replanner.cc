@@ -30,7 +30,7 @@ std::string ReplannerParams::Validate() const {
   if (!(cycle_budget >= 0) || !(cycle_budget < planning_step))
     return "cycle_budget must be in [0, planning_step)";
   if (!(ssm_patience >= 0) || !std::isfinite(ssm_patience)) return "ssm_patience must be >= 0";
-  return "";
+  return human_points.Validate();
 }
 
 Replanner::Replanner(const planning::Planner& planner, const collision::HumanBodyModel& body, ReplannerParams params)
@@ -63,6 +63,19 @@ std::optional<std::string> Replanner::UpdateRobotState(int64_t stamp_ns, const s
 
 std::optional<std::string> Replanner::UpdatePrediction(cell::BodyId body_id, const collision::JointMixture& in) {
   return cell::KeepNewestPrediction(body_, body_id, in, params_.stale_after, &predictions_);
+}
+
+std::optional<std::string> Replanner::UpdateHumanPoints(const cell::HumanPoints& seen) {
+  if (auto why = seen.Check()) return "human points: " + *why;
+  if (seen.stamp_ns < points_stamp_ns_) return std::string("human points: older than the last ones");
+  points_prediction_ = BuildPointsPrediction(params_.human_points, seen, planner_.params().ssm);
+  points_stamp_ns_ = seen.stamp_ns;
+  return std::nullopt;
+}
+
+bool Replanner::PlansOnPoints(int64_t now_ns) const {
+  const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
+  return points_prediction_ && now_ns - points_stamp_ns_ <= stale && predictions_.CountFresh(now_ns, stale) == 0;
 }
 
 TaskOutcome Replanner::Finish(TaskStatus status, const std::string& reason, int64_t now_ns) {
@@ -193,7 +206,7 @@ CycleResult Replanner::StandBy(int64_t now_ns) {
   if (!park_) park_ = q_->second;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
   predictions_.Expire(now_ns, stale);
-  if (!planner_.params().predict_ssm || predictions_.CountFresh(now_ns, stale) == 0) {
+  if (!planner_.params().predict_ssm || (predictions_.CountFresh(now_ns, stale) == 0 && !PlansOnPoints(now_ns))) {
     previous_.reset();
     park_ = q_->second;
     return Hold(now_ns, q_->second, "idle");
@@ -370,6 +383,13 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
     const cell::TimedPrediction& p = e.value;
     req.people.push_back({&p.spheres(), p.time_step(), p.StartRelativeTo(*start_ns)});
     r->prediction_t0_ns = std::max(r->prediction_t0_ns, p.t0_ns());
+  }
+  // A person the depth camera alone sees: the points' prediction, step k at
+  // the cloud's stamp + (k + 1) time_step.
+  if (PlansOnPoints(now_ns)) {
+    const double dt_points = params_.human_points.time_step;
+    req.people.push_back({&*points_prediction_, dt_points, (points_stamp_ns_ - *start_ns) * 1e-9 + dt_points});
+    r->prediction_t0_ns = points_stamp_ns_;
   }
   r->num_people = static_cast<int>(req.people.size());
   return req;

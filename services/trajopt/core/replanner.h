@@ -23,6 +23,8 @@
 
 #include <Eigen/Core>
 
+#include "core/points_prediction.h"
+#include "iplan/cell/human_points.h"
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/cell/people.h"
 #include "iplan/cell/status.h"
@@ -66,6 +68,9 @@ struct ReplannerParams {
   /// that came too close is not sent straight back at the person. 0: off
   /// (the margin is always the planner's).
   double ssm_patience = 0.0;
+  /// The person seen only by the depth camera (points_prediction.h): what
+  /// cycles plan against while no fresh skeleton prediction exists.
+  PointsPredictionParams human_points;
   /// The keys of section trajopt (config/trajopt.yaml); ranges: Validate().
   template <class Archive>
   void Serialize(Archive* a) {
@@ -79,6 +84,7 @@ struct ReplannerParams {
     a->Visit(IPLAN_NVP(joint_velocity_factor, "a state faster than this x the velocity limit is refused, >= 1"));
     a->Visit(IPLAN_NVP(cycle_budget, "s of wall time one cycle's planning may take, [0, planning_step); 0: none"));
     a->Visit(IPLAN_NVP(ssm_patience, "s of a task's delay (since its last protective stop) after which its plans keep no margin above S_p, >= 0; 0: off"));
+    a->Visit(IPLAN_NVP(human_points, "the depth camera's human points as a constant-velocity prediction, planned against while no skeleton prediction is fresh"));
   }
   std::string Validate() const;
 };
@@ -158,6 +164,16 @@ class Replanner {
   std::optional<std::string> UpdatePrediction(const collision::JointMixture& prediction) {
     return UpdatePrediction(1, prediction);
   }
+  /// The people the depth camera sees (the cloud service's points and their
+  /// tracked velocities): while no fresh skeleton prediction exists, cycles
+  /// plan against their constant-velocity prediction (points_prediction.h),
+  /// fresh for stale_after from the cloud's stamp; an empty set means
+  /// nobody is seen. Returns why the points were refused (seen.Check()).
+  std::optional<std::string> UpdateHumanPoints(const cell::HumanPoints& seen);
+  /// True when a cycle at now_ns would plan against the depth camera's
+  /// points (fresh points, no fresh skeleton prediction).
+  bool PlansOnPoints(int64_t now_ns) const;
+
   /// The perceived obstacles (W) every later cycle keeps clear of
   /// (PlanningRequest::obstacles; see obstacle_set.h).
   void SetObstacles(std::vector<collision::SceneObject> obstacles) { obstacles_ = std::move(obstacles); }
@@ -187,6 +203,9 @@ class Replanner {
   bool robot_stopped_ = false;
   std::vector<std::string> robot_joints_;
   cell::PerBody<cell::TimedPrediction> predictions_;  // newest per person, stamp: its observation
+  // The depth camera's points as a prediction (none: nobody seen), and the cloud's stamp.
+  std::optional<collision::HumanPrediction> points_prediction_;
+  int64_t points_stamp_ns_ = 0;
   std::vector<collision::SceneObject> obstacles_;
   struct Active {
     TaskSpec spec;

@@ -65,7 +65,8 @@ struct CellBridge::Impl {
   std::size_t scene_channel = 0, cell_channel = 0;
   BridgeStats stats;
   Clock::time_point last_message = Clock::time_point::min(), next_status = Clock::now(), next_static = Clock::now();
-  Clock::time_point next_robot = Clock::now(), next_prediction = Clock::now(), next_cloud = Clock::now();
+  Clock::time_point next_robot = Clock::now(), next_prediction = Clock::now(), next_cloud = Clock::now(),
+                    next_human_points = Clock::now();
   bool alive = false;
 
   ~Impl() {
@@ -124,6 +125,12 @@ struct CellBridge::Impl {
       if (Clock::now() < next_cloud) return;
       next_cloud = Clock::now() + std::chrono::milliseconds(200);
       EmitScene(scene->Obstacles(m));
+    });
+    SceneInput(topics::Obstacles(), [this](const msg::ObstacleArray& m) { EmitScene(scene->Boxes(m)); });
+    SceneInput(topics::HumanPoints(), [this](const msg::HumanPoints& m) {
+      if (Clock::now() < next_human_points) return;
+      next_human_points = Clock::now() + std::chrono::milliseconds(100);
+      EmitScene(scene->HumanPoints(m));
     });
     SceneInput(topics::CollisionRisk(), [this](const msg::CollisionRisk& m) {
       const json update = scene->Safety(m);

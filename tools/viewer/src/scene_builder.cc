@@ -363,6 +363,68 @@ const json* SceneBuilder::Obstacles(const msg::PointCloud2& c) {
   return &updates_[entity::kObstacles];
 }
 
+const json* SceneBuilder::Boxes(const msg::ObstacleArray& a) {
+  if (a.header.frame_id != "world") {
+    Reject("obstacles in frame '" + a.header.frame_id + "', not the cell frame 'world'");
+    return nullptr;
+  }
+  json& e = Persistent(entity::kBoxes, a.header.stamp);
+  const Rgba color{0.95, 0.45, 0.1, 0.45};
+  json& cubes = e["cubes"];
+  cubes = json::array();
+  for (const msg::Obstacle& o : a.obstacles) {
+    // The message's boxes are axis-aligned in "world" (idl/iplan_msgs.idl).
+    const Eigen::Vector3d size(2 * o.half_extents[0], 2 * o.half_extents[1], 2 * o.half_extents[2]);
+    cubes.push_back({{"pose", Pose({o.centre.x, o.centre.y, o.centre.z})}, {"size", Point(size)}, {"color", Color(color)}});
+  }
+  e["metadata"] = json::array({{{"key", "boxes"}, {"value", std::to_string(a.obstacles.size())}}});
+  return &updates_[entity::kBoxes];
+}
+
+const json* SceneBuilder::HumanPoints(const msg::HumanPoints& p) {
+  if (p.header.frame_id != "world") {
+    Reject("human points in frame '" + p.header.frame_id + "', not the cell frame 'world'");
+    return nullptr;
+  }
+  constexpr double kVelocityLead = 0.5;  // s drawn ahead along each part's velocity
+  const Rgba tracked{0.55, 0.2, 0.85, 0.9}, untracked{0.9, 0.15, 0.15, 0.9}, arrow{0.35, 0.05, 0.6, 1.0};
+  json& e = Persistent(entity::kHumanPoints, p.header.stamp);
+  const std::size_t n = p.points.size();
+  const std::size_t stride = std::max<std::size_t>(1, (n + options_.max_cloud_points - 1) / options_.max_cloud_points);
+  const double d = p.voxel_size > 0 ? p.voxel_size : options_.cloud_point_size;
+  json& cubes = e["cubes"];
+  cubes = json::array();
+  std::vector<Eigen::Vector3d> sum(p.motions.size(), Eigen::Vector3d::Zero());
+  std::vector<int> count(p.motions.size(), 0);
+  std::size_t n_tracked = 0;
+  for (std::size_t i = 0; i < n; ++i) {
+    const msg::PointGaussian& g = p.points[i];
+    const Eigen::Vector3d v(g.mean.x, g.mean.y, g.mean.z);
+    const bool moving = g.motion > 0 && g.motion <= p.motions.size();
+    if (moving) {
+      sum[g.motion - 1] += v;
+      ++count[g.motion - 1];
+      ++n_tracked;
+    }
+    if (i % stride != 0) continue;
+    cubes.push_back({{"pose", Pose(v)}, {"size", {{"x", d}, {"y", d}, {"z", d}}}, {"color", Color(moving ? tracked : untracked)}});
+  }
+  json segments = json::array();
+  for (std::size_t k = 0; k < p.motions.size(); ++k) {
+    if (count[k] == 0) continue;
+    const Eigen::Vector3d c = sum[k] / count[k];
+    const auto& v = p.motions[k].velocity;
+    segments.push_back(Point(c));
+    segments.push_back(Point(c + kVelocityLead * Eigen::Vector3d(v.x, v.y, v.z)));
+  }
+  e["lines"] = json::array();
+  if (!segments.empty()) e["lines"].push_back(Line(2, std::move(segments), 0.01, arrow));
+  e["metadata"] = json::array({{{"key", "points"}, {"value", std::to_string(n)}},
+                               {{"key", "tracked"}, {"value", std::to_string(n_tracked)}},
+                               {{"key", "motions"}, {"value", std::to_string(p.motions.size())}}});
+  return &updates_[entity::kHumanPoints];
+}
+
 json SceneBuilder::Safety(const msg::CollisionRisk& r) const {
   static const char* kVerdicts[] = {"OK", "SLOW_DOWN", "PROTECTIVE_STOP"};
   static const Rgba kColors[] = {{0.1, 0.7, 0.2, 1}, {0.95, 0.6, 0.0, 1}, {0.9, 0.1, 0.1, 1}};

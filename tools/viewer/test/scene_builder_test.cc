@@ -225,6 +225,59 @@ TEST(SceneBuilder, ObstaclePointsBecomeCubes) {
   EXPECT_EQ(b.rejected(), 3u);
 }
 
+// Issue 29: the cloud service's boxes and the person's points.
+TEST(SceneBuilder, CloudBoxesAndHumanPointsAreDrawn) {
+  SceneBuilder b(Model());
+  msg::ObstacleArray a;
+  a.header.frame_id = "world";
+  msg::Obstacle o;
+  o.id = 3;
+  o.centre.x = 0.5;
+  o.centre.y = -0.2;
+  o.centre.z = 0.1;
+  o.half_extents = {0.05, 0.1, 0.15};
+  a.obstacles.push_back(o);
+  const auto* u = b.Boxes(a);
+  ASSERT_TRUE(u);
+  const auto& box = (*u)["entities"][0]["cubes"][0];
+  EXPECT_EQ((*u)["entities"][0]["id"], entity::kBoxes);
+  EXPECT_NEAR(At(box).y(), -0.2, 1e-12);
+  EXPECT_DOUBLE_EQ(box["size"]["z"].get<double>(), 0.3);
+  EXPECT_DOUBLE_EQ(box["pose"]["orientation"]["w"].get<double>(), 1.0);
+  // Three points: two of a part moving at 1 m/s along -x, one not tracked.
+  msg::HumanPoints p;
+  p.header.frame_id = "world";
+  p.voxel_size = 0.03;
+  for (int i = 0; i < 3; ++i) {
+    msg::PointGaussian g;
+    g.mean.x = 1.0 + 0.1 * i;
+    g.mean.z = 1.0;
+    g.motion = i < 2 ? 1 : 0;
+    p.points.push_back(g);
+  }
+  msg::PointMotion m;
+  m.id = 7;
+  m.velocity.x = -1.0;
+  p.motions.push_back(m);
+  u = b.HumanPoints(p);
+  ASSERT_TRUE(u);
+  const auto& e = (*u)["entities"][0];
+  ASSERT_EQ(e["cubes"].size(), 3u);
+  EXPECT_DOUBLE_EQ(e["cubes"][0]["size"]["x"].get<double>(), 0.03);
+  EXPECT_NE(e["cubes"][0]["color"], e["cubes"][2]["color"]);  // tracked vs not
+  EXPECT_EQ(e["cubes"][0]["color"], e["cubes"][1]["color"]);
+  // The part's velocity: from its centroid (1.05, 0, 1) to 0.5 s ahead.
+  ASSERT_EQ(e["lines"].size(), 1u);
+  ASSERT_EQ(e["lines"][0]["points"].size(), 2u);
+  EXPECT_NEAR(e["lines"][0]["points"][0]["x"].get<double>(), 1.05, 1e-12);
+  EXPECT_NEAR(e["lines"][0]["points"][1]["x"].get<double>(), 0.55, 1e-12);
+  p.header.frame_id = "camera";
+  EXPECT_FALSE(b.HumanPoints(p));
+  a.header.frame_id = "camera";
+  EXPECT_FALSE(b.Boxes(a));
+  EXPECT_EQ(b.rejected(), 2u);
+}
+
 TEST(SceneBuilder, StaticSceneHasEveryObject) {
   SceneBuilder b(Model());
   const auto u = b.Static(msg::Time{});

@@ -55,6 +55,7 @@ struct Limits {
   // ObstacleArray and HumanPoints.
   static constexpr std::size_t kObstacles = 256;        ///< boxes per array
   static constexpr std::size_t kHumanPoints = 65536;    ///< a person on a 1 cm grid has ~20,000
+  static constexpr std::size_t kPointMotions = 1024;    ///< HumanPoints motions: a person has ~10 tracked parts
 
   // DiagnosticArray.
   static constexpr std::size_t kDiagnosticStatuses = 64;   ///< status entries per array

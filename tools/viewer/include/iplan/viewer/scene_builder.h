@@ -46,6 +46,8 @@ inline constexpr const char* kPrediction = "prediction";
 inline constexpr const char* kTrajectory = "trajectory";
 inline constexpr const char* kSafety = "safety";
 inline constexpr const char* kObstacles = "obstacles";
+inline constexpr const char* kBoxes = "boxes";
+inline constexpr const char* kHumanPoints = "human_points";
 }  // namespace entity
 
 /// A colour, red, green, blue and opacity in [0, 1].
@@ -89,10 +91,19 @@ class SceneBuilder {
   /// End-effector path of the newly planned trajectory, the previous plan's
   /// path faded, and ghost robot poses along the new one.
   const nlohmann::json* Trajectory(const msg::JointTrajectory& t);
-  /// Obstacle points (/iplan/obstacles: a PointCloud2 in the cell frame
-  /// "world" with FLOAT32 fields x, y, z, little endian) as small cubes;
-  /// non-finite points are skipped.
+  /// Obstacle points (a PointCloud2 in the cell frame "world" with FLOAT32
+  /// fields x, y, z, little endian) as small cubes; non-finite points are
+  /// skipped.
   const nlohmann::json* Obstacles(const msg::PointCloud2& c);
+  /// The cloud service's static obstacles (/iplan/obstacles) as translucent
+  /// boxes, each with its pose (the cell frame "world" only).
+  const nlohmann::json* Boxes(const msg::ObstacleArray& a);
+  /// The cloud service's human points (/iplan/human/points, "world") as
+  /// cubes of the voxel size (at most max_cloud_points, evenly subsampled):
+  /// points of a tracked part in one colour, untracked ones in another; and
+  /// each tracked part's velocity as a line from its points' centroid to
+  /// where it is in 0.5 s.
+  const nlohmann::json* HumanPoints(const msg::HumanPoints& p);
   /// Separation, S_p and verdict as text above the table, coloured by verdict.
   nlohmann::json Safety(const msg::CollisionRisk& r) const;
 
