@@ -129,6 +129,11 @@ std::optional<TaskOutcome> Replanner::StartTask(const TaskSpec& task, int64_t no
   }
   if (task.retreat.size() != 0) check_limits(task.retreat, "retreat");
   if (task_) replaced = Finish(TaskStatus::kCancelled, "replaced by task " + std::to_string(task.id), now_ns);
+  // A robot at rest under a standby plan that only holds it there (kept
+  // while a person is predicted near) starts the task from its state: kept,
+  // that plan's frozen prefix would hold it (frozen_waypoints - 1) planning
+  // steps longer. A standby plan that moves the arm (yielding) is kept.
+  if (previous_ && StandsStill(now_ns)) previous_.reset();
   task_ = Active{};
   task_->spec = task;
   task_->start_ns = now_ns;
@@ -195,6 +200,20 @@ CycleResult Replanner::Cycle(int64_t now_ns) {
   ApplyPlan(req, res, &r);
   previous_ = std::make_pair(start_ns, r.positions);
   return r;
+}
+
+// True when the robot is at rest and the executing plan keeps it where it is
+// over the prefix a cycle at now_ns would freeze.
+bool Replanner::StandsStill(int64_t now_ns) const {
+  constexpr double kStill = 1e-4;  // rad
+  if (!q_ || !previous_ || qd_.cwiseAbs().maxCoeff() >= params_.settle_speed) return false;
+  const double dt = planner_.params().dt;
+  const cell::JointTrajectory plan = cell::JointTrajectory::Uniform(previous_->first, dt, previous_->second);
+  for (int k = 0; k < params_.frozen_waypoints; ++k) {
+    const int64_t t = now_ns + static_cast<int64_t>(std::llround(k * dt * 1e9));
+    if ((plan.PositionAt(t) - q_->second).cwiseAbs().maxCoeff() > kStill) return false;
+  }
+  return true;
 }
 
 // Without a task the robot stays where it was left (the park pose), unless

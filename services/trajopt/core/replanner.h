@@ -190,6 +190,7 @@ class Replanner {
   std::optional<CycleResult> CheckProgress(int64_t now_ns, CycleResult* r);
   planning::PlanningRequest MakeRequest(int64_t now_ns, const planning::Goal& goal, int64_t* start_ns, CycleResult* r);
   CycleResult StandBy(int64_t now_ns);
+  bool StandsStill(int64_t now_ns) const;
   std::optional<planning::Goal> AsideGoal(const planning::PlanningRequest& req) const;
   void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
   static std::pair<int64_t, double> PathLag(const cell::JointTrajectory& plan, int64_t stamp_ns, const Eigen::VectorXd& q,

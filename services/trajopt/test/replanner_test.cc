@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <limits>
+#include <memory>
 
 #include <gtest/gtest.h>
 
@@ -37,6 +38,19 @@ class ReplannerTest : public ::testing::Test {
     Eigen::VectorXd q(7);
     q << 0.6, -0.2, 0.0, -2.0, 0.0, 1.9, 0.8;
     return q;
+  }
+  // A planner with the cell's replanning settings (predict_ssm on).
+  static std::unique_ptr<planning::Planner> PredictingPlanner() {
+    const planning::PlannerParams pp = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+    EXPECT_TRUE(pp.predict_ssm);
+    return std::make_unique<planning::Planner>(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                               collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), pp);
+  }
+  // The tool sphere's centre (m, world) at the ready pose.
+  static Eigen::Vector3d ToolAtReady(const collision::RobotModel& robot) {
+    collision::RobotData d(robot);
+    collision::CalcForwardKinematics(robot, Ready(), &d);
+    return d.p_WS.col(static_cast<int>(robot.spheres.size()) - 1);
   }
   // Position of a published plan at time t (linear interpolation).
   static Eigen::VectorXd At(const CycleResult& c, int64_t t) {
@@ -123,17 +137,12 @@ TEST_F(ReplannerTest, IdleHoldsTheCurrentPose) {
 // their way until the monitor stops it, or they touch it), and returns to
 // where it was left once they have gone back.
 TEST_F(ReplannerTest, AnIdleRobotYieldsToAPersonComingAtItAndReturns) {
-  // The cell's replanning settings (predict_ssm on).
-  const planning::PlannerParams pp = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
-  ASSERT_TRUE(pp.predict_ssm);
-  const planning::Planner predicting(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
-                                     collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), pp);
-  Replanner replanner(predicting, body_, ReplannerParams{});
-  const collision::RobotModel& robot = predicting.robot();
+  const std::unique_ptr<planning::Planner> predicting = PredictingPlanner();
+  Replanner replanner(*predicting, body_, ReplannerParams{});
+  const collision::RobotModel& robot = predicting->robot();
   collision::RobotData d(robot);
-  collision::CalcForwardKinematics(robot, Ready(), &d);
   const int tool = static_cast<int>(robot.spheres.size()) - 1;
-  const Eigen::Vector3d tool_W = d.p_WS.col(tool);
+  const Eigen::Vector3d tool_W = ToolAtReady(robot);
   // The hand's x offset from the tool: 0.60 m, in at 0.35 m/s to 0.20 m
   // (inside S_p of a robot at rest), held there until 3 s, then back to 0.9 m.
   auto offset = [](double s) { return s < 3.0 ? std::max(0.20, 0.60 - 0.35 * s) : 0.90; };
@@ -170,6 +179,39 @@ TEST_F(ReplannerTest, AnIdleRobotYieldsToAPersonComingAtItAndReturns) {
   // Back where it was left.
   EXPECT_LT((q - Ready()).cwiseAbs().maxCoeff(), 0.02);
   EXPECT_EQ(statuses.back().rfind("idle", 0), 0u) << statuses.back();
+}
+
+// A robot standing by while a person is near (a fresh prediction, the
+// standby plan holding it where it is) starts a new task at once: the
+// task's first plan moves from its first step on instead of keeping the
+// standby plan's frozen prefix, which held the robot 0.2 s at every task's
+// start (iplan eval cell: about 1 s of idle per episode).
+TEST_F(ReplannerTest, ARobotStandingByNearAPersonStartsItsTaskAtOnce) {
+  const std::unique_ptr<planning::Planner> predicting = PredictingPlanner();
+  Replanner replanner(*predicting, body_, ReplannerParams{});
+  const Eigen::Vector3d hand = ToolAtReady(predicting->robot()) + Eigen::Vector3d(0.9, 0, 0);
+  int64_t t = 100 * kSec;
+  auto tick = [&] {
+    const Eigen::VectorXd ready = Ready();
+    const std::vector<double> q(ready.data(), ready.data() + ready.size());
+    ASSERT_EQ(replanner.UpdateRobotState(t, replanner.joint_names(), q, std::vector<double>(7, 0.0)), std::nullopt);
+    ASSERT_EQ(replanner.UpdatePrediction(PersonAt(t, hand)), std::nullopt);
+  };
+  for (int k = 0; k < 5; ++k) {
+    tick();
+    const CycleResult c = replanner.Cycle(t);
+    ASSERT_TRUE(c.publish) << c.status;
+    ASSERT_EQ(c.status, "idle");
+    ASSERT_EQ(c.positions.cols() > 1, true);
+    t += kSec / 10;
+  }
+  tick();
+  ASSERT_EQ(replanner.StartTask({3, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+  const CycleResult c = replanner.Cycle(t);
+  ASSERT_TRUE(c.publish) << c.status;
+  EXPECT_EQ(c.start_ns, t);
+  EXPECT_LT((c.positions.col(0) - Ready()).cwiseAbs().maxCoeff(), 1e-9);
+  EXPECT_GT((c.positions.col(1) - Ready()).cwiseAbs().maxCoeff(), 1e-3) << c.status;
 }
 
 TEST_F(ReplannerTest, ReachesAJointGoalWithoutDelay) {
