@@ -32,6 +32,7 @@
 #include "iplan/framework/service_file.h"
 #include "perception_settings.h"
 #include "service_cell.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -155,14 +156,7 @@ class CameraOnlyCell {
   }
   void Command(uint32_t id, const std::vector<double>& goal) {
     while (cmd_->MatchedReaders() == 0) tc_.node->SpinOnce(10ms);
-    msg::TaskCommand c;
-    c.header.stamp = msg::Now();
-    c.task_id = id;
-    c.task_name = "task" + std::to_string(id);
-    c.command = msg::TaskCommand::START;
-    c.goal_type = msg::TaskCommand::GOAL_JOINTS;
-    c.goal_positions = goal;
-    c.time_limit = 30;
+    msg::TaskCommand c = testing::JointGoalCommand(id, "task" + std::to_string(id), goal, 30);
     cmd_->Write(c);
   }
   // Spins until task `id`'s outcome (or t_max); the outcome if any.

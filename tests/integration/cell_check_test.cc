@@ -39,15 +39,6 @@ void Edit(const fs::path& file, const std::string& pattern, const std::string& r
 
 class CellCheck : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("iplan-cell-check-" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::copy(fs::path(IPLAN_SOURCE_DIR) / "config", dir_, fs::copy_options::recursive);
-    fs::remove_all(dir_ / "state");
-    fs::remove_all(dir_ / "models");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
-
   // Runs the check; returns the exit code, output in *out.
   int Run(std::string* out, const std::vector<std::string>& extra = {}) {
     std::vector<std::string> argv = {BinPath("iplan"), "cell-check", "--config-dir", dir_.string(), "--repetitions", "3"};
@@ -58,7 +49,8 @@ class CellCheck : public ::testing::Test {
     return rc.value_or(-1);
   }
 
-  fs::path dir_;
+  ScratchCell scratch_{"cell-check"};
+  const fs::path dir_ = scratch_.config();
 };
 
 TEST_F(CellCheck, ShippedCellPassesWithItsMarginTable) {

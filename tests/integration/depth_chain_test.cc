@@ -33,6 +33,7 @@
 #include "iplan/framework/node.h"
 #include "robot_distance.h"
 #include "service_cell.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -286,25 +287,13 @@ struct BoxRun {
 // Commands the sweep and grants permits every 50 ms until the outcome (30 s at most).
 void Sweep(framework::Node& node, dds::Writer<msg::TaskCommand>& cmd, dds::Writer<msg::SafetyPermit>& permit, BoxRun* run) {
   while (cmd.MatchedReaders() == 0) node.SpinOnce(10ms);
-  msg::TaskCommand c;
-  c.header.stamp = msg::Now();
-  c.task_id = 7;
-  c.task_name = "reach_goal";
-  c.command = msg::TaskCommand::START;
-  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
-  c.goal_positions = kGoal;
-  c.time_limit = 30;
+  msg::TaskCommand c = testing::JointGoalCommand(7, "reach_goal", kGoal, 30);
   const auto start = Clock::now();
   auto next_permit = start;
   cmd.Write(c);
   while (!run->outcome && Clock::now() - start < 30s) {
     if (Clock::now() >= next_permit) {
-      msg::SafetyPermit p;
-      p.header.stamp = msg::Now();
-      p.state = msg::SafetyPermit::PERMIT;
-      p.validity = 0.2;
-      p.source = "test";
-      permit.Write(p);
+      permit.Write(testing::TestPermit());
       next_permit += 50ms;
     }
     node.SpinOnce(5ms);

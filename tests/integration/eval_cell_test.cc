@@ -20,15 +20,6 @@ using namespace std::chrono_literals;
 
 class EvalCell : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("iplan-eval-cell-" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    fs::copy(fs::path(IPLAN_SOURCE_DIR) / "config", dir_ / "config", fs::copy_options::recursive);
-    fs::remove_all(dir_ / "config" / "state");
-    fs::remove_all(dir_ / "config" / "models");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   int Run(const std::vector<std::string>& extra, std::string* out) {
     std::vector<std::string> argv = {BinPath("iplan"), "eval", "cell", "--config-dir", (dir_ / "config").string(),
@@ -40,7 +31,8 @@ class EvalCell : public ::testing::Test {
     return rc.value_or(-1);
   }
 
-  fs::path dir_;
+  ScratchCell scratch_{"eval-cell"};
+  const fs::path dir_ = scratch_.dir();
 };
 
 TEST_F(EvalCell, OneEpisodeWritesEveryFieldAndRepeatsForASeed) {

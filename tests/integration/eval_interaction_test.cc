@@ -19,15 +19,6 @@ using namespace std::chrono_literals;
 
 class EvalInteraction : public ::testing::Test {
  protected:
-  void SetUp() override {
-    dir_ = fs::temp_directory_path() / ("iplan-eval-interaction-" + std::to_string(getpid()));
-    fs::remove_all(dir_);
-    fs::create_directories(dir_);
-    fs::copy(fs::path(IPLAN_SOURCE_DIR) / "config", dir_ / "config", fs::copy_options::recursive);
-    fs::remove_all(dir_ / "config" / "state");
-    fs::remove_all(dir_ / "config" / "models");
-  }
-  void TearDown() override { fs::remove_all(dir_); }
 
   int Run(const std::vector<std::string>& extra, std::string* out) {
     std::vector<std::string> argv = {BinPath("iplan"),
@@ -47,7 +38,8 @@ class EvalInteraction : public ::testing::Test {
     return rc.value_or(-1);
   }
 
-  fs::path dir_;
+  ScratchCell scratch_{"eval-interaction"};
+  const fs::path dir_ = scratch_.dir();
   std::string recordings_ = std::string(IPLAN_SHARED_DIR) + "/data/assembly.csv";
 };
 

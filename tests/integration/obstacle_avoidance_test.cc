@@ -18,6 +18,7 @@
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
 #include "robot_distance.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -77,14 +78,7 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   EXPECT_GT(cmd.MatchedReaders(), 0) << opt.Stderr();
   EXPECT_GT(obstacles.MatchedReaders(), 0) << opt.Stderr();
 
-  msg::TaskCommand c;
-  c.header.stamp = msg::Now();
-  c.task_id = 7;
-  c.task_name = "reach_goal";
-  c.command = msg::TaskCommand::START;
-  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
-  c.goal_positions = kGoal;
-  c.time_limit = 30;
+  msg::TaskCommand c = testing::JointGoalCommand(7, "reach_goal", kGoal, 30);
   const auto start = Clock::now();
   auto next_permit = start, next_box = start + 200ms;
   started = true;
@@ -92,12 +86,7 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   while (!e.outcome && Clock::now() - start < 40s) {
     const auto now = Clock::now();
     if (now >= next_permit) {
-      msg::SafetyPermit p;
-      p.header.stamp = msg::Now();
-      p.state = msg::SafetyPermit::PERMIT;
-      p.validity = 0.2;
-      p.source = "test";
-      permit.Write(p);
+      permit.Write(testing::TestPermit());
       next_permit += 50ms;
     }
     if (box && now >= next_box) {  // the cloud stage's rate with a static scene

@@ -116,16 +116,7 @@ Eigen::Vector3d GoalHand() {
 
 // Task 42 to kGoal (then `retreat`, if any), 30 s time limit.
 msg::TaskCommand StartCommand(const std::vector<double>& retreat) {
-  msg::TaskCommand c;
-  c.header.stamp = msg::Now();
-  c.task_id = 42;
-  c.task_name = "reach_goal";
-  c.command = msg::TaskCommand::START;
-  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
-  c.goal_positions = kGoal;
-  c.retreat_positions = retreat;
-  c.time_limit = 30;
-  return c;
+  return testing::JointGoalCommand(42, "reach_goal", kGoal, 30, retreat);
 }
 
 // Sends one task to the goal kGoal (with `retreat`, if any) while a person
@@ -171,12 +162,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool
   auto next_permit = start;
   while (!r.outcome && Clock::now() - start < 40s) {
     if (Clock::now() >= next_permit) {
-      msg::SafetyPermit p;
-      p.header.stamp = msg::Now();
-      p.state = msg::SafetyPermit::PERMIT;
-      p.validity = 0.2;
-      p.source = "test";
-      permit.Write(p);
+      permit.Write(testing::TestPermit());
       next_permit += 50ms;
     }
     if (Clock::now() >= next) {

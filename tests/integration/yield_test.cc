@@ -20,6 +20,7 @@
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -188,12 +189,7 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
     const double s = std::chrono::duration<double>(now - walk).count();
     seen.walking = s >= 0;
     if (now >= next_permit) {
-      msg::SafetyPermit p;
-      p.header.stamp = msg::Now();
-      p.state = msg::SafetyPermit::PERMIT;
-      p.validity = 0.2;
-      p.source = "test";
-      permit.Write(p);
+      permit.Write(testing::TestPermit());
       next_permit += 50ms;
     }
     if (now >= next_frame) {

@@ -30,4 +30,32 @@ inline msg::HumanSkeleton SkeletonMessage(const msg::Time& stamp, const std::vec
   return s;
 }
 
+/// A START command of task `task_id` to the joint positions `goal` (rad, the
+/// robot's joints in order), then to `retreat` if it is not empty, within
+/// `time_limit_s`.
+inline msg::TaskCommand JointGoalCommand(uint32_t task_id, const std::string& task_name, const std::vector<double>& goal,
+                                         double time_limit_s, const std::vector<double>& retreat = {}) {
+  msg::TaskCommand c;
+  c.header.stamp = msg::Now();
+  c.task_id = task_id;
+  c.task_name = task_name;
+  c.command = msg::TaskCommand::START;
+  c.goal_type = msg::TaskCommand::GOAL_JOINTS;
+  c.goal_positions = goal;
+  c.retreat_positions = retreat;
+  c.time_limit = time_limit_s;
+  return c;
+}
+
+/// The permit a test grants in the supervisor's place (source "test"),
+/// stamped now and valid for `validity_s`.
+inline msg::SafetyPermit TestPermit(double validity_s = 0.2) {
+  msg::SafetyPermit p;
+  p.header.stamp = msg::Now();
+  p.state = msg::SafetyPermit::PERMIT;
+  p.validity = validity_s;
+  p.source = "test";
+  return p;
+}
+
 }  // namespace iplan::testing

@@ -73,4 +73,33 @@ inline int UniqueDomain(int offset = 0) {
                            dir.string() + "/*.lock holders");
 }
 
+/// A scratch folder `<tmp>/iplan-<name>-<pid>` holding a copy of the source
+/// tree's `config/` as `config` without its learned state and trained
+/// models, so a test runs a cell's configuration from scratch and may edit
+/// it; removed with this object.
+class ScratchCell {
+ public:
+  explicit ScratchCell(const std::string& name)
+      : dir_(std::filesystem::temp_directory_path() / ("iplan-" + name + "-" + std::to_string(getpid()))) {
+    namespace fs = std::filesystem;
+    fs::remove_all(dir_);
+    fs::create_directories(dir_);
+    fs::copy(fs::path(IPLAN_SOURCE_DIR) / "config", config(), fs::copy_options::recursive);
+    fs::remove_all(config() / "state");
+    fs::remove_all(config() / "models");
+  }
+  ~ScratchCell() {
+    std::error_code ec;
+    std::filesystem::remove_all(dir_, ec);
+  }
+  ScratchCell(const ScratchCell&) = delete;
+  ScratchCell& operator=(const ScratchCell&) = delete;
+
+  const std::filesystem::path& dir() const { return dir_; }
+  std::filesystem::path config() const { return dir_ / "config"; }
+
+ private:
+  std::filesystem::path dir_;
+};
+
 }  // namespace iplan::testing
