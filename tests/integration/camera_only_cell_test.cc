@@ -44,9 +44,8 @@ using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
 const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 
-const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                               "panda_joint5", "panda_joint6", "panda_joint7"};
-const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+const std::vector<std::string>& kRobotJoints = kPandaJoints;
+const std::vector<double>& kReady = kPandaReady;
 
 // The scripted person: the demo cell's synthetic person doing `action`,
 // moved by offset(t) (m, W) as a whole.

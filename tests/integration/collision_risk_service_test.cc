@@ -22,11 +22,9 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
-                                          "shoulder_r", "elbow_r", "hand_r"};
-const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                               "panda_joint5", "panda_joint6", "panda_joint7"};
-const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+const std::vector<std::string>& kJoints = kUpperBodyJoints;
+const std::vector<std::string>& kRobotJoints = kPandaJoints;
+const std::vector<double>& kReady = kPandaReady;
 
 std::vector<Eigen::Vector3d> Person(const Eigen::Vector3d& torso) {
   return {torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.30), torso,

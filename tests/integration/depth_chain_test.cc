@@ -67,9 +67,8 @@ std::vector<std::string> DepthPerception(std::vector<std::string> more) {
 
 // ---------------------------------------------------------------- 1. person
 
-const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                               "panda_joint5", "panda_joint6", "panda_joint7"};
-const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+const std::vector<std::string>& kRobotJoints = kPandaJoints;
+const std::vector<double>& kReady = kPandaReady;
 const std::vector<double> kReach = {0, 0.3, 0, -1.5, 0, 1.9, 0.785};
 // The person walks into the camera's view kPersonAfter s after perception's activation; the arm starts its one
 // reach (kReady to kReach in kRobotMove s, then holding) kRobotLead s before that, so it is moving when the person

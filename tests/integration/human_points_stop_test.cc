@@ -17,6 +17,7 @@
 
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
 
@@ -26,9 +27,8 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const std::vector<std::string> kRobotJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
-                                               "panda_joint5", "panda_joint6", "panda_joint7"};
-const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+const std::vector<std::string>& kRobotJoints = kPandaJoints;
+const std::vector<double>& kReady = kPandaReady;
 constexpr double kVoxel = 0.02;  // m, the points' grid (r_p = 1 cm)
 
 // The side of a standing person the camera sees: a half cylinder of radius

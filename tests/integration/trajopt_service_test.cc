@@ -28,8 +28,7 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
-                                          "shoulder_r", "elbow_r", "hand_r"};
+const std::vector<std::string>& kJoints = kUpperBodyJoints;
 const std::vector<double> kGoal = {0.6, -0.2, 0.0, -2.0, 0.0, 1.9, 0.8};
 
 std::vector<Eigen::Vector3d> PersonWithHandAt(const Eigen::Vector3d& hand) {

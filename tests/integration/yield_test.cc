@@ -30,7 +30,7 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const std::vector<double> kReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+const std::vector<double>& kReady = kPandaReady;
 
 // The person's joints (the body model's order) with the right hand at `hand`,
 // standing behind it (+x), facing the robot.

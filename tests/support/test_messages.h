@@ -11,6 +11,16 @@
 
 namespace iplan::testing {
 
+/// The Panda's joints, in the order the cell's trajectories and joint states
+/// carry them (config/robots/panda.yaml).
+inline const std::vector<std::string> kPandaJoints = {"panda_joint1", "panda_joint2", "panda_joint3", "panda_joint4",
+                                                      "panda_joint5", "panda_joint6", "panda_joint7"};
+/// The Panda's ready pose (rad), where the simulated robot starts.
+inline const std::vector<double> kPandaReady = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+/// The upper-body skeleton's joints (collision::HumanBodyParams::DefaultUpperBody).
+inline const std::vector<std::string> kUpperBodyJoints = {"head",   "neck",       "torso",   "shoulder_l", "elbow_l",
+                                                          "hand_l", "shoulder_r", "elbow_r", "hand_r"};
+
 /// A skeleton in the cell frame: joint j named names[j] at positions[j]
 /// (m, world), every confidence 1.
 inline msg::HumanSkeleton SkeletonMessage(const msg::Time& stamp, const std::vector<std::string>& names,
@@ -33,8 +43,9 @@ inline msg::HumanSkeleton SkeletonMessage(const msg::Time& stamp, const std::vec
 /// A START command of task `task_id` to the joint positions `goal` (rad, the
 /// robot's joints in order), then to `retreat` if it is not empty, within
 /// `time_limit_s`.
-inline msg::TaskCommand JointGoalCommand(uint32_t task_id, const std::string& task_name, const std::vector<double>& goal,
-                                         double time_limit_s, const std::vector<double>& retreat = {}) {
+inline msg::TaskCommand JointGoalCommand(uint32_t task_id, const std::string& task_name,
+                                         const std::vector<double>& goal, double time_limit_s,
+                                         const std::vector<double>& retreat = {}) {
   msg::TaskCommand c;
   c.header.stamp = msg::Now();
   c.task_id = task_id;
