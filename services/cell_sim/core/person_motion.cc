@@ -7,39 +7,19 @@
 
 #include <Eigen/Geometry>
 
+#include "core/person_body.h"
 #include "core/skeleton_replay.h"
 
 namespace iplan::cell_sim {
 namespace {
 
-// The synthetic person's proportions (services/perception/core/synthetic_person.cc).
-constexpr double kShoulderBelowNeck = 0.05;  // m
-constexpr double kNeckToHead = 0.18;         // m
-constexpr double kTorsoToNeck = 0.30;        // m
-constexpr double kUpperArm = 0.30;           // m
-constexpr double kForearm = 0.28;            // m
-constexpr double kMaxReach = 0.97 * (kUpperArm + kForearm);
-
-// Minimum-jerk position profile s(u), u in [0, 1].
-double MinJerk(double u) {
-  u = std::clamp(u, 0.0, 1.0);
-  return u * u * u * (10 - 15 * u + 6 * u * u);
-}
-
-// Elbow of a two-link arm from shoulder to hand, bending down (as the
-// synthetic person's).
-Eigen::Vector3d Elbow(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& hand) {
-  const Eigen::Vector3d d = hand - shoulder;
-  const double dist = std::clamp(d.norm(), 1e-6, kUpperArm + kForearm - 1e-6);
-  const double a = (kUpperArm * kUpperArm - kForearm * kForearm + dist * dist) / (2 * dist);
-  const double h = std::sqrt(std::max(0.0, kUpperArm * kUpperArm - a * a));
-  const Eigen::Vector3d dir = d.norm() > 1e-9 ? Eigen::Vector3d(d / d.norm()) : Eigen::Vector3d::UnitX();
-  Eigen::Vector3d down = Eigen::Vector3d::UnitZ().cross(dir).cross(dir);  // perpendicular, pointing down
-  if (down.norm() < 1e-9) down = Eigen::Vector3d::UnitX();
-  down.normalize();
-  if (down.z() > 0) down = -down;
-  return shoulder + a * dir + h * down;
-}
+// The synthetic person's body (services/perception/core/person_body.h).
+using perception::ArmElbow;
+using perception::kMaxReach;
+using perception::kNeckToHead;
+using perception::kShoulderBelowNeck;
+using perception::kTorsoToNeck;
+using perception::MinJerk;
 
 // Where the sweep puts the hand at t (s), the script having it at `own`;
 // nullopt outside the sweep.
@@ -291,7 +271,7 @@ PersonStream SyntheticPersonStream(const perception::SyntheticPersonParams& pers
         const Eigen::Vector3d s_W = q.col(shoulder), d = *h - s_W;
         const Eigen::Vector3d h_W = d.norm() > kMaxReach ? Eigen::Vector3d(s_W + d.normalized() * kMaxReach) : *h;
         q.col(hand) = h_W;
-        q.col(elbow) = Elbow(s_W, h_W);
+        q.col(elbow) = ArmElbow(s_W, h_W);
       }
     }
     s.truth.push_back(std::move(q));

@@ -7,38 +7,14 @@
 
 #include <Eigen/Geometry>
 
+#include "person_body.h"
+
 namespace iplan::perception {
 namespace {
 
-constexpr double kUpperArm = 0.30;   // m
-constexpr double kForearm = 0.28;    // m
-constexpr double kMaxReach = 0.97 * (kUpperArm + kForearm);
 constexpr double kShoulderHalfWidth = 0.18;
-constexpr double kTorsoToNeck = 0.30;
-constexpr double kNeckToHead = 0.18;
-constexpr double kShoulderBelowNeck = 0.05;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kWorkHalfSpread = 0.10;  // m, each hand from the work centre
-
-// Minimum-jerk position profile s(u), u in [0, 1].
-double MinJerk(double u) {
-  u = std::clamp(u, 0.0, 1.0);
-  return u * u * u * (10 - 15 * u + 6 * u * u);
-}
-
-// Elbow position for a two-link arm from shoulder to hand, bending down.
-Eigen::Vector3d Elbow(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& hand) {
-  const Eigen::Vector3d d = hand - shoulder;
-  const double dist = std::clamp(d.norm(), 1e-6, kUpperArm + kForearm - 1e-6);
-  const double a = (kUpperArm * kUpperArm - kForearm * kForearm + dist * dist) / (2 * dist);
-  const double h = std::sqrt(std::max(0.0, kUpperArm * kUpperArm - a * a));
-  const Eigen::Vector3d dir = d / d.norm();
-  Eigen::Vector3d down = Eigen::Vector3d::UnitZ().cross(dir).cross(dir);  // perpendicular, pointing down
-  if (down.norm() < 1e-9) down = Eigen::Vector3d::UnitX();
-  down.normalize();
-  if (down.z() > 0) down = -down;
-  return shoulder + a * dir + h * down;
-}
 
 // Keeps a hand within arm's reach of its shoulder.
 Eigen::Vector3d WithinReach(const Eigen::Vector3d& shoulder, const Eigen::Vector3d& hand) {
@@ -207,8 +183,8 @@ std::vector<JointSample> SyntheticPerson::TruePose(double t) const {
   }
   hand_l = WithinReach(shoulder_l, hand_l);
   hand_r = WithinReach(shoulder_r, hand_r);
-  const Eigen::Vector3d p9[9] = {head,   neck,   params_.torso_W,        shoulder_l, Elbow(shoulder_l, hand_l),
-                                 hand_l, shoulder_r, Elbow(shoulder_r, hand_r), hand_r};
+  const Eigen::Vector3d p9[9] = {head,   neck,   params_.torso_W,        shoulder_l, ArmElbow(shoulder_l, hand_l),
+                                 hand_l, shoulder_r, ArmElbow(shoulder_r, hand_r), hand_r};
   std::vector<JointSample> out;
   out.reserve(9);
   for (int i = 0; i < 9; ++i) out.push_back({UpperBodyJointNames()[i], p9[i], 0.0});
