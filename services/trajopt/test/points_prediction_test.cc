@@ -13,12 +13,10 @@
 
 #include "core/replanner.h"
 #include "iplan/planning/planner_params.h"
+#include "replanner_fixture.h"
 
 namespace iplan::trajopt {
 namespace {
-
-constexpr int64_t kSec = 1000000000;
-const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config/";
 
 // Points on a sphere of radius r around c, about 3 cm apart, appended to
 // `p` with motion `motion` (-1: not tracked), sensor noise (2 mm)^2.
@@ -109,17 +107,7 @@ TEST(PointsPrediction, ManySpheresCoarsenTheGrid) {
 
 class PointsReplannerTest : public ::testing::Test {
  protected:
-  PointsReplannerTest()
-      : planner_(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
-                 collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
-                 planning::LoadPlannerParams(kConfig + "planner_replanning.yaml")),
-        body_(collision::HumanBodyParams::DefaultUpperBody()),
-        replanner_(planner_, body_, ReplannerParams{}) {}
-  static Eigen::VectorXd Ready() {
-    Eigen::VectorXd q(7);
-    q << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
-    return q;
-  }
+  static Eigen::VectorXd Ready() { return ReplannerTest::Ready(); }
   // A still-standing tracked person: a torso-sized ball behind a hand-sized one at `hand`.
   static cell::HumanPoints PersonAt(int64_t t, const Eigen::Vector3d& hand, const Eigen::Vector3d& v) {
     cell::HumanPoints p;
@@ -130,16 +118,17 @@ class PointsReplannerTest : public ::testing::Test {
     AddBall(&p, hand + Eigen::Vector3d(0.45, 0.0, 0.1), 0.17, 0);
     return p;
   }
-  planning::Planner planner_;
-  collision::HumanBodyModel body_;
-  Replanner replanner_;
+  // The cell's replanning planner (predict_ssm on), as the service plans.
+  const std::unique_ptr<planning::Planner> predicting_ = ReplannerTest::PredictingPlanner();
+  const planning::Planner& planner_ = *predicting_;
+  collision::HumanBodyModel body_{collision::HumanBodyParams::DefaultUpperBody()};
+  Replanner replanner_{planner_, body_, ReplannerParams{}};
 };
 
 // Points (no skeleton prediction) on the goal: the robot is held until the
 // person walks away, then arrives.
 TEST_F(PointsReplannerTest, PointsOnTheGoalHoldTheRobotUntilTheyLeave) {
-  Eigen::VectorXd goal(7);
-  goal << 0.6, -0.2, 0.0, -2.0, 0.0, 1.9, 0.8;
+  const Eigen::VectorXd goal = ReplannerTest::Goal();
   collision::RobotData data(planner_.robot());
   collision::CalcForwardKinematics(planner_.robot(), goal, &data);
   const Eigen::Vector3d goal_hand = data.X_WL.back().translation();

@@ -23,14 +23,8 @@ inline constexpr int64_t kSec = 1000000000;
 inline const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config/";
 
 class ReplannerTest : public ::testing::Test {
- protected:
-  ReplannerTest()
-      : planner_(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
-                 collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
-                 planning::LoadPlannerParams(kConfig + "planner.yaml")),
-        body_(collision::HumanBodyParams::DefaultUpperBody()),
-        replanner_(planner_, body_, ReplannerParams{}) {}
-
+ public:
+  // The Panda's ready pose and a goal (rad); also used by the points tests.
   static Eigen::VectorXd Ready() {
     Eigen::VectorXd q(7);
     q << 0, -0.785, 0, -2.356, 0, 1.571, 0.785;
@@ -54,6 +48,14 @@ class ReplannerTest : public ::testing::Test {
     collision::CalcForwardKinematics(robot, Ready(), &d);
     return d.p_WS.col(static_cast<int>(robot.spheres.size()) - 1);
   }
+ protected:
+  ReplannerTest()
+      : planner_(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                 collision::LoadSceneParams(kConfig + "scenes/cell.yaml"),
+                 planning::LoadPlannerParams(kConfig + "planner.yaml")),
+        body_(collision::HumanBodyParams::DefaultUpperBody()),
+        replanner_(planner_, body_, ReplannerParams{}) {}
+
   // Position of a published plan at time t (linear interpolation).
   static Eigen::VectorXd At(const CycleResult& c, int64_t t) {
     const double s = std::max(0.0, (t - c.start_ns) * 1e-9 / c.dt);
