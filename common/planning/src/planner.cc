@@ -308,7 +308,8 @@ PlanningResult Planner::Plan(const PlanningRequest& req, int num_optimizers, int
     have_fail = true;
     result.winning_optimizer = pick;
     // Waiting helps only against the person, and takes another attempt.
-    if (at.people.empty() || result.num_waits >= P.max_waits || at.OutOfTime()) break;
+    const int max_waits = req.max_waits >= 0 ? req.max_waits : P.max_waits;
+    if (at.people.empty() || result.num_waits >= max_waits || at.OutOfTime()) break;
     M.InsertWait(&at, sel.reference >= 0 ? &cands[sel.reference] : nullptr, wait_steps);
     ++result.num_waits;
     result.delay += wait_steps * P.dt;

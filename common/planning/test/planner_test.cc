@@ -242,6 +242,13 @@ TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
   EXPECT_EQ(r.num_waits, planner_.params().max_waits);
   EXPECT_NEAR(r.delay, r.num_waits * 0.5, 1e-12);
   EXPECT_GE(r.max_bound, 1.0 - planner_.params().delta_cl);
+  // A request may forbid waits (an escape must move now): one attempt.
+  req.max_waits = 0;
+  const PlanningResult now = planner_.Plan(req);
+  EXPECT_EQ(now.status, PlanStatus::kNoSafeTrajectory) << now.reason;
+  EXPECT_EQ(now.num_waits, 0);
+  EXPECT_EQ(now.delay, 0.0);
+  EXPECT_EQ(now.positions.cols(), r.positions.cols() - r.num_waits * 5);
 }
 
 TEST_F(PlannerTest, SeparationKeepOutHoldsPlansAwayFromThePredictedPerson) {

@@ -113,6 +113,10 @@ struct PlanningRequest {
   /// robot for a while, not for ever; at 0 a plan may come as close as the
   /// predicted monitor allows, never closer.
   double ssm_scale = 1.0;
+  /// Waits this request may insert before giving up; -1: PlannerParams::
+  /// max_waits. 0 for a plan that must move now (an escape: a wait would
+  /// leave the robot where it is).
+  int max_waits = -1;
 };
 
 enum class PlanStatus {
