@@ -123,6 +123,7 @@ class CollisionRiskService : public framework::Service {
     m.speed_scale = r.speed_scale;
     m.verdict = services::ToWire(r.verdict);
     m.reason = r.reason;
+    m.retreating = r.retreating;
     writer_->Write(m);
     msg::SafetyPermit p;
     p.header.stamp = msg::Now();

@@ -1,6 +1,7 @@
 #include "risk_config.h"
 
 #include <stdexcept>
+#include <tuple>
 
 #include "iplan/cell/safety.h"
 #include "iplan/core/params.h"
@@ -41,8 +42,17 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
       if (const std::string d = cell::SsmDifference(p.ssm, safety.ssm); config.Has("iso_ts_15066") && !d.empty()) {
         config.AddError("iso_ts_15066", "disagrees with " + c.safety_file + " (" + d + "): give it in one place");
       }
+      for (const auto& [key, mine, cell] : {std::tuple{"stop_horizon", p.stop_horizon, safety.stop_horizon},
+                                            std::tuple{"bound_retreat_gain", p.bound_retreat_gain, safety.bound_retreat_gain}}) {
+        if (config.Has(key) && mine != cell) {
+          config.AddError(key, std::string("disagrees with ") + c.safety_file + " (" + core::ParamText(mine) + " vs " +
+                                   core::ParamText(cell) + "): give it in one place");
+        }
+      }
       p.delta_cl = safety.delta_cl;
       p.ssm = safety.ssm;
+      p.stop_horizon = safety.stop_horizon;
+      p.bound_retreat_gain = safety.bound_retreat_gain;
     } catch (const std::exception& e) {
       config.AddError("safety", e.what());
     }

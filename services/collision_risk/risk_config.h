@@ -26,7 +26,7 @@ struct RiskSettings {
     a->Visit(IPLAN_NVP(human_body, "human body spheres file, relative to the configuration file"));
     a->Visit(IPLAN_NVP(rate_hz, "Hz, evaluations per second between predictions, in [1, 1000]"));
     a->Visit(IPLAN_NVP(permit_validity, "s; the permit published with every evaluation lapses after this, in [0.01, 10]"));
-    a->Visit(IPLAN_NVP(safety, "the cell's safety file (delta_cl, iso_ts_15066: the one source); empty: none"));
+    a->Visit(IPLAN_NVP(safety, "the cell's safety file (delta_cl, iso_ts_15066, stop_horizon, bound_retreat_gain: the one source); empty: none"));
     params.Serialize(a);
   }
   std::string Validate() const;
@@ -44,13 +44,14 @@ struct RiskConfig {
 /// Reads `section` (collision_risk); every problem, RiskParams::Validate()'s
 /// (the only ranges of RiskParams) included, is recorded in the
 /// configuration (reported by Finish()). Keys: robot, human_body, rate_hz,
-/// delta_cl, stop_horizon, slow_down_fraction, slow_down_margin, stale_after,
-/// iso_ts_15066.{measure_human_speed, default_human_speed, speed_window,
-/// reaction_time, stopping_time, stopping_distance, intrusion_distance,
-/// sensing_uncertainty, robot_uncertainty}; `safety` names the cell's
-/// safety file (iplan/cell/safety.h), the one source of delta_cl and
-/// iso_ts_15066 (a value given here as well that disagrees is an error
-/// naming both files).
+/// delta_cl, stop_horizon, slow_down_fraction, slow_down_margin,
+/// bound_retreat_gain, stale_after, iso_ts_15066.{measure_human_speed,
+/// default_human_speed, speed_window, reaction_time, stopping_time,
+/// stopping_distance, intrusion_distance, sensing_uncertainty,
+/// robot_uncertainty}; `safety` names the cell's safety file
+/// (iplan/cell/safety.h), the one source of delta_cl, iso_ts_15066,
+/// stop_horizon and bound_retreat_gain (a value given here as well that
+/// disagrees is an error naming both files).
 RiskConfig ReadRiskConfig(framework::ConfigSection& section);
 
 /// Reads `collision_risk_yaml` as the collision-risk service does (section

@@ -135,7 +135,7 @@ class SupervisorService : public framework::Service {
                      if constexpr (std::is_same_v<T, msg::CollisionRisk>) {
                        // The boundary refuses octets the IDL does not define; an unknown one would stop.
                        monitor_->OnRiskVerdict(services::VerdictFromWire(m.verdict).value_or(cell::Verdict::kProtectiveStop),
-                                               m.reason);
+                                               m.reason, m.retreating);
                      }
                      if constexpr (std::is_same_v<T, msg::ActionBelief>) Belief(m);
                    }));

@@ -13,6 +13,9 @@ std::string Text(bool v) { return core::ParamText(v); }
 std::string SafetyParams::Validate() const {
   if (!(delta_cl > 0 && delta_cl < 1)) return "delta_cl must be in (0, 1), got " + Text(delta_cl);
   if (std::string why = ssm.Validate(); !why.empty()) return "iso_ts_15066: " + why;
+  if (!(stop_horizon >= 0)) return "stop_horizon must be >= 0, got " + Text(stop_horizon);
+  if (!(bound_retreat_gain >= 0 && bound_retreat_gain <= 1))
+    return "bound_retreat_gain must be in [0, 1], got " + Text(bound_retreat_gain);
   return "";
 }
 

@@ -85,11 +85,19 @@ TEST_F(CellConfigTest, AgreeingValuesGivenTwiceAreAccepted) {
 }
 
 TEST_F(CellConfigTest, AMonitorFileThatDisagreesIsRefusedNamingBothFiles) {
-  Edit("collision_risk.yaml", "  stop_horizon:", "  iso_ts_15066:\n    stopping_time: 0.5\n  stop_horizon:");
+  Edit("collision_risk.yaml", "  slow_down_fraction:", "  iso_ts_15066:\n    stopping_time: 0.5\n  slow_down_fraction:");
   const std::string why = LoadError();
   EXPECT_NE(why.find("collision_risk.yaml"), std::string::npos) << why;
   EXPECT_NE(why.find("safety.yaml"), std::string::npos) << why;
   EXPECT_NE(why.find("iso_ts_15066.stopping_time 0.5 vs 0.3"), std::string::npos) << why;
+}
+
+TEST_F(CellConfigTest, AMonitorStopHorizonThatDisagreesIsRefusedAndTheSafetyFileReachesBoth) {
+  Edit("collision_risk.yaml", "  slow_down_fraction:", "  stop_horizon: 0.5\n  slow_down_fraction:");
+  const std::string why = LoadError();
+  EXPECT_NE(why.find("collision_risk.yaml"), std::string::npos) << why;
+  EXPECT_NE(why.find("safety.yaml"), std::string::npos) << why;
+  EXPECT_NE(why.find("stop_horizon"), std::string::npos) << why;
 }
 
 TEST_F(CellConfigTest, ABadSafetyFileIsRefusedByName) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <stdexcept>
 
@@ -22,6 +23,7 @@ std::string RiskParams::Validate() const {
   if (!(stop_horizon >= 0)) return "stop_horizon must be >= 0";
   if (!(slow_down_fraction > 0 && slow_down_fraction <= 1)) return "slow_down_fraction must be in (0, 1]";
   if (!(slow_down_margin >= 0)) return "slow_down_margin must be >= 0";
+  if (!(bound_retreat_gain >= 0 && bound_retreat_gain <= 1)) return "bound_retreat_gain must be in [0, 1]";
   if (!(stale_after > 0)) return "stale_after must be > 0";
   if (!(joint_limit_tolerance >= 0)) return "joint_limit_tolerance must be >= 0";
   if (std::string why = ssm.Validate(); !why.empty()) return why;
@@ -299,13 +301,15 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
     traj.radii.push_back(sp.radius);
     traj.links.push_back(sp.link);
   }
-  std::vector<int64_t> times;
+  BoundWaypoints bw;
+  bw.ref = ref;
   for (int k = 0; k < m.num_steps(); ++k) {
     if (m.StepTime(k) < now_ns) continue;
     traj.steps.push_back(k);
-    times.push_back(m.StepTime(k));
+    bw.times.push_back(m.StepTime(k));
   }
-  const std::vector<int> ref_steps = traj.steps;
+  bw.ref_steps = traj.steps;
+  const std::vector<int64_t>& times = bw.times;
   traj.centres.resize(3, static_cast<Eigen::Index>(traj.steps.size()) * S);
   for (std::size_t w = 0; w < traj.steps.size(); ++w) {
     collision::CalcForwardKinematics(robot_, RobotConfigurationAt(times[w]), &data_);
@@ -319,15 +323,7 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
   std::vector<collision::WaypointBound> top(traj.steps.size());
   std::vector<cell::BodyId> top_body(traj.steps.size(), 0);
   std::vector<const cell::TimedPrediction*> top_prediction(traj.steps.size(), &m);
-  for (const auto& [id, e] : predictions_) {
-    const cell::TimedPrediction& p = e.value;
-    if (!p.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9))) continue;
-    for (std::size_t w = 0; w < times.size(); ++w) {  // its step nearest to each waypoint's time
-      const double k = std::round((times[w] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
-      traj.steps[w] =
-          &p == ref ? ref_steps[w] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
-    }
-    collision::EvaluateTrajectoryBound(p.spheres(), traj, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
+  ForEachPersonBound(now_ns, bw, &traj, [&](cell::BodyId id, const cell::TimedPrediction& p) {
     for (std::size_t w = 0; w < bounds_.size(); ++w) {
       shares[w].push_back(bounds_[w].bound);
       sum[w] += bounds_[w].bound;
@@ -338,7 +334,7 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
         top_prediction[w] = &p;
       }
     }
-  }
+  });
   for (std::size_t w = 0; w < sum.size(); ++w) {
     const auto& b = top[w];
     r.waypoint_bounds.push_back(cell::UnionBound(shares[w]));
@@ -353,19 +349,78 @@ void RiskMonitor::EvaluateBound(int64_t now_ns, RiskReport* out) {
       r.max_action = b.action >= 0 ? top_prediction[w]->actions()[static_cast<std::size_t>(b.action)] : "";
     }
   }
+  CompareWithStandingStill(now_ns, bw, &traj, &r);
 }
+
+// Every fresh person's bound along `t` (its centres set) into bounds_, then
+// `use`; each person's prediction taken at its step nearest to each
+// waypoint's time (the reference prediction at its own steps).
+void RiskMonitor::ForEachPersonBound(int64_t now_ns, const BoundWaypoints& w, collision::RobotSpheresTrajectory* t,
+                                     const std::function<void(cell::BodyId, const cell::TimedPrediction&)>& use) {
+  for (const auto& [id, e] : predictions_) {
+    const cell::TimedPrediction& p = e.value;
+    if (!p.FreshAt(now_ns, static_cast<int64_t>(params_.stale_after * 1e9))) continue;
+    for (std::size_t i = 0; i < w.times.size(); ++i) {
+      const double k = std::round((w.times[i] - p.t0_ns()) * 1e-9 / p.time_step()) - 1;
+      t->steps[i] =
+          &p == w.ref ? w.ref_steps[i] : static_cast<int>(std::clamp(k, 0.0, static_cast<double>(p.num_steps() - 1)));
+    }
+    collision::EvaluateTrajectoryBound(p.spheres(), *t, collision::TrajectoryBoundParams{}, &workspace_, &bounds_);
+    use(id, p);
+  }
+}
+
+// The alternative to a stop: the robot held where it stands (DecideVerdict's
+// bound retreat), its largest bound within the stop horizon against the
+// trajectory's. Not evaluated when the trajectory holds the robot there.
+void RiskMonitor::CompareWithStandingStill(int64_t now_ns, const BoundWaypoints& w,
+                                           collision::RobotSpheresTrajectory* traj, RiskReport* r) {
+  if (params_.bound_retreat_gain <= 0 || trajectory_.empty()) return;
+  double travel = 0;
+  for (std::size_t i = 0; i < w.times.size() && r->waypoint_times[i] <= params_.stop_horizon; ++i)
+    travel = std::max(travel, (RobotConfigurationAt(w.times[i]) - state_->second).cwiseAbs().maxCoeff());
+  if (travel < 1e-3) return;  // rad: a hold
+  const int S = static_cast<int>(robot_.spheres.size());
+  collision::CalcForwardKinematics(robot_, state_->second, &data_);
+  for (std::size_t i = 0; i < w.times.size(); ++i) traj->centres.middleCols(static_cast<Eigen::Index>(i) * S, S) = data_.p_WS;
+  std::vector<std::vector<double>> hold(w.times.size());
+  ForEachPersonBound(now_ns, w, traj, [&](cell::BodyId, const cell::TimedPrediction&) {
+    for (std::size_t i = 0; i < bounds_.size(); ++i) hold[i].push_back(bounds_[i].bound);
+  });
+  r->hold_bound = 0;
+  r->horizon_bound = 0;
+  for (std::size_t i = 0; i < hold.size() && r->waypoint_times[i] <= params_.stop_horizon; ++i) {
+    r->hold_bound = std::max(r->hold_bound, cell::UnionBound(hold[i]));
+    r->horizon_bound = std::max(r->horizon_bound, r->waypoint_bounds[i]);
+  }
+}
+
+// Why an OK verdict is one: what the monitor saw.
+const char* RiskMonitor::ClearReason(const Inputs& in, bool seen, bool separation) {
+  return !seen         ? "no person seen"
+         : !in.person   ? (separation ? "clear (depth points only)" : "no person seen (depth: no points)")
+         : in.predicted ? "clear"
+         : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
+                        : "clear (separation only: no current prediction)";
+}
+
+namespace {
+
+// s after the evaluation of the first waypoint whose bound reaches
+// `threshold`, -1 when none does.
+double FirstViolation(const RiskReport& r, double threshold) {
+  for (std::size_t w = 0; w < r.waypoint_bounds.size(); ++w)
+    if (r.waypoint_bounds[w] >= threshold) return r.waypoint_times[w];
+  return -1;
+}
+
+}  // namespace
 
 // Verdict: the hard layer first, then the prediction.
 void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* out) const {
   RiskReport& r = *out;
   const double threshold = 1 - params_.delta_cl;
-  double first_violation = -1;
-  for (std::size_t w = 0; w < r.waypoint_bounds.size(); ++w) {
-    if (r.waypoint_bounds[w] >= threshold) {
-      first_violation = r.waypoint_times[w];
-      break;
-    }
-  }
+  const double first_violation = FirstViolation(r, threshold);
   const double margin = r.separation_margin.value_or(std::numeric_limits<double>::infinity());
   const std::string separation = r.binding_separation ? Fmt(*r.binding_separation) : std::string("none");
   // With several people the reason names the person (nothing added for one).
@@ -374,6 +429,10 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                                                           std::to_string(r.num_predicted) + ")"
                                                     : "";
   const bool seen = in.person || in.points;  // fresh points: the depth camera tracks the person
+  // Standing still would reach the bound within the stop horizon, and the
+  // trajectory lowers it by the gain: it takes the robot out of the way.
+  const bool bound_retreat = params_.bound_retreat_gain > 0 && r.hold_bound >= threshold &&
+                             r.hold_bound - r.horizon_bound >= params_.bound_retreat_gain;
   // Inside S_p at the trajectory's speed, but not at min_speed_scale of it:
   // the robot is slowed down, not stopped (ISO/TS 15066 speed reduction).
   const cell::SsmParams& s = params_.ssm;
@@ -390,6 +449,15 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                (r.num_people > 1 ? " of body " + std::to_string(r.binding_body_id) : "") +
                ") below the protective separation " + Fmt(r.protective_separation) + " m (v_h " + Fmt(r.human_speed) +
                ", v_r " + Fmt(r.robot_speed) + " m/s)";
+  } else if (first_violation >= 0 && first_violation <= params_.stop_horizon && bound_retreat) {
+    // Stopping would leave the robot where the person is predicted to come:
+    // the trajectory that takes it out of their way goes on.
+    r.verdict = Verdict::kSlowDown;
+    r.retreating = true;
+    r.reason = "retreating from the predicted person: collision bound " + Fmt(r.horizon_bound) + " within " +
+               Fmt(params_.stop_horizon) + " s along the trajectory against " + Fmt(r.hold_bound) +
+               " standing still (" + r.max_robot_link + " / " + r.max_human_segment + ", " + r.max_action + ")" +
+               likeliest;
   } else if (first_violation >= 0 && first_violation <= params_.stop_horizon) {
     r.verdict = Verdict::kProtectiveStop;
     r.reason = "collision bound " + Fmt(r.max_bound) + " >= " + Fmt(threshold) + " in " + Fmt(first_violation) +
@@ -422,14 +490,12 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                " m of the protective separation" + nearest;
   } else {
     r.verdict = Verdict::kOk;
-    r.reason = !seen         ? "no person seen"
-               : !in.person   ? (r.binding_separation ? "clear (depth points only)"
-                                                      : "no person seen (depth: no points)")
-               : in.predicted ? "clear"
-               : in.degraded  ? "clear (degraded: no usable prediction; separation at the default human speed)"
-                              : "clear (separation only: no current prediction)";
+    r.reason = ClearReason(in, seen, r.binding_separation.has_value());
   }
   if (r.verdict == Verdict::kProtectiveStop) r.speed_scale = 0.0;
+  // Clear, and away from where the person will come: a supervisor that
+  // stopped the robot lets it go at once.
+  if (r.verdict != Verdict::kProtectiveStop && bound_retreat) r.retreating = true;
 }
 
 }  // namespace iplan::collision_risk

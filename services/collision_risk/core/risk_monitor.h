@@ -50,6 +50,7 @@
 
 #include <cstdint>
 #include <deque>
+#include <functional>
 #include <optional>
 #include <string>
 #include <vector>
@@ -77,6 +78,12 @@ struct RiskParams {
   double stop_horizon = 1.0;       ///< s; a violating waypoint within it means stop, later means slow down
   double slow_down_fraction = 0.5; ///< slow down above this fraction of 1 - delta_cl
   double slow_down_margin = 0.2;   ///< m; slow down within S_p + margin
+  /// Bound retreat: a trajectory that violates the bound within the stop
+  /// horizon is not stopped when its largest bound there is at least this
+  /// much below that of the robot held where it stands (stopping would
+  /// leave it in the person's predicted way): SLOW_DOWN, "retreating".
+  /// 0: off (every violation within the horizon stops).
+  double bound_retreat_gain = 0.05;
   double stale_after = 0.5;        ///< s; older skeletons, predictions, robot states are ignored
   /// No fresh skeleton and no fresh depth points mean protective stop: a
   /// person no sensor sees could be anywhere. false: "no person seen" is
@@ -99,6 +106,7 @@ struct RiskParams {
     a->Visit(IPLAN_NVP(stop_horizon, "s; a violation within it stops, later slows down, >= 0"));
     a->Visit(IPLAN_NVP(slow_down_fraction, "slow down above this fraction of 1 - delta_cl, in (0, 1]"));
     a->Visit(IPLAN_NVP(slow_down_margin, "m; slow down within S_p + this, >= 0"));
+    a->Visit(IPLAN_NVP(bound_retreat_gain, "a trajectory that lowers the bound within the stop horizon by this much against standing still is a retreat, not a stop (0: off), in [0, 1]"));
     a->Visit(IPLAN_NVP(stale_after, "s; older skeletons, predictions, robot states are not used, > 0"));
     a->Visit(IPLAN_NVP(person_required, "no fresh skeleton or depth points means protective stop"));
     a->Visit(IPLAN_NVP(joint_limit_tolerance, "rad; a robot state further outside the limits is refused, >= 0"));
@@ -130,7 +138,15 @@ struct RiskReport {
   double robot_speed = 0;                ///< m/s used for that S_p (towards the person when directed)
   cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
   cell::Separation separation_margin;    ///< m, binding_separation - protective_separation (0 for a retreat); < 0 stops
-  bool retreating = false;               ///< the binding pair is inside S_p, its robot sphere moving away (cell::SsmPair)
+  /// A retreat, not a stop: the binding pair is inside S_p, its robot
+  /// sphere moving away (cell::SsmPair), or the trajectory lowers the bound
+  /// within the stop horizon against standing still (bound_retreat_gain).
+  /// A supervisor resumes a retreat at once (no resume delay).
+  bool retreating = false;
+  /// Largest bound within the stop horizon along the trajectory and with the
+  /// robot held where it stands; both 0 unless a prediction is fresh and the
+  /// trajectory moves the robot within the stop horizon.
+  double horizon_bound = 0, hold_bound = 0;
   /// ISO/TS 15066 speed reduction (SsmParams::speed_reduction): the
   /// fraction of the executing trajectory's speed the robot may run at, in
   /// [0, 1]: below 1 with SLOW_DOWN (the path time-scaled), 0 with
@@ -213,6 +229,20 @@ class RiskMonitor {
   void EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskReport* r);
   /// The prediction layer into r: bound along the executing trajectory.
   void EvaluateBound(int64_t now_ns, RiskReport* r);
+  /// The prediction layer's waypoints: the times of the newest prediction's
+  /// steps not yet past, and that prediction's own step at each.
+  struct BoundWaypoints {
+    const cell::TimedPrediction* ref = nullptr;
+    std::vector<int> ref_steps;
+    std::vector<int64_t> times;  ///< ns since the epoch
+  };
+  void ForEachPersonBound(int64_t now_ns, const BoundWaypoints& w, collision::RobotSpheresTrajectory* t,
+                          const std::function<void(cell::BodyId, const cell::TimedPrediction&)>& use);
+  /// RiskReport::hold_bound and horizon_bound (the bound retreat).
+  void CompareWithStandingStill(int64_t now_ns, const BoundWaypoints& w, collision::RobotSpheresTrajectory* traj,
+                                RiskReport* r);
+  /// Why an OK verdict is one: what the monitor saw.
+  static const char* ClearReason(const Inputs& in, bool seen, bool separation);
   /// The verdict policy (see the file comment) from both layers.
   void DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* r) const;
   Eigen::VectorXd RobotConfigurationAt(int64_t t_ns) const;

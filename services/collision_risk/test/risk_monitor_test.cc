@@ -320,6 +320,56 @@ TEST_F(RiskMonitorTest, ExecutingTrajectoryIsWhatIsChecked) {
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
 }
 
+// Bound retreat: standing still is what the bound forbids, and the
+// trajectory takes the robot out of the way; one that does not is stopped.
+TEST_F(RiskMonitorTest, ATrajectoryOutOfThePredictedWayIsARetreatNotAStop) {
+  const int64_t t = 100 * kSec;
+  RobotAtReady(t);
+  // As above: the person walks at the robot's hand, contact predicted soon.
+  const Eigen::Vector3d torso(1.4, 0, 0.55), v(-0.8, 0, 0);
+  SeePerson(t - 3 * kSec / 10, torso - v * 0.3);
+  SeePerson(t, torso);
+  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+  const std::vector<double> ready = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
+  // Turning the arm to the side, out of the person's path, within 0.5 s.
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, {ready, {1.6, -0.785, 0, -2.356, 0, 1.571, 0.785}}),
+            std::nullopt);
+  const RiskReport aside = monitor_.Evaluate(t);
+  EXPECT_GE(aside.hold_bound, 0.05) << "standing still is what the bound forbids";
+  EXPECT_LE(aside.horizon_bound, aside.hold_bound - 0.05);
+  EXPECT_EQ(aside.verdict, Verdict::kSlowDown) << aside.reason;
+  EXPECT_TRUE(aside.retreating);
+  EXPECT_EQ(aside.reason.rfind("retreating from the predicted person: ", 0), 0u) << aside.reason;
+  // Reaching towards the person instead lowers nothing: a stop.
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, {ready, {0, 0.3, 0, -1.2, 0, 1.571, 0.785}}),
+            std::nullopt);
+  const RiskReport towards = monitor_.Evaluate(t);
+  EXPECT_EQ(towards.verdict, Verdict::kProtectiveStop) << towards.reason;
+  EXPECT_FALSE(towards.retreating);
+  // Half as far round (1.0 rad): the bound within the horizon stays above
+  // 1 - delta_cl (about 0.9) but 0.05 below standing still's 1: a retreat
+  // with the default gain, a stop with the gain 0 (off) or 0.2.
+  const std::vector<std::vector<double>> half = {ready, {1.0, -0.785, 0, -2.356, 0, 1.571, 0.785}};
+  ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, half), std::nullopt);
+  const RiskReport partial = monitor_.Evaluate(t);
+  EXPECT_GE(partial.horizon_bound, 0.05);
+  EXPECT_EQ(partial.verdict, Verdict::kSlowDown) << partial.reason;
+  EXPECT_TRUE(partial.retreating);
+  for (double gain : {0.0, 0.2}) {
+    RiskParams other = monitor_.params();
+    other.bound_retreat_gain = gain;
+    RiskMonitor m(monitor_.robot(), collision::HumanBodyParams::DefaultUpperBody(), other);
+    ASSERT_EQ(m.UpdateRobotState(t, kRobotJoints, ready), std::nullopt);
+    ASSERT_EQ(m.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, half), std::nullopt);
+    ASSERT_EQ(m.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person(torso - v * 0.3)), std::nullopt);
+    ASSERT_EQ(m.UpdateSkeleton(t, kJoints, Person(torso)), std::nullopt);
+    ASSERT_EQ(m.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+    const RiskReport r = m.Evaluate(t);
+    EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << "gain " << gain << ": " << r.reason;
+    EXPECT_FALSE(r.retreating);
+  }
+}
+
 TEST_F(RiskMonitorTest, RejectsRobotStatesOutsideTheJointLimits) {
   const std::vector<double> ready = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
   std::vector<double> q = ready;

@@ -26,8 +26,9 @@ void SafetyMonitor::OnLivelinessLost(const std::string& topic, int alive_writers
   if (causes_.count(topic) && alive_writers == 0) causes_[topic] = "publisher gone (liveliness lost)";
 }
 
-void SafetyMonitor::OnRiskVerdict(cell::Verdict verdict, const std::string& reason) {
+void SafetyMonitor::OnRiskVerdict(cell::Verdict verdict, const std::string& reason, bool retreating) {
   risk_cause_ = verdict == cell::Verdict::kProtectiveStop ? "collision risk: " + reason : "";
+  risk_retreat_ = retreating && verdict != cell::Verdict::kProtectiveStop;
 }
 
 SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {
@@ -49,7 +50,7 @@ SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {
   d.reason = d.stop ? reason : "all inputs healthy";
   if (d.stop) {
     clear_since_ns_.reset();
-  } else if (last_ && last_->stop && resume_delay_ns_ > 0) {
+  } else if (last_ && last_->stop && resume_delay_ns_ > 0 && !risk_retreat_) {
     if (!clear_since_ns_) clear_since_ns_ = now_ns;
     if (now_ns - *clear_since_ns_ < resume_delay_ns_) {
       if (changed) *changed = false;

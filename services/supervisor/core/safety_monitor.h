@@ -36,12 +36,16 @@ class SafetyMonitor {
   void SetDeadline(const std::string& topic, double seconds);
   void OnDeadlineMissed(const std::string& topic);
   void OnLivelinessLost(const std::string& topic, int alive_writers);
-  /// Collision risk's latest verdict; a protective stop is a cause.
-  void OnRiskVerdict(cell::Verdict verdict, const std::string& reason);
+  /// Collision risk's latest verdict; a protective stop is a cause. A
+  /// `retreating` verdict (the robot moving out of the person's way) resumes
+  /// at once when it clears the last cause: holding it for the resume delay
+  /// would keep the robot where the person is coming.
+  void OnRiskVerdict(cell::Verdict verdict, const std::string& reason, bool retreating = false);
 
   /// The decision at `now_ns`; `changed` is set when it differs from the
   /// last call. After a stop, the cell resumes only once every cause has been
-  /// clear for the resume delay (no stop/resume chatter at a threshold).
+  /// clear for the resume delay (no stop/resume chatter at a threshold),
+  /// or at once for a retreat (OnRiskVerdict).
   SafetyDecision Evaluate(bool* changed, int64_t now_ns = 0);
   /// Seconds every cause must stay clear before resuming (default 0).
   void SetResumeDelay(double seconds) { resume_delay_ns_ = static_cast<int64_t>(seconds * 1e9); }
@@ -53,6 +57,7 @@ class SafetyMonitor {
   std::map<std::string, std::string> causes_;
   std::map<std::string, int64_t> deadline_ns_, last_data_ns_;
   std::string risk_cause_;
+  bool risk_retreat_ = false;
   std::optional<SafetyDecision> last_;
   int64_t resume_delay_ns_ = 0;
   std::optional<int64_t> clear_since_ns_;

@@ -497,6 +497,37 @@ TEST(SafetyMonitor, ResumesOnlyAfterTheCausesStayedClearForTheResumeDelay) {
   EXPECT_TRUE(changed);
 }
 
+TEST(SafetyMonitor, ARetreatResumesAtOnceAndAStopAfterItWaitsAgain) {
+  SafetyMonitor m({"rt/a"});
+  m.SetResumeDelay(0.5);
+  bool changed = false;
+  const int64_t s = 1'000'000'000;
+  m.OnData("rt/a");
+  EXPECT_FALSE(m.Evaluate(&changed, 10 * s).stop);
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "collision bound 1 >= 0.05 in 0.5 s", true);  // a stop is never a retreat
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s).stop);
+  // The trajectory now takes the robot out of the person's way: holding it
+  // for the delay would keep it where they are coming.
+  m.OnRiskVerdict(cell::Verdict::kSlowDown, "retreating from the predicted person", true);
+  SafetyDecision d = m.Evaluate(&changed, 11 * s + s / 30);
+  EXPECT_FALSE(d.stop) << d.reason;
+  EXPECT_TRUE(changed);
+  // Stopped again; a verdict that is clear but no retreat waits the delay.
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "too close");
+  EXPECT_TRUE(m.Evaluate(&changed, 12 * s).stop);
+  m.OnRiskVerdict(cell::Verdict::kOk, "clear");
+  EXPECT_TRUE(m.Evaluate(&changed, 12 * s + s / 10).stop);
+  EXPECT_FALSE(m.Evaluate(&changed, 12 * s + 7 * s / 10).stop);
+  // A retreat does not lift another cause.
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "too close");
+  EXPECT_TRUE(m.Evaluate(&changed, 13 * s).stop);
+  m.OnDeadlineMissed("rt/a");
+  m.OnRiskVerdict(cell::Verdict::kSlowDown, "retreating", true);
+  d = m.Evaluate(&changed, 13 * s + s / 10);
+  EXPECT_TRUE(d.stop);
+  EXPECT_EQ(d.reason, "rt/a: deadline missed");
+}
+
 TEST(SupervisorSettings, TheDocumentedDefaultsAreTheDeclaredOnesAndValid) {
   const std::string doc = std::string(IPLAN_SOURCE_DIR) + "/docs/configuration.md";
   EXPECT_EQ(core::CheckDocumentedDefaults(doc, core::DescribeParams(SupervisorSettings{})), "");

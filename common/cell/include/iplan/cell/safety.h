@@ -21,6 +21,15 @@ struct SafetyParams {
   /// ISO/TS 15066 speed and separation monitoring, as the monitor applies
   /// it and the planner predicts it.
   SsmParams ssm;
+  /// s; the monitor stops for a bound violation within this time (later:
+  /// slows down), and compares a trajectory with standing still over it.
+  double stop_horizon = 1.0;
+  /// A trajectory that lowers the largest bound within stop_horizon by at
+  /// least this much against the robot standing still, where standing still
+  /// would reach 1 - delta_CL, takes the robot out of the person's way: the
+  /// monitor does not stop it (a retreat) and the planner escapes with it
+  /// when no safe plan exists; in [0, 1], 0: off.
+  double bound_retreat_gain = 0.05;
 
   /// Empty when valid, else the reason.
   std::string Validate() const;
@@ -29,6 +38,8 @@ struct SafetyParams {
   void Serialize(Archive* a) {
     a->Visit(IPLAN_NVP(delta_cl, "safe when the bound P_i < 1 - delta_cl, in (0, 1); planner and monitor"));
     a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "ISO/TS 15066 speed and separation monitoring; monitor and planner"));
+    a->Visit(IPLAN_NVP(stop_horizon, "s; a bound violation within it stops, later slows down, >= 0; monitor and planner"));
+    a->Visit(IPLAN_NVP(bound_retreat_gain, "a trajectory lowering the bound within stop_horizon this much against standing still is a retreat, in [0, 1], 0: off; monitor and planner"));
   }
 };
 
