@@ -19,7 +19,17 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
   c.replan_on_prediction = s.replan_on_prediction;
   c.obstacle_timeout = s.obstacle_timeout;
   c.output = s.output;
-  if (s.safety) c.safety_file = config.ResolvePath(*s.safety);
+  if (s.safety) {
+    c.safety_file = config.ResolvePath(*s.safety);
+    // Escaping predicts the monitor's bound retreat: its horizon and gain.
+    try {
+      const cell::SafetyParams safety = cell::LoadSafetyParams(c.safety_file);
+      c.replanner.escape.horizon = safety.stop_horizon;
+      c.replanner.escape.gain = safety.bound_retreat_gain;
+    } catch (const std::exception& e) {
+      config.AddError("safety", e.what());
+    }
+  }
   c.robot_file = config.ResolvePath(s.robot);
   c.human_body_file = config.ResolvePath(s.human_body);
   c.scene_file = config.ResolvePath(s.scene);

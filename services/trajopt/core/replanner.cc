@@ -1,6 +1,7 @@
 #include "replanner.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 #include <stdexcept>
@@ -157,6 +158,7 @@ CycleResult Replanner::Hold(int64_t now_ns, const Eigen::VectorXd& q, const std:
 }
 
 CycleResult Replanner::Cycle(int64_t now_ns) {
+  cycle_start_ = std::chrono::steady_clock::now();
   CycleResult r;
   const int64_t stale = static_cast<int64_t>(params_.stale_after * 1e9);
   if (!q_ || now_ns - q_->first > stale) {
@@ -266,6 +268,12 @@ CycleResult Replanner::StandBy(int64_t now_ns) {
                 : std::isfinite(res.ssm_margin) ? "idle, yielding to the person (predicted margin " +
                                                      std::to_string(res.ssm_margin) + " m)"
                                                 : "idle, returning to where it was left";
+  } else if (std::optional<planning::PlanningResult> escape = Escape(req, res)) {
+    r.positions = escape->positions;
+    r.max_bound = escape->max_bound;
+    r.held_off = true;
+    r.status += "idle, escaping the person's predicted way (bound " + std::to_string(escape->max_bound) +
+                "; no safe trajectory: " + res.reason + ")";
   } else {
     const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);
     const int keep = std::max(1, std::min<int>(req.num_frozen, static_cast<int>(base.cols())));
@@ -313,6 +321,23 @@ std::optional<planning::Goal> Replanner::AsideGoal(const planning::PlanningReque
   if (!std::isfinite(best) || away.norm() < 1e-6) return std::nullopt;
   const Eigen::Quaterniond R_WE(d.X_WL[static_cast<std::size_t>(ee)].rotation());
   return planning::Goal::Pose(p_WE + kAsideDistance * away.normalized(), R_WE);
+}
+
+// Escaping (escape.h): only when standing still is itself unsafe, as the
+// monitor judges it (its stop horizon and bound retreat gain).
+std::optional<planning::PlanningResult> Replanner::Escape(const planning::PlanningRequest& req,
+                                                          const planning::PlanningResult& failed) const {
+  const EscapeParams& e = params_.escape;
+  if (e.horizon <= 0 || e.gain <= 0 || req.people.empty()) return std::nullopt;
+  const double hold = HoldBound(planner_, req, q_->second, e.horizon);
+  if (hold < 1 - planner_.params().delta_cl) return std::nullopt;
+  // What the cycle's budget leaves (the plans before spent the rest).
+  double budget = 0.0;
+  if (params_.cycle_budget > 0) {
+    budget = params_.cycle_budget - std::chrono::duration<double>(std::chrono::steady_clock::now() - cycle_start_).count();
+    if (budget <= 0) return std::nullopt;
+  }
+  return FindEscape(planner_, req, failed, q_->second, hold, e, budget);
 }
 
 // Arrived? At the goal of a task with a retreat, the task goes on to it.
@@ -461,6 +486,15 @@ void Replanner::ApplyPlan(const planning::PlanningRequest& req, const planning::
     } else {
       r->status = prefix + "planned";
     }
+    return;
+  }
+  if (std::optional<planning::PlanningResult> escape = Escape(req, res)) {
+    r->positions = escape->positions;
+    r->max_bound = escape->max_bound;
+    r->held_off = true;
+    t.waiting = true;
+    r->status = prefix + "escaping the person's predicted way (bound " + std::to_string(escape->max_bound) +
+                "; no safe trajectory: " + res.reason + ")";
     return;
   }
   const Eigen::MatrixXd& base = previous_ ? req.warm_start : q_->second.replicate(1, 1);

@@ -13,6 +13,7 @@
 // Cycle() blocks for the planning time.
 #pragma once
 
+#include <chrono>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -23,6 +24,7 @@
 
 #include <Eigen/Core>
 
+#include "core/escape.h"
 #include "core/points_prediction.h"
 #include "iplan/cell/human_points.h"
 #include "iplan/cell/joint_trajectory.h"
@@ -71,6 +73,9 @@ struct ReplannerParams {
   /// The person seen only by the depth camera (points_prediction.h): what
   /// cycles plan against while no fresh skeleton prediction exists.
   PointsPredictionParams human_points;
+  /// Getting out of the person's way when no safe plan exists (escape.h):
+  /// the collision-risk monitor's stop horizon and bound retreat gain.
+  EscapeParams escape;
   /// The keys of section trajopt (config/trajopt.yaml); ranges: Validate().
   template <class Archive>
   void Serialize(Archive* a) {
@@ -192,6 +197,10 @@ class Replanner {
   CycleResult StandBy(int64_t now_ns);
   bool StandsStill(int64_t now_ns) const;
   std::optional<planning::Goal> AsideGoal(const planning::PlanningRequest& req) const;
+  /// When the robot held where it stands would reach the bound within the
+  /// monitor's stop horizon: the escape plan (escape.h), else nullopt.
+  std::optional<planning::PlanningResult> Escape(const planning::PlanningRequest& req,
+                                                 const planning::PlanningResult& failed) const;
   void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
   static std::pair<int64_t, double> PathLag(const cell::JointTrajectory& plan, int64_t stamp_ns, const Eigen::VectorXd& q,
                                             int64_t max_lag_ns);
@@ -225,6 +234,8 @@ class Replanner {
   std::optional<Active> task_;
   // Where the robot was left without a task (it returns there after yielding).
   std::optional<Eigen::VectorXd> park_;
+  // Wall time the running cycle started (its budget: ReplannerParams::cycle_budget).
+  std::chrono::steady_clock::time_point cycle_start_;
   // Previous plan (the trajectory being executed).
   std::optional<std::pair<int64_t, Eigen::MatrixXd>> previous_;
 };
