@@ -173,7 +173,7 @@ class Interaction {
     const collision_risk::RiskReport report = monitor_.Evaluate(kEpochNs + t);
     last_evaluation_ = t;
     const bool risk_stop = report.verdict == collision_risk::Verdict::kProtectiveStop;
-    supervisor_.OnRiskVerdict(report.verdict, report.reason);
+    supervisor_.OnRiskVerdict(report.verdict, report.reason, report.retreating);
     // Both permits: the monitor's own (a stop at once) and the supervisor's
     // (which holds a stop until every cause has been clear for the delay).
     const bool held = supervisor_.Evaluate(nullptr, kEpochNs + t).stop;
@@ -181,7 +181,10 @@ class Interaction {
     if (params_.trace && stop != robot_.stopped()) {
       params_.trace(t * 1e-9, stop ? "STOP: " + (risk_stop ? report.reason : std::string("held by the resume delay"))
                                    : "resume: " + report.reason);
+    } else if (params_.trace && stop && report.reason != last_stop_reason_) {
+      params_.trace(t * 1e-9, "still stopped: " + (risk_stop ? report.reason : std::string("held by the resume delay")));
     }
+    last_stop_reason_ = stop ? (risk_stop ? report.reason : std::string("held")) : std::string();
     if (stop && !robot_.stopped()) {
       robot_.Stop();
       stop_since_ = t;
@@ -226,6 +229,10 @@ class Interaction {
     // still while the person moved into it?
     if (robot_.contacts() > contacts) {
       const bool moving = speed > kMovingContactSpeed;
+      if (params_.trace) {
+        params_.trace(t * 1e-9, std::string("CONTACT with the robot ") + (moving ? "moving" : "at rest") +
+                                    (robot_.stopped() ? " (stopped)" : "") + ", separation " + std::to_string(separation) + " m");
+      }
       if (in_task_) {
         result_.contact_speeds.push_back(speed);
         ++(moving ? result_.robot_moving_contacts : result_.robot_at_rest_contacts);
@@ -404,6 +411,7 @@ class Interaction {
   int64_t finish_ = 0;       // scenario time the run ended
   std::vector<double> pending_times_;  // s, planning cycles while no task ran
   int64_t last_evaluation_ = INT64_MIN / 2, stop_since_ = 0, slow_since_ = 0;
+  std::string last_stop_reason_;  // for the trace: the stop's cause as last traced
   std::vector<Eigen::Vector3d> skeleton_;
   Eigen::Matrix3Xd p_WJ_;
 };
