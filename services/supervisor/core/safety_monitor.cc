@@ -48,9 +48,15 @@ SafetyDecision SafetyMonitor::Evaluate(bool* changed, int64_t now_ns) {
   if (!risk_cause_.empty()) reason += (reason.empty() ? "" : "; ") + risk_cause_;
   d.stop = !reason.empty();
   d.reason = d.stop ? reason : "all inputs healthy";
+  // A retreat resumes at once, but not twice within the delay: a robot
+  // stopped again that soon waits like any other (no stop/go chatter).
+  const bool at_once = risk_retreat_ && stop_since_ns_ - quick_resume_ns_ >= resume_delay_ns_;
   if (d.stop) {
     clear_since_ns_.reset();
-  } else if (last_ && last_->stop && resume_delay_ns_ > 0 && !risk_retreat_) {
+    if (!last_ || !last_->stop) stop_since_ns_ = now_ns;
+  } else if (last_ && last_->stop && resume_delay_ns_ > 0 && at_once) {
+    quick_resume_ns_ = now_ns;
+  } else if (last_ && last_->stop && resume_delay_ns_ > 0) {
     if (!clear_since_ns_) clear_since_ns_ = now_ns;
     if (now_ns - *clear_since_ns_ < resume_delay_ns_) {
       if (changed) *changed = false;

@@ -61,6 +61,8 @@ class SafetyMonitor {
   std::optional<SafetyDecision> last_;
   int64_t resume_delay_ns_ = 0;
   std::optional<int64_t> clear_since_ns_;
+  int64_t stop_since_ns_ = 0;                    // start of the current (or last) stop
+  int64_t quick_resume_ns_ = INT64_MIN / 2;      // last resume at once (a retreat)
 };
 
 }  // namespace iplan::supervisor

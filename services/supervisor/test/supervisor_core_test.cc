@@ -512,6 +512,13 @@ TEST(SafetyMonitor, ARetreatResumesAtOnceAndAStopAfterItWaitsAgain) {
   SafetyDecision d = m.Evaluate(&changed, 11 * s + s / 30);
   EXPECT_FALSE(d.stop) << d.reason;
   EXPECT_TRUE(changed);
+  // Stopped again within the delay: the next retreat waits it (no chatter).
+  m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "collision bound 1 >= 0.05 in 0.3 s");
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 2 * s / 10).stop);
+  m.OnRiskVerdict(cell::Verdict::kSlowDown, "retreating from the predicted person", true);
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 3 * s / 10).stop);
+  EXPECT_TRUE(m.Evaluate(&changed, 11 * s + 7 * s / 10).stop);
+  EXPECT_FALSE(m.Evaluate(&changed, 11 * s + 8 * s / 10).stop);
   // Stopped again; a verdict that is clear but no retreat waits the delay.
   m.OnRiskVerdict(cell::Verdict::kProtectiveStop, "too close");
   EXPECT_TRUE(m.Evaluate(&changed, 12 * s).stop);
