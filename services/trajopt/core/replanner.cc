@@ -328,16 +328,25 @@ std::optional<planning::Goal> Replanner::AsideGoal(const planning::PlanningReque
 std::optional<planning::PlanningResult> Replanner::Escape(const planning::PlanningRequest& req,
                                                           const planning::PlanningResult& failed) const {
   const EscapeParams& e = params_.escape;
-  if (e.horizon <= 0 || e.gain <= 0 || req.people.empty()) return std::nullopt;
-  const double hold = HoldBound(planner_, req, q_->second, e.horizon);
-  if (hold < 1 - planner_.params().delta_cl) return std::nullopt;
+  const std::optional<double> hold = UnsafeHoldBound(req);
+  if (!hold) return std::nullopt;
   // What the cycle's budget leaves (the plans before spent the rest).
   double budget = 0.0;
   if (params_.cycle_budget > 0) {
     budget = params_.cycle_budget - std::chrono::duration<double>(std::chrono::steady_clock::now() - cycle_start_).count();
     if (budget <= 0) return std::nullopt;
   }
-  return FindEscape(planner_, req, failed, q_->second, hold, e, budget);
+  return FindEscape(planner_, req, failed, q_->second, *hold, e, budget);
+}
+
+// The bound of standing still within the escape horizon, when it reaches
+// 1 - delta_CL and escaping is on; else nullopt.
+std::optional<double> Replanner::UnsafeHoldBound(const planning::PlanningRequest& req) const {
+  const EscapeParams& e = params_.escape;
+  if (e.horizon <= 0 || e.gain <= 0 || req.people.empty()) return std::nullopt;
+  const double hold = HoldBound(planner_, req, q_->second, e.horizon);
+  if (hold < 1 - planner_.params().delta_cl) return std::nullopt;
+  return hold;
 }
 
 // Arrived? At the goal of a task with a retreat, the task goes on to it.
@@ -436,6 +445,9 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
     r->prediction_t0_ns = points_stamp_ns_;
   }
   r->num_people = static_cast<int>(req.people.size());
+  // Standing still would reach the bound: half the cycle's budget stays
+  // for an escape, should this plan fail.
+  if (req.time_budget > 0 && UnsafeHoldBound(req)) req.time_budget *= 0.5;
   return req;
 }
 

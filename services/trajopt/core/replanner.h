@@ -201,6 +201,7 @@ class Replanner {
   /// monitor's stop horizon: the escape plan (escape.h), else nullopt.
   std::optional<planning::PlanningResult> Escape(const planning::PlanningRequest& req,
                                                  const planning::PlanningResult& failed) const;
+  std::optional<double> UnsafeHoldBound(const planning::PlanningRequest& req) const;
   void ApplyPlan(const planning::PlanningRequest& req, const planning::PlanningResult& res, CycleResult* r);
   static std::pair<int64_t, double> PathLag(const cell::JointTrajectory& plan, int64_t stamp_ns, const Eigen::VectorXd& q,
                                             int64_t max_lag_ns);
