@@ -142,13 +142,15 @@ class CollisionRiskService : public framework::Service {
       node.SetDiagnosticValue("people", std::to_string(r.num_people) + " seen, " + std::to_string(r.num_predicted) +
                                             " predicted");
     }
-    if (r.verdict != last_verdict_) {
-      node.log().info("verdict {}: {}", ToString(r.verdict), r.reason);
+    if (r.verdict != last_verdict_ || r.retreating != last_retreating_) {
+      node.log().info("verdict {}{}: {}", ToString(r.verdict), r.retreating ? " (retreating)" : "", r.reason);
       last_verdict_ = r.verdict;
+      last_retreating_ = r.retreating;
     }
   }
 
   RiskParams params_;
+  bool last_retreating_ = false;
   double rate_hz_ = 15;
   std::unique_ptr<RiskMonitor> monitor_;
   dds::Writer<msg::CollisionRisk>* writer_ = nullptr;

@@ -253,6 +253,11 @@ class TrajoptService : public framework::Service {
       node.log().debug("{}", r.status);
       last_status_ = r.status;
     }
+    // Escapes are rare and the integrator's question after a near miss.
+    if (const bool escaping = r.status.find("escaping") != std::string::npos; escaping != escaping_) {
+      node.log().info("{}{}", escaping ? "" : "no longer escaping: ", r.status);
+      escaping_ = escaping;
+    }
     node.SetDiagnosticValue("status", r.status);
     if (r.planning_time > 0) node.SetDiagnosticValue("people", std::to_string(r.num_people));
     if (r.budget_exhausted) node.SetDiagnosticValue("budget_exhausted_cycles", std::to_string(++budget_exhausted_));
@@ -260,6 +265,7 @@ class TrajoptService : public framework::Service {
   }
 
   services::TrajectoryOutput output_;
+  bool escaping_ = false;  // the last cycle's plan was an escape (escape.h)
   double planning_step_ = 0.1;  // s
   bool replan_on_prediction_ = true;
   bool active_ = false;
