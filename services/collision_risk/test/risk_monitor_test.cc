@@ -68,6 +68,14 @@ class RiskMonitorTest : public ::testing::Test {
     }
     return p;
   }
+  // A person 1.0 m in front of the robot's hand at ready, walking at it at
+  // 0.8 m/s: seen 0.3 s before t and at t, predicted from t.
+  void WalkAtTheHand(RiskMonitor* m, int64_t t) {
+    const Eigen::Vector3d torso(1.4, 0, 0.55), v(-0.8, 0, 0);
+    ASSERT_EQ(m->UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person(torso - v * 0.3)), std::nullopt);
+    ASSERT_EQ(m->UpdateSkeleton(t, kJoints, Person(torso)), std::nullopt);
+    ASSERT_EQ(m->UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+  }
   RiskMonitor monitor_;
 };
 
@@ -275,11 +283,7 @@ TEST_F(RiskMonitorTest, StopsWhenSeparationIsBelowProtectiveDistance) {
 TEST_F(RiskMonitorTest, PredictionOfContactSoonStopsBeforeSeparationIsViolated) {
   const int64_t t = 100 * kSec;
   RobotAtReady(t);
-  // Person 1.0 m in front of the robot's hand, walking at 0.8 m/s towards it.
-  const Eigen::Vector3d torso(1.4, 0, 0.55), v(-0.8, 0, 0);
-  SeePerson(t - 3 * kSec / 10, torso - v * 0.3);
-  SeePerson(t, torso);
-  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+  WalkAtTheHand(&monitor_, t);
   const RiskReport r = monitor_.Evaluate(t);
   EXPECT_GT(r.separation_margin.value(), 0) << "the separation layer alone would not stop yet";
   EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
@@ -325,11 +329,7 @@ TEST_F(RiskMonitorTest, ExecutingTrajectoryIsWhatIsChecked) {
 TEST_F(RiskMonitorTest, ATrajectoryOutOfThePredictedWayIsARetreatNotAStop) {
   const int64_t t = 100 * kSec;
   RobotAtReady(t);
-  // As above: the person walks at the robot's hand, contact predicted soon.
-  const Eigen::Vector3d torso(1.4, 0, 0.55), v(-0.8, 0, 0);
-  SeePerson(t - 3 * kSec / 10, torso - v * 0.3);
-  SeePerson(t, torso);
-  ASSERT_EQ(monitor_.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+  WalkAtTheHand(&monitor_, t);  // contact predicted soon
   const std::vector<double> ready = {0, -0.785, 0, -2.356, 0, 1.571, 0.785};
   // Turning the arm to the side, out of the person's path, within 0.5 s.
   ASSERT_EQ(monitor_.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, {ready, {1.6, -0.785, 0, -2.356, 0, 1.571, 0.785}}),
@@ -361,9 +361,7 @@ TEST_F(RiskMonitorTest, ATrajectoryOutOfThePredictedWayIsARetreatNotAStop) {
     RiskMonitor m(monitor_.robot(), collision::HumanBodyParams::DefaultUpperBody(), other);
     ASSERT_EQ(m.UpdateRobotState(t, kRobotJoints, ready), std::nullopt);
     ASSERT_EQ(m.UpdateTrajectory(t, kRobotJoints, {0.0, 0.5}, half), std::nullopt);
-    ASSERT_EQ(m.UpdateSkeleton(t - 3 * kSec / 10, kJoints, Person(torso - v * 0.3)), std::nullopt);
-    ASSERT_EQ(m.UpdateSkeleton(t, kJoints, Person(torso)), std::nullopt);
-    ASSERT_EQ(m.UpdatePrediction(Predict(t, torso, v, 15, 1.0 / 15)), std::nullopt);
+    WalkAtTheHand(&m, t);
     const RiskReport r = m.Evaluate(t);
     EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << "gain " << gain << ": " << r.reason;
     EXPECT_FALSE(r.retreating);

@@ -53,46 +53,52 @@ double HorizonBound(const std::vector<double>& bounds, double dt, double horizon
   return worst;
 }
 
+std::optional<AwayFromPerson> FindAwayFromPerson(const planning::Planner& planner, const planning::PlanningRequest& req,
+                                                 const Eigen::VectorXd& q, bool last_step_only) {
+  const collision::RobotModel& robot = planner.robot();
+  const int ee = robot.FindLink(planner.params().end_effector_link);
+  if (ee < 0 || req.people.empty()) return std::nullopt;
+  collision::RobotData d(robot);
+  collision::CalcForwardKinematics(robot, q, &d);
+  const auto& offset = planner.params().end_effector_offset;
+  AwayFromPerson out;
+  out.p_WE = d.X_WL[static_cast<std::size_t>(ee)] * Eigen::Vector3d(offset[0], offset[1], offset[2]);
+  out.R_WE = Eigen::Quaterniond(d.X_WL[static_cast<std::size_t>(ee)].rotation());
+  double best = std::numeric_limits<double>::infinity();
+  Eigen::Vector3d nearest = out.p_WE;
+  for (const planning::PersonPrediction& person : req.people) {
+    const collision::HumanPrediction& hp = *person.spheres;
+    for (int a = 0; a < hp.num_actions(); ++a) {
+      for (int k = last_step_only ? hp.num_steps() - 1 : 0; k < hp.num_steps(); ++k) {
+        for (int l = 0; l < hp.num_spheres(); ++l) {
+          const Eigen::Vector3d& mu = hp.sphere(a, k, l).mean;
+          if ((mu - out.p_WE).norm() < best) {
+            best = (mu - out.p_WE).norm();
+            nearest = mu;
+          }
+        }
+      }
+    }
+  }
+  out.away = out.p_WE - nearest;
+  out.away.z() = 0;
+  return out;
+}
+
 std::vector<Eigen::VectorXd> AsideGoals(const planning::Planner& planner, const planning::PlanningRequest& req,
                                         const Eigen::VectorXd& q, double distance) {
   const collision::RobotModel& robot = planner.robot();
   std::vector<Eigen::VectorXd> goals;
   if (req.people.empty()) return goals;
-  const int ee = robot.FindLink(planner.params().end_effector_link);
-  if (ee >= 0) {
-    collision::RobotData d(robot);
-    collision::CalcForwardKinematics(robot, q, &d);
-    const auto& offset = planner.params().end_effector_offset;
-    const Eigen::Vector3d p_WE = d.X_WL[static_cast<std::size_t>(ee)] * Eigen::Vector3d(offset[0], offset[1], offset[2]);
-    const Eigen::Quaterniond R_WE(d.X_WL[static_cast<std::size_t>(ee)].rotation());
-    // The predicted sphere nearest to the end effector over every step.
-    double best = std::numeric_limits<double>::infinity();
-    Eigen::Vector3d nearest = p_WE;
-    for (const planning::PersonPrediction& person : req.people) {
-      const collision::HumanPrediction& hp = *person.spheres;
-      for (int a = 0; a < hp.num_actions(); ++a) {
-        for (int k = 0; k < hp.num_steps(); ++k) {
-          for (int l = 0; l < hp.num_spheres(); ++l) {
-            const Eigen::Vector3d& mu = hp.sphere(a, k, l).mean;
-            if ((mu - p_WE).norm() < best) {
-              best = (mu - p_WE).norm();
-              nearest = mu;
-            }
-          }
-        }
-      }
-    }
-    Eigen::Vector3d away = p_WE - nearest;
-    away.z() = 0;
+  if (const std::optional<AwayFromPerson> e = FindAwayFromPerson(planner, req, q, false)) {
     const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
-    const Eigen::Vector3d back(-p_WE.x(), -p_WE.y(), 0.0);  // towards the base (W = base frame)
+    const Eigen::Vector3d back(-e->p_WE.x(), -e->p_WE.y(), 0.0);  // towards the base (W = base frame)
     std::vector<Eigen::Vector3d> directions = {up, back};
-    if (away.norm() > 1e-6) directions.insert(directions.begin(), {away.normalized(), away.normalized() + up});
+    if (e->away.norm() > 1e-6) directions.insert(directions.begin(), {e->away.normalized(), e->away.normalized() + up});
     std::uint64_t seed = 1;
     for (const Eigen::Vector3d& direction : directions) {
       if (direction.norm() < 1e-6) continue;
-      const planning::IkResult ik =
-          planner.SolveIk(p_WE + distance * direction.normalized(), R_WE, q, seed++);
+      const planning::IkResult ik = planner.SolveIk(e->p_WE + distance * direction.normalized(), e->R_WE, q, seed++);
       if (ik.success) goals.push_back(ik.q);
     }
   }

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "iplan/planning/planner.h"
 
@@ -40,6 +41,19 @@ double HoldBound(const planning::Planner& planner, const planning::PlanningReque
 /// Largest of `bounds` (PlanningResult::bounds, per waypoint at dt) within
 /// `horizon` s of waypoint 0.
 double HorizonBound(const std::vector<double>& bounds, double dt, double horizon);
+
+/// The end effector (PlannerParams::end_effector_link and offset) at q (rad):
+/// its pose in W and the horizontal vector (m, W, z = 0, not normalised)
+/// from the predicted human sphere nearest to it, over every step of every
+/// action and person, or over each one's last step only. nullopt without
+/// people or an end-effector link.
+struct AwayFromPerson {
+  Eigen::Vector3d p_WE;
+  Eigen::Quaterniond R_WE;
+  Eigen::Vector3d away;
+};
+std::optional<AwayFromPerson> FindAwayFromPerson(const planning::Planner& planner, const planning::PlanningRequest& req,
+                                                 const Eigen::VectorXd& q, bool last_step_only);
 
 /// Joint goals (rad) out of the person's way from q (rad): the end effector,
 /// its orientation kept, `distance` m horizontally away from the predicted

@@ -293,34 +293,10 @@ CycleResult Replanner::StandBy(int64_t now_ns) {
 // direction.
 std::optional<planning::Goal> Replanner::AsideGoal(const planning::PlanningRequest& req) const {
   constexpr double kAsideDistance = 0.25;  // m
-  const collision::RobotModel& robot = planner_.robot();
-  const int ee = robot.FindLink(planner_.params().end_effector_link);
-  if (ee < 0 || req.people.empty()) return std::nullopt;
-  collision::RobotData d(robot);
   const Eigen::VectorXd q = req.warm_start.cols() > 0 ? Eigen::VectorXd(req.warm_start.col(0)) : req.start_q;
-  collision::CalcForwardKinematics(robot, q, &d);
-  const Eigen::Vector3d offset(planner_.params().end_effector_offset[0], planner_.params().end_effector_offset[1],
-                               planner_.params().end_effector_offset[2]);
-  const Eigen::Vector3d p_WE = d.X_WL[static_cast<std::size_t>(ee)] * offset;
-  double best = std::numeric_limits<double>::infinity();
-  Eigen::Vector3d nearest = Eigen::Vector3d::Zero();
-  for (const planning::PersonPrediction& person : req.people) {
-    const collision::HumanPrediction& hp = *person.spheres;
-    for (int a = 0; a < hp.num_actions(); ++a) {
-      for (int l = 0; l < hp.num_spheres(); ++l) {
-        const Eigen::Vector3d& mu = hp.sphere(a, hp.num_steps() - 1, l).mean;
-        if ((mu - p_WE).norm() < best) {
-          best = (mu - p_WE).norm();
-          nearest = mu;
-        }
-      }
-    }
-  }
-  Eigen::Vector3d away = p_WE - nearest;
-  away.z() = 0;
-  if (!std::isfinite(best) || away.norm() < 1e-6) return std::nullopt;
-  const Eigen::Quaterniond R_WE(d.X_WL[static_cast<std::size_t>(ee)].rotation());
-  return planning::Goal::Pose(p_WE + kAsideDistance * away.normalized(), R_WE);
+  const std::optional<AwayFromPerson> e = FindAwayFromPerson(planner_, req, q, true);
+  if (!e || e->away.norm() < 1e-6) return std::nullopt;
+  return planning::Goal::Pose(e->p_WE + kAsideDistance * e->away.normalized(), e->R_WE);
 }
 
 // Escaping (escape.h): only when standing still is itself unsafe, as the
@@ -328,7 +304,7 @@ std::optional<planning::Goal> Replanner::AsideGoal(const planning::PlanningReque
 std::optional<planning::PlanningResult> Replanner::Escape(const planning::PlanningRequest& req,
                                                           const planning::PlanningResult& failed) const {
   const EscapeParams& e = params_.escape;
-  const std::optional<double> hold = UnsafeHoldBound(req);
+  const std::optional<double>& hold = unsafe_hold_;  // of this cycle's request (MakeRequest)
   if (!hold) return std::nullopt;
   // What the cycle's budget leaves (the plans before spent the rest).
   double budget = 0.0;
@@ -447,7 +423,8 @@ planning::PlanningRequest Replanner::MakeRequest(int64_t now_ns, const planning:
   r->num_people = static_cast<int>(req.people.size());
   // Standing still would reach the bound: half the cycle's budget stays
   // for an escape, should this plan fail.
-  if (req.time_budget > 0 && UnsafeHoldBound(req)) req.time_budget *= 0.5;
+  unsafe_hold_ = UnsafeHoldBound(req);
+  if (req.time_budget > 0 && unsafe_hold_) req.time_budget *= 0.5;
   return req;
 }
 

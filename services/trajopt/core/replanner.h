@@ -235,6 +235,9 @@ class Replanner {
   std::optional<Active> task_;
   // Where the robot was left without a task (it returns there after yielding).
   std::optional<Eigen::VectorXd> park_;
+  // The running cycle's bound of standing still, when it reaches 1 - delta_CL
+  // (UnsafeHoldBound of MakeRequest's request; nullopt: safe, or no escaping).
+  std::optional<double> unsafe_hold_;
   // Wall time the running cycle started (its budget: ReplannerParams::cycle_budget).
   std::chrono::steady_clock::time_point cycle_start_;
   // Previous plan (the trajectory being executed).

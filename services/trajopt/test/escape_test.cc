@@ -19,29 +19,12 @@ namespace {
 // steps of 0.1 s from t0, the hand at each step where it will then be.
 collision::JointMixture Sweep(const collision::HumanBodyModel& body, int64_t t0, double elapsed,
                               const Eigen::Vector3d& through) {
-  collision::JointMixture m;
-  m.t0_ns = t0;
-  m.time_step = 0.1;
-  m.num_steps = 15;
-  m.joint_names = body.params().joints;
-  m.actions = {"sweep"};
-  m.probabilities = {1.0};
-  m.means.resize(1);
-  m.covariances.resize(1);
-  for (int k = 0; k < m.num_steps; ++k) {
-    const double s = elapsed + 0.1 * (k + 1);
-    const Eigen::Vector3d hand = through + Eigen::Vector3d(0, -0.9 + 1.2 * s, 0);
-    const Eigen::Vector3d torso = through + Eigen::Vector3d(0.45, 0.0, 0.1);
-    const std::vector<Eigen::Vector3d> joints = {
-        torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.3), torso,
-        torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0), torso + Eigen::Vector3d(-0.2, -0.2, -0.05),
-        torso + Eigen::Vector3d(0, 0.18, 0.25), 0.5 * (hand + torso + Eigen::Vector3d(0, 0.18, 0.25)), hand};
-    for (const auto& j : joints) {
-      m.means[0].push_back(j);
-      m.covariances[0].push_back(0.03 * 0.03 * Eigen::Matrix3d::Identity());
-    }
-  }
-  return m;
+  const Eigen::Vector3d torso = through + Eigen::Vector3d(0.45, 0.0, 0.1);
+  const Eigen::Vector3d shoulder_r = torso + Eigen::Vector3d(0, 0.18, 0.25);
+  return ReplannerTest::Mixture(body, t0, 15, [&](int k) {
+    const Eigen::Vector3d hand = through + Eigen::Vector3d(0, -0.9 + 1.2 * (elapsed + 0.1 * (k + 1)), 0);
+    return ReplannerTest::Body(torso, hand, 0.5 * (hand + shoulder_r));
+  });
 }
 
 TEST_F(ReplannerTest, StandingInTheSweepIsWhatTheBoundForbidsAndAnEscapeLowersIt) {

@@ -48,6 +48,36 @@ class ReplannerTest : public ::testing::Test {
     collision::CalcForwardKinematics(robot, Ready(), &d);
     return d.p_WS.col(static_cast<int>(robot.spheres.size()) - 1);
   }
+  // A one-action prediction of `body` from t0: `num_steps` steps of 0.1 s,
+  // the joints (body order, m, world) of step k from joints_at(k), each with
+  // a 3 cm isotropic standard deviation.
+  static collision::JointMixture Mixture(const collision::HumanBodyModel& body, int64_t t0, int num_steps,
+                                         const std::function<std::vector<Eigen::Vector3d>(int)>& joints_at) {
+    collision::JointMixture m;
+    m.t0_ns = t0;
+    m.time_step = 0.1;
+    m.num_steps = num_steps;
+    m.joint_names = body.params().joints;
+    m.actions = {"stand"};
+    m.probabilities = {1.0};
+    m.means.resize(1);
+    m.covariances.resize(1);
+    for (int k = 0; k < m.num_steps; ++k) {
+      for (const auto& j : joints_at(k)) {
+        m.means[0].push_back(j);
+        m.covariances[0].push_back(0.03 * 0.03 * Eigen::Matrix3d::Identity());
+      }
+    }
+    return m;
+  }
+  // The upper body standing with its torso at `torso` and its right hand at
+  // `hand` (m, world), body joint order.
+  static std::vector<Eigen::Vector3d> Body(const Eigen::Vector3d& torso, const Eigen::Vector3d& hand,
+                                           const Eigen::Vector3d& elbow_r) {
+    return {torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.3), torso,
+            torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0), torso + Eigen::Vector3d(-0.2, -0.2, -0.05),
+            torso + Eigen::Vector3d(0, 0.18, 0.25), elbow_r, hand};
+  }
  protected:
   ReplannerTest()
       : planner_(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
@@ -72,27 +102,8 @@ class ReplannerTest : public ::testing::Test {
   }
   // A person whose right hand is at `hand` (m, world), standing behind it.
   collision::JointMixture PersonAt(int64_t t0, const Eigen::Vector3d& hand) {
-    collision::JointMixture m;
-    m.t0_ns = t0;
-    m.time_step = 0.1;
-    m.num_steps = 10;
-    m.joint_names = body_.params().joints;
-    m.actions = {"stand"};
-    m.probabilities = {1.0};
-    m.means.resize(1);
-    m.covariances.resize(1);
     const Eigen::Vector3d torso = hand + Eigen::Vector3d(0.35, 0.1, 0.1);
-    const std::vector<Eigen::Vector3d> joints = {
-        torso + Eigen::Vector3d(0, 0, 0.48), torso + Eigen::Vector3d(0, 0, 0.3), torso,
-        torso + Eigen::Vector3d(0, -0.18, 0.25), torso + Eigen::Vector3d(-0.1, -0.2, 0), torso + Eigen::Vector3d(-0.2, -0.2, -0.05),
-        torso + Eigen::Vector3d(0, 0.18, 0.25), hand + Eigen::Vector3d(0.15, 0, 0.05), hand};
-    for (int k = 0; k < m.num_steps; ++k) {
-      for (const auto& j : joints) {
-        m.means[0].push_back(j);
-        m.covariances[0].push_back(0.03 * 0.03 * Eigen::Matrix3d::Identity());
-      }
-    }
-    return m;
+    return Mixture(body_, t0, 10, [&](int) { return Body(torso, hand, hand + Eigen::Vector3d(0.15, 0, 0.05)); });
   }
   // Runs cycles every 0.1 s with an ideal robot until an outcome or `max_cycles`.
   std::optional<TaskOutcome> Run(int64_t* t, int max_cycles, const std::function<void(int64_t)>& each = nullptr) {
