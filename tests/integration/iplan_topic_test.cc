@@ -84,12 +84,16 @@ TEST_F(IplanTopic, UnknownTopicWithoutTypeIsAClearError) {
 }
 
 TEST_F(IplanTopic, PubDeliversAMessageToEcho) {
-  auto echo = Tool({"topic", "echo", "/iplan/safety/permit/supervisor", "-n", "1", "--timeout", "20"});
+  auto echo = Tool({"topic", "echo", "/iplan/safety/permit/supervisor", "-n", "1", "--timeout", "40"});
   std::this_thread::sleep_for(1s);
+  // The echo's reader may take seconds to appear beside three other tests
+  // on two cores; the permit topic is volatile, so publish once it has.
   auto pub = Tool({"topic", "pub", "/iplan/safety/permit/supervisor",
-                   R"({"state": 0, "validity": 0.2, "source": "test", "reason": "operator", "seq": 7})", "--stamp-now"});
+                   R"({"state": 0, "validity": 0.2, "source": "test", "reason": "operator", "seq": 7})", "--stamp-now",
+                   "--wait-readers", "20"});
   ASSERT_EQ(pub->Wait(30s), 0) << pub->Stderr();
-  ASSERT_EQ(echo->Wait(30s), 0) << echo->Stderr();
+  EXPECT_EQ(pub->Stderr().find("no reader"), std::string::npos) << pub->Stderr();
+  ASSERT_EQ(echo->Wait(60s), 0) << echo->Stderr();
   const auto j = nlohmann::json::parse(echo->Stdout());
   EXPECT_EQ(j["seq"], 7);
   EXPECT_EQ(j["reason"], "operator");
@@ -97,6 +101,14 @@ TEST_F(IplanTopic, PubDeliversAMessageToEcho) {
   auto bad = Tool({"topic", "pub", "/iplan/safety/permit/supervisor", R"({"stat": 0})"});
   ASSERT_EQ(bad->Wait(30s), 1);
   EXPECT_NE(bad->Stderr().find("unknown field 'stat'"), std::string::npos) << bad->Stderr();
+  // Nobody reads the collision-risk permit here: published, and said so.
+  auto lonely = Tool({"topic", "pub", "/iplan/safety/permit/collision_risk",
+                      R"({"state": 0, "validity": 0.2, "source": "test", "reason": "operator", "seq": 8})",
+                      "--wait-readers", "0.5"});
+  ASSERT_EQ(lonely->Wait(30s), 0) << lonely->Stderr();
+  EXPECT_NE(lonely->Stderr().find("no reader of /iplan/safety/permit/collision_risk matched within 0.5 s"),
+            std::string::npos)
+      << lonely->Stderr();
 }
 
 }  // namespace

@@ -222,7 +222,10 @@ int RunPub(const PubOptions& o) {
   }
   auto p = MakeParticipant(o.dds, "iplan-topic-pub");
   dds::AnyWriter writer(*p, topic, type->dds_name, qos);
-  writer.WaitForReaders(1, Seconds(o.wait_readers));
+  if (!writer.WaitForReaders(1, Seconds(o.wait_readers))) {
+    std::cerr << "iplan topic pub: no reader of " << RosTopicName(topic) << " matched within " << o.wait_readers
+              << " s; publishing anyway (a volatile topic's late readers will not see it; raise --wait-readers)\n";
+  }
   InstallStop();
   const auto period = o.rate > 0 ? Seconds(1.0 / o.rate) : std::chrono::nanoseconds(0);
   auto next = Clock::now();
