@@ -222,7 +222,7 @@ int RunPub(const PubOptions& o) {
   }
   auto p = MakeParticipant(o.dds, "iplan-topic-pub");
   dds::AnyWriter writer(*p, topic, type->dds_name, qos);
-  if (!writer.WaitForReaders(1, Seconds(o.wait_readers))) {
+  if (!writer.WaitForReaders(1, Seconds(o.wait_readers)) && o.count == 1) {
     std::cerr << "iplan topic pub: no reader of " << RosTopicName(topic) << " matched within " << o.wait_readers
               << " s; publishing anyway (a volatile topic's late readers will not see it; raise --wait-readers)\n";
   }
