@@ -41,6 +41,7 @@ std::string List(const std::vector<double>& v) {
 struct Episode {
   std::optional<msg::TaskOutcome> outcome;
   std::vector<std::vector<double>> states;  // executed joint positions after the command (model order)
+  std::string log;                          // the optimiser's log, printed when an expectation fails
 };
 
 collision::RobotModel Panda() {
@@ -54,7 +55,7 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
                "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
   Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
-               "node.entitled_writers./iplan/task/command=[test_cell]"});
+               "node.entitled_writers./iplan/task/command=[test_cell]", "--log-level", "debug"});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
   TestNode cloud("iplan-cloud", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
@@ -103,7 +104,8 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   sim.Signal(SIGTERM);
   EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
   EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
-  if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << opt.Stderr() << "\n";  // the optimiser's log, to debug
+  e.log = opt.Stderr();
+  if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << e.log << "\n";
   return e;
 }
 
@@ -161,12 +163,12 @@ TEST(ObstacleAvoidance, ABoxAppearingOnTheTableIsAvoidedWithNoContact) {
 
   const Episode e = RunEpisode(92, o);
   ASSERT_TRUE(e.outcome.has_value()) << "no outcome";
-  EXPECT_EQ(e.outcome->status, msg::TaskOutcome::SUCCEEDED) << e.outcome->reason;
+  EXPECT_EQ(e.outcome->status, msg::TaskOutcome::SUCCEEDED) << e.outcome->reason << "\n" << e.log;
   ASSERT_GT(e.states.size(), 20u);
   const double distance = MinDistance(robot, box, e.states);
   std::cout << "with the box: " << e.states.size() << " joint states, closest " << distance << " m, duration "
             << e.outcome->duration << " s (free " << free_run.outcome->duration << " s)\n";
-  EXPECT_GE(distance, 0.0);
+  EXPECT_GE(distance, 0.0) << e.log;
 }
 
 }  // namespace

@@ -20,11 +20,17 @@ void PlannerModel::Project(const Problem& at, Eigen::MatrixXd* Q) const {
 void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, Candidate* c) const {
   const Eigen::MatrixXd& Q = c->Q;
   c->static_ok = CheckLimits(robot, Q, at.dt, at.qdot0).empty();
-  double clear = std::numeric_limits<double>::infinity();
   const int sub = params.collision_check_substeps;
   collision::RobotData& d = ws->data[0];
+  const int first = std::max(0, at.k - 1);
+  // A start that is already too close (a box put down against the arm, or
+  // reached by the frozen prefix before the box was seen) cannot be
+  // undone: from there a feasible trajectory may leave but not go deeper.
+  collision::CalcForwardKinematics(robot, Q.col(first), &d);
+  const double floor = std::min(params.min_clearance, Clearance(d, &at.obstacles));
+  double clear = std::numeric_limits<double>::infinity();
   Eigen::VectorXd q(at.nq);
-  for (int i = std::max(0, at.k - 1); i <= at.n && clear >= params.min_clearance; ++i) {
+  for (int i = first; i <= at.n && clear >= floor; ++i) {
     const int count = i < at.n ? sub : 1;
     for (int s = 0; s < count; ++s) {
       q = Q.col(i) + (static_cast<double>(s) / sub) *
@@ -34,7 +40,7 @@ void PlannerModel::Check(const Problem& at, const CostTerms& ev, Workspace* ws, 
     }
   }
   c->min_clearance = clear;
-  c->static_ok = c->static_ok && clear >= params.min_clearance;
+  c->static_ok = c->static_ok && clear >= floor;
   c->bounds.clear();
   c->max_bound = 0.0;
   c->first_unsafe = -1;

@@ -83,6 +83,28 @@ TEST_F(ObstaclesTest, ABoxInThePathOnTheTableIsPlannedAround) {
               std::min(planner_.CalcClearance(g.q), FclDistanceToBox(g.q, box)), 1e-9);
 }
 
+TEST_F(ObstaclesTest, AStartInsideABoxMovesOutWithoutGoingDeeper) {
+  // A box put down under the hand 2 cm into it (or reached by the frozen
+  // prefix before it was seen): the robot may leave it, not stay stuck.
+  const IkResult s = planner_.SolveIk({0.45, -0.1, 0.25}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner_.SolveIk({0.40, 0.30, 0.45}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const double low = 0.1 + planner_.CalcClearance(s.q, {TableBox(0.45, -0.1, {0.12, 0.12, 0.1})});
+  const collision::SceneObject box = TableBox(0.45, -0.1, {0.12, 0.12, low + 0.02});
+  const double start_clearance = planner_.CalcClearance(s.q, {box});
+  ASSERT_NEAR(start_clearance, -0.02, 0.005);
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.obstacles = {box};
+  const PlanningResult r = planner_.Plan(req);
+  ASSERT_TRUE(r.success()) << r.reason;
+  EXPECT_EQ(r.positions.col(0), req.start_q);
+  EXPECT_GE(r.min_clearance, start_clearance - 1e-12);
+  EXPECT_GE(FclDistanceToBox(r.positions, box), start_clearance - 0.005);
+  EXPECT_GE(planner_.CalcClearance(r.positions.col(r.positions.cols() - 1), {box}), 0.0);
+}
+
 TEST_F(ObstaclesTest, AGoalInsideABoxIsReportedAndBadBoxesAreRejected) {
   const IkResult g = planner_.SolveIk({0.45, 0.15, 0.10}, DownOrientation(0.0), Ready(), 1);
   ASSERT_TRUE(g.success);

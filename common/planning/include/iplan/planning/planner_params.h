@@ -78,7 +78,8 @@ struct PlannerParams {
   double initial_perturbation = 0.5;
   /// Static clearance: hinge margin of the obstacle cost (m, >= 0) and the
   /// clearance a feasible trajectory must keep (m) at collision_check_substeps
-  /// linearly interpolated points per interval (>= 1).
+  /// linearly interpolated points per interval (>= 1); from a start closer
+  /// than min_clearance, no closer than the start (it may only move out).
   double obstacle_margin = 0.05;
   double min_clearance = 0.0;
   int collision_check_substeps = 10;
