@@ -10,9 +10,9 @@
 #include <deque>
 #include <optional>
 
-#include "common/cloud_adapters.h"
-#include "core/cloud_stage.h"
-#include "core/cloud_settings.h"
+#include "iplan/adapters/cloud_adapters.h"
+#include "services/cloud/core/cloud_stage.h"
+#include "services/cloud/core/cloud_settings.h"
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"

@@ -7,8 +7,8 @@
 #include <chrono>
 #include <filesystem>
 
-#include "common/adapters.h"
-#include "core/risk_monitor.h"
+#include "iplan/adapters/adapters.h"
+#include "services/collision_risk/core/risk_monitor.h"
 #include "risk_config.h"
 #include "iplan/framework/service.h"
 

@@ -3,7 +3,7 @@
 #include <stdexcept>
 #include <tuple>
 
-#include "iplan/cell/safety.h"
+#include "iplan/safety/safety_params.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service_file.h"
 
@@ -34,12 +34,12 @@ RiskConfig ReadRiskConfig(framework::ConfigSection& config) {
   if (!settings.safety.empty()) {
     c.safety_file = config.ResolvePath(settings.safety);
     try {
-      const cell::SafetyParams safety = cell::LoadSafetyParams(c.safety_file);
+      const safety::SafetyParams safety = safety::LoadSafetyParams(c.safety_file);
       if (config.Has("delta_cl") && p.delta_cl != safety.delta_cl) {
         config.AddError("delta_cl", "disagrees with " + c.safety_file + " (" + core::ParamText(p.delta_cl) + " vs " +
                                         core::ParamText(safety.delta_cl) + "): give it in one place");
       }
-      if (const std::string d = cell::SsmDifference(p.ssm, safety.ssm); config.Has("iso_ts_15066") && !d.empty()) {
+      if (const std::string d = safety::SsmDifference(p.ssm, safety.ssm); config.Has("iso_ts_15066") && !d.empty()) {
         config.AddError("iso_ts_15066", "disagrees with " + c.safety_file + " (" + d + "): give it in one place");
       }
       for (const auto& [key, mine, cell] : {std::tuple{"stop_horizon", p.stop_horizon, safety.stop_horizon},

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "core/risk_monitor.h"
+#include "services/collision_risk/core/risk_monitor.h"
 #include "iplan/framework/config.h"
 
 namespace iplan::collision_risk {

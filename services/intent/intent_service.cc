@@ -14,8 +14,8 @@
 #include <map>
 #include <memory>
 
-#include "core/intent_estimator.h"
-#include "core/intent_settings.h"
+#include "services/intent/core/intent_estimator.h"
+#include "services/intent/core/intent_settings.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 #include "iplan/intent/baseline_predictors.h"

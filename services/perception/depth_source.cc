@@ -5,8 +5,8 @@
 #include <filesystem>
 #include <optional>
 
-#include "common/cloud_adapters.h"
-#include "core/depth_camera.h"
+#include "iplan/adapters/cloud_adapters.h"
+#include "services/perception/core/depth_camera.h"
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"

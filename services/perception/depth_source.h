@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "core/synthetic_person.h"
+#include "services/perception/core/synthetic_person.h"
 #include "perception_settings.h"
 #include "iplan/framework/service.h"
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "core/skeleton_replay.h"
+#include "services/perception/core/skeleton_replay.h"
 #include "depth_source.h"
 #include "iplan/framework/service.h"
 #include "perception_settings.h"

@@ -15,9 +15,9 @@
 #include <string>
 #include <vector>
 
-#include "core/depth_camera.h"
-#include "core/skeleton_replay.h"
-#include "core/synthetic_person.h"
+#include "services/perception/core/depth_camera.h"
+#include "services/perception/core/skeleton_replay.h"
+#include "services/perception/core/synthetic_person.h"
 #include "iplan/cloud/camera.h"
 #include "iplan/cloud/noise.h"
 #include "iplan/core/name_value.h"

@@ -7,9 +7,9 @@
 #include <chrono>
 #include <filesystem>
 
-#include "common/adapters.h"
-#include "core/robot_simulator.h"
-#include "core/robot_sim_settings.h"
+#include "iplan/adapters/adapters.h"
+#include "services/robot_sim/core/robot_simulator.h"
+#include "services/robot_sim/core/robot_sim_settings.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 #include "iplan/safety/permit_gate.h"

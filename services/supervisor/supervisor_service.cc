@@ -10,14 +10,14 @@
 #include <chrono>
 #include <filesystem>
 
-#include "common/adapters.h"
-#include "core/safety_monitor.h"
-#include "core/supervisor_settings.h"
-#include "core/task_goals.h"
-#include "core/task_planner.h"
+#include "iplan/adapters/adapters.h"
+#include "services/supervisor/core/safety_monitor.h"
+#include "services/supervisor/core/supervisor_settings.h"
+#include "services/supervisor/core/task_goals.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
-#include "trajopt_config.h"
+#include "services/trajopt/trajopt_config.h"
 
 namespace iplan::supervisor {
 namespace {

@@ -1,6 +1,6 @@
 #include "trajopt_config.h"
 
-#include "iplan/cell/safety.h"
+#include "iplan/safety/safety_params.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service_file.h"
 #include "iplan/planning/planner_params.h"
@@ -23,7 +23,7 @@ TrajoptConfig ReadTrajoptConfig(framework::ConfigSection& config) {
     c.safety_file = config.ResolvePath(*s.safety);
     // Escaping predicts the monitor's bound retreat: its horizon and gain.
     try {
-      const cell::SafetyParams safety = cell::LoadSafetyParams(c.safety_file);
+      const safety::SafetyParams safety = safety::LoadSafetyParams(c.safety_file);
       c.replanner.escape.horizon = safety.stop_horizon;
       c.replanner.escape.gain = safety.bound_retreat_gain;
     } catch (const std::exception& e) {
@@ -48,7 +48,7 @@ TrajoptConfig LoadTrajoptConfig(const std::string& trajopt_yaml, const std::stri
 planning::PlannerParams LoadPlannerParams(const TrajoptConfig& config) {
   planning::PlannerParams p = planning::LoadPlannerParams(config.planner_file, config.planner_overrides);
   if (config.safety_file.empty()) return p;
-  const cell::SafetyParams safety = cell::LoadSafetyParams(config.safety_file);
+  const safety::SafetyParams safety = safety::LoadSafetyParams(config.safety_file);
   // Given in the planner's file or by an override: it must agree.
   const core::ConfigSection file =
       core::ConfigSection::Load(config.planner_file, core::ConfigSection::EmptyFile::kAllDefaults);
@@ -63,7 +63,7 @@ planning::PlannerParams LoadPlannerParams(const TrajoptConfig& config) {
                             core::ParamText(p.delta_cl) + " vs " + core::ParamText(safety.delta_cl) +
                             "): give it in one place");
   }
-  if (const std::string d = cell::SsmDifference(p.ssm, safety.ssm); given("iso_ts_15066") && !d.empty()) {
+  if (const std::string d = safety::SsmDifference(p.ssm, safety.ssm); given("iso_ts_15066") && !d.empty()) {
     throw core::ConfigError(config.planner_file + ": key 'iso_ts_15066': disagrees with " + config.safety_file + " (" +
                             d + "): give it in one place");
   }

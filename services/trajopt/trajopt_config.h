@@ -8,8 +8,8 @@
 #include <optional>
 #include <string>
 
-#include "common/adapters.h"
-#include "core/replanner.h"
+#include "iplan/adapters/adapters.h"
+#include "services/trajopt/core/replanner.h"
 #include "iplan/core/name_value.h"
 #include "iplan/framework/config.h"
 #include "iplan/planning/planner.h"

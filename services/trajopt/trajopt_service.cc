@@ -7,8 +7,8 @@
 #include <optional>
 #include <stdexcept>
 
-#include "common/adapters.h"
-#include "core/obstacle_set.h"
+#include "iplan/adapters/adapters.h"
+#include "services/trajopt/core/obstacle_set.h"
 #include "iplan/framework/service.h"
 #include "trajopt_config.h"
 

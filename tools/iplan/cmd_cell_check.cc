@@ -21,17 +21,17 @@
 #include <sstream>
 
 #include "command_registry.h"
-#include "perception/core/synthetic_person.h"
-#include "supervisor/core/task_goals.h"
-#include "supervisor/core/task_planner.h"
+#include "services/perception/core/synthetic_person.h"
+#include "services/supervisor/core/task_goals.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/framework/config.h"
 #include "iplan/framework/service.h"
 #include "iplan/framework/service_file.h"
 #include "iplan/planning/planner.h"
-#include "collision_risk/risk_config.h"
-#include "perception/perception_settings.h"
-#include "supervisor/core/supervisor_settings.h"
-#include "trajopt/trajopt_config.h"
+#include "services/collision_risk/risk_config.h"
+#include "services/perception/perception_settings.h"
+#include "services/supervisor/core/supervisor_settings.h"
+#include "services/trajopt/trajopt_config.h"
 
 namespace iplan::cli {
 namespace {

@@ -5,20 +5,20 @@
 #include <map>
 #include <string>
 
-#include "collision_risk/risk_config.h"
-#include "cloud/core/cloud_settings.h"
+#include "services/collision_risk/risk_config.h"
+#include "services/cloud/core/cloud_settings.h"
 #include "command_registry.h"
-#include "intent/core/intent_settings.h"
-#include "robot_sim/core/robot_sim_settings.h"
-#include "supervisor/core/supervisor_settings.h"
-#include "supervisor/core/task_planner.h"
+#include "services/intent/core/intent_settings.h"
+#include "services/robot_sim/core/robot_sim_settings.h"
+#include "services/supervisor/core/supervisor_settings.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/node.h"
-#include "perception/perception_settings.h"
-#include "iplan/cell/safety.h"
+#include "services/perception/perception_settings.h"
+#include "iplan/safety/safety_params.h"
 #include "iplan/planning/planner_params.h"
-#include "trajopt/trajopt_config.h"
+#include "services/trajopt/trajopt_config.h"
 
 namespace {
 
@@ -34,7 +34,7 @@ const std::map<std::string, std::pair<std::string, std::vector<ParamDoc>(*)()>>&
       {"safety",
        {"config/safety.yaml (top level, named by `safety:` in collision_risk.yaml and trajopt.yaml); SafetyParams: "
         "the one source of delta_cl and iso_ts_15066 for monitor, planner, benchmark and cell-check",
-        [] { return iplan::core::DescribeParams(iplan::cell::SafetyParams{}); }}},
+        [] { return iplan::core::DescribeParams(iplan::safety::SafetyParams{}); }}},
       {"intent",
        {"config/intent.yaml, section intent; IntentSettings (IntentEstimatorParams' keys inline)",
         [] { return iplan::core::DescribeParams(iplan::intent_service::IntentSettings{}); }}},

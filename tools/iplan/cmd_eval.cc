@@ -25,9 +25,9 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cell_sim/cell_config.h"
+#include "tools/cell_sim/cell_config.h"
 #include "command_registry.h"
-#include "cell_sim/core/interaction_benchmark.h"
+#include "tools/cell_sim/core/interaction_benchmark.h"
 #include "dds_cell_model.h"
 #include "eval_cell.h"
 #include "eval_common.h"

@@ -16,7 +16,7 @@
 #include <string>
 #include <vector>
 
-#include "cell_sim/core/cell_benchmark.h"
+#include "tools/cell_sim/core/cell_benchmark.h"
 #include "command_registry.h"
 #include "dds_cell_model.h"
 #include "eval_cell.h"

@@ -5,14 +5,14 @@
 #include <fstream>
 #include <sstream>
 
-#include "intent/core/intent_settings.h"
-#include "perception/core/synthetic_person.h"
+#include "services/intent/core/intent_settings.h"
+#include "services/perception/core/synthetic_person.h"
 #include "iplan/core/params.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/framework/service_file.h"
 #include "iplan/intent/intent_model.h"
 #include "iplan/intent/model_io.h"
-#include "perception/perception_settings.h"
+#include "services/perception/perception_settings.h"
 
 namespace iplan::cli {
 namespace {

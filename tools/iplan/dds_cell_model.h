@@ -6,7 +6,7 @@
 #include <cstdint>
 #include <string>
 
-#include "perception/core/synthetic_person.h"
+#include "services/perception/core/synthetic_person.h"
 #include "iplan/intent/skeleton_data.h"
 
 namespace iplan::cli {

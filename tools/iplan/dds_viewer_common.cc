@@ -6,7 +6,7 @@
 #include <stdexcept>
 
 #include "iplan/framework/service_file.h"
-#include "trajopt/trajopt_config.h"
+#include "services/trajopt/trajopt_config.h"
 
 namespace iplan::cli {
 

@@ -18,8 +18,8 @@
 
 #include <nlohmann/json.hpp>
 
-#include "cell_sim/cell_config.h"
-#include "cell_sim/core/interaction_benchmark.h"
+#include "tools/cell_sim/cell_config.h"
+#include "tools/cell_sim/core/interaction_benchmark.h"
 #include "dds_cell_model.h"
 #include "iplan/framework/service.h"
 #include "iplan/intent/model_io.h"

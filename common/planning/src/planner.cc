@@ -206,7 +206,7 @@ void DescribeFailure(const PlannerModel& M, const Problem& at, const Candidate& 
       s << "no trajectory kept the bound below " << M.Threshold() << " after " << result->num_waits
         << " waits; best max bound " << best.max_bound;
     } else {
-      const cell::SsmPair& v = best.ssm.violation;
+      const safety::SsmPair& v = best.ssm.violation;
       s << "the separation monitor would stop every trajectory after " << result->num_waits
         << " waits; best: separation " << v.separation << " m below S_p " << v.protective_separation << " + "
         << at.ssm_margin << " m (v_h " << v.v_h << ", v_r " << v.v_r << " m/s) at waypoint "

@@ -27,7 +27,7 @@
 #include <Eigen/Core>
 
 #include "clearance.h"
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/scene.h"
 #include "iplan/collision/trajectory_bound.h"
@@ -108,14 +108,14 @@ struct SsmVisit {
 struct SsmNearPair {
   SsmVisit at;
   Eigen::Vector3d delta;  // robot - human sphere centre (m, W)
-  cell::SsmPair pair;
+  safety::SsmPair pair;
 };
 
 /// Scratch space of one thread.
 struct Workspace {
   std::vector<SsmNearPair> ssm_near;         // AddSsmCost's pairs
   std::vector<std::uint64_t> ssm_actions;    // [waypoint * persons + person]: their actions (bits)
-  std::vector<cell::SsmPair> ssm_tightest;   // JudgeSsm: the tightest violating pair there
+  std::vector<safety::SsmPair> ssm_tightest;   // JudgeSsm: the tightest violating pair there
   std::vector<collision::RobotData> data;
   std::unique_ptr<collision::TrajectoryBoundWorkspace> bound_ws;
   Eigen::MatrixXd A, V, G;
@@ -135,7 +135,7 @@ struct Workspace {
 struct SsmJudgement {
   double min_margin = std::numeric_limits<double>::infinity();  // m, smallest d - S_p of the non-retreating pairs
   int first_violation = -1;  // first waypoint with a pair below ssm_margin, -1: none
-  cell::SsmPair violation;   // its tightest pair
+  safety::SsmPair violation;   // its tightest pair
   double stop_probability = 0.0;  // of the actions stopped there
   bool ok() const { return first_violation < 0; }
 };
@@ -251,7 +251,7 @@ struct PlannerModel {
   // Called per sphere pair near enough to matter (margin < ssm_activation):
   // where it is, delta (robot - human centre, m) and the pair rule's
   // result; returns false to stop.
-  using SsmPairVisitor = std::function<bool(const SsmVisit& at, const Eigen::Vector3d& delta, const cell::SsmPair& pair)>;
+  using SsmPairVisitor = std::function<bool(const SsmVisit& at, const Eigen::Vector3d& delta, const safety::SsmPair& pair)>;
   // Waypoints [from, to] with the FK in data[from .. min(to + 1, n)].
   void VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
                      const SsmPairVisitor& visit) const;

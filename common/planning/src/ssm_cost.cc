@@ -1,5 +1,5 @@
 // Predicting the separation monitor (PlannerParams::predict_ssm): the
-// monitor's ISO/TS 15066 pair rule (cell::SsmPairRule, the same function the
+// monitor's ISO/TS 15066 pair rule (safety::SsmPairRule, the same function the
 // collision-risk monitor applies) evaluated along a plan against the
 // predicted person.
 //
@@ -28,7 +28,7 @@
 #include <cstdint>
 #include <limits>
 
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "planner_model.h"
 
 namespace iplan::planning::internal {
@@ -39,8 +39,8 @@ constexpr double kRetreatFactor = 2.0;
 // Actions less likely than this are not judged (nor cost anything).
 constexpr double kMinProbability = 0.05;
 
-// dS_p / dv_r of cell::ProtectiveSeparationDistance at v_r (directed).
-double ProtectiveSeparationSlope(const cell::SsmParams& s, double v_r) {
+// dS_p / dv_r of safety::ProtectiveSeparationDistance at v_r (directed).
+double ProtectiveSeparationSlope(const safety::SsmParams& s, double v_r) {
   double slope = s.reaction_time;
   if (!s.directed || v_r < s.stopping_speed) slope += s.directed ? s.stopping_distance / s.stopping_speed : 0.0;
   return slope;
@@ -64,7 +64,7 @@ int PlannerModel::SsmLastWaypoint(const Problem& at) const {
 
 void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
                                  const SsmPairVisitor& visit) const {
-  const cell::SsmParams& s = params.ssm;
+  const safety::SsmParams& s = params.ssm;
   const double reach = at.ssm_activation;
   const int S = static_cast<int>(radii.size());
   Eigen::Matrix3Xd v_robot(3, S);
@@ -90,14 +90,14 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
           // Any pair of this group and sphere l: S_p is at most that of the
           // fastest robot sphere and the fastest action's mean speed.
           const double far = (c - sm.centre).norm() - sm.spread - cover - hp.radius(l);
-          if (far >= reach + cell::ProtectiveSeparationDistance(s, 0.0, v_r_max)) {
+          if (far >= reach + safety::ProtectiveSeparationDistance(s, 0.0, v_r_max)) {
             double v_h_max = 0.0;
             if (t_next > t_prev) {
               for (int a = 0; a < hp.num_actions(); ++a)
                 v_h_max = std::max(v_h_max, (hp.sphere(a, t_next, l).mean - hp.sphere(a, t_prev, l).mean).norm());
               v_h_max /= person.dt * (t_next - t_prev);
             }
-            if (far >= reach + cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max)) continue;
+            if (far >= reach + safety::ProtectiveSeparationDistance(s, v_h_max, v_r_max)) continue;
           }
           for (int a = 0; a < hp.num_actions(); ++a) {
             const double pa = hp.action_probability(a);
@@ -109,7 +109,7 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
                                 : Eigen::Vector3d::Zero();
             for (int sp : link_groups[g]) {
               const Eigen::Vector3d delta = d.p_WS.col(sp) - mu;
-              const cell::SsmPair pair = cell::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_h, v_robot.col(sp));
+              const safety::SsmPair pair = safety::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_h, v_robot.col(sp));
               if (pair.margin >= reach) continue;
               const double away = delta.norm() > 1e-9 ? v_robot.col(sp).dot(delta.normalized()) : 0.0;
               const bool retreat = s.retreat_speed > 0 && away >= kRetreatFactor * s.retreat_speed;
@@ -126,7 +126,7 @@ void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, E
   const int last = std::min(SsmLastWaypoint(at), at.n - 1);
   if (last < at.k) return;
   const double w = params.weights.ssm, act = at.ssm_activation;
-  const cell::SsmParams& s = params.ssm;
+  const safety::SsmParams& s = params.ssm;
   // The pairs within the activation band (not retreating), and per waypoint
   // and person the actions they belong to: only where those actions are
   // likely enough to stop the plan (ssm_stop_probability) do they cost, so
@@ -135,7 +135,7 @@ void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, E
   std::vector<SsmNearPair>& near = ws->ssm_near;
   near.clear();
   ws->ssm_actions.assign(static_cast<std::size_t>(at.n + 1) * P, 0);
-  VisitSsmPairs(at, ws->data, at.k, last, [&](const SsmVisit& v, const Eigen::Vector3d& delta, const cell::SsmPair& pair) {
+  VisitSsmPairs(at, ws->data, at.k, last, [&](const SsmVisit& v, const Eigen::Vector3d& delta, const safety::SsmPair& pair) {
     if (v.retreat || v.action >= 64) return true;
     near.push_back({v, delta, pair});
     ws->ssm_actions[static_cast<std::size_t>(v.waypoint) * P + static_cast<std::size_t>(v.person)] |= std::uint64_t{1}
@@ -181,9 +181,9 @@ SsmJudgement PlannerModel::JudgeSsm(const Problem& at, const Eigen::MatrixXd& Q,
   const std::size_t P = at.people.size();
   std::vector<std::uint64_t>& stopped = ws->ssm_actions;
   stopped.assign(static_cast<std::size_t>(last + 1) * P, 0);
-  std::vector<cell::SsmPair>& tightest = ws->ssm_tightest;
+  std::vector<safety::SsmPair>& tightest = ws->ssm_tightest;
   tightest.resize(stopped.size());
-  VisitSsmPairs(at, data, from, last, [&](const SsmVisit& v, const Eigen::Vector3d&, const cell::SsmPair& pair) {
+  VisitSsmPairs(at, data, from, last, [&](const SsmVisit& v, const Eigen::Vector3d&, const safety::SsmPair& pair) {
     if (v.retreat) return true;
     if (v.probability >= kSeparationMinProbability) j.min_margin = std::min(j.min_margin, pair.margin);
     if (pair.margin < at.ssm_margin && v.action < 64) {

@@ -1,6 +1,6 @@
 // The planner predicts the separation monitor (PlannerParams::predict_ssm):
 // plans are checked here against the monitor's ISO/TS 15066 pair rule
-// (cell::SsmPairRule) waypoint by waypoint, independently of the planner's
+// (safety::SsmPairRule) waypoint by waypoint, independently of the planner's
 // own bookkeeping.
 #include <algorithm>
 #include <cmath>
@@ -8,7 +8,7 @@
 
 #include <gtest/gtest.h>
 
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/planning/planner.h"
 #include "test_util.h"
 
@@ -32,7 +32,7 @@ collision::HumanPrediction Hand(int steps, F at, double probability = 1.0) {
 // against the hand (action 0) whose step k is at waypoint k; pairs whose
 // robot sphere moves away at `retreat` m/s or faster are left out.
 double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& Q, double dt,
-                     const collision::HumanPrediction& hand, const cell::SsmParams& ssm, int last, double retreat) {
+                     const collision::HumanPrediction& hand, const safety::SsmParams& ssm, int last, double retreat) {
   double worst = std::numeric_limits<double>::infinity();
   collision::RobotData d0(robot), d1(robot);
   for (int i = 1; i <= std::min<int>(last, static_cast<int>(Q.cols()) - 1); ++i) {
@@ -45,7 +45,7 @@ double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& 
       const Eigen::Vector3d delta = d0.p_WS.col(s) - mu;
       const Eigen::Vector3d v_r = (d1.p_WS.col(s) - d0.p_WS.col(s)) / dt;
       if (v_r.dot(delta.normalized()) >= retreat) continue;
-      const cell::SsmPair pair = cell::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h, v_r);
+      const safety::SsmPair pair = safety::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h, v_r);
       worst = std::min(worst, pair.margin);
     }
   }

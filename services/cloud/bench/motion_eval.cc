@@ -27,14 +27,14 @@
 #include <cstdlib>
 #include <vector>
 
-#include "core/cloud_settings.h"
-#include "core/cloud_stage.h"
-#include "core/depth_camera.h"
+#include "services/cloud/core/cloud_settings.h"
+#include "services/cloud/core/cloud_stage.h"
+#include "services/perception/core/depth_camera.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/scene.h"
 #include "iplan/core/stats.h"
 #include "iplan/framework/service_file.h"
-#include "perception_settings.h"
+#include "services/perception/perception_settings.h"
 
 namespace {
 

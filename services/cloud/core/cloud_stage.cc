@@ -1,4 +1,4 @@
-#include "core/cloud_stage.h"
+#include "services/cloud/core/cloud_stage.h"
 
 #include <cmath>
 #include <limits>

@@ -18,8 +18,8 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
-#include "core/cluster_tracker.h"
-#include "core/point_motion.h"
+#include "services/cloud/core/cluster_tracker.h"
+#include "services/cloud/core/point_motion.h"
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/noise.h"
 #include "iplan/cloud/pipeline.h"

@@ -1,4 +1,4 @@
-#include "core/cluster_tracker.h"
+#include "services/cloud/core/cluster_tracker.h"
 
 #include <algorithm>
 #include <cmath>

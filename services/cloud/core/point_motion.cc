@@ -1,4 +1,4 @@
-#include "core/point_motion.h"
+#include "services/cloud/core/point_motion.h"
 
 #include <algorithm>
 #include <cmath>

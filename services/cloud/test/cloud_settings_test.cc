@@ -1,6 +1,6 @@
 // Section cloud read from its declaration (CloudSettings): the documented
 // defaults, the cell's own file, bad values named with the file.
-#include "core/cloud_settings.h"
+#include "services/cloud/core/cloud_settings.h"
 
 #include <fstream>
 

@@ -10,8 +10,8 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "core/cloud_stage.h"
-#include "core/depth_camera.h"
+#include "services/cloud/core/cloud_stage.h"
+#include "services/perception/core/depth_camera.h"
 #include "iplan/cloud/camera.h"
 
 namespace iplan::cloud_service {

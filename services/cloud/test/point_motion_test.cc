@@ -13,7 +13,7 @@
 
 #include <Eigen/Eigenvalues>
 
-#include "core/point_motion.h"
+#include "services/cloud/core/point_motion.h"
 
 namespace iplan::cloud_service {
 namespace {

@@ -28,7 +28,7 @@ std::string PointsParams::Validate() const {
 
 PointsSeparation EvaluatePointsSeparation(const collision::GaussianPoints& points, const cell::HumanPoints& seen,
                                           const Eigen::Matrix3Xd& p_WS, const std::vector<double>& radii,
-                                          const Eigen::Matrix3Xd& v_WS, const cell::SsmParams& s,
+                                          const Eigen::Matrix3Xd& v_WS, const safety::SsmParams& s,
                                           double speed_sigmas) {
   PointsSeparation out;
   if (points.empty()) return out;
@@ -57,7 +57,7 @@ PointsSeparation EvaluatePointsSeparation(const collision::GaussianPoints& point
     for (std::size_t bi = 0; bi < points.blocks().size(); ++bi) {
       const collision::GaussianPoints::Block& blk = points.blocks()[bi];
       const double lower = (b - blk.centre).norm() - blk.radius - r;
-      const double sp_max = cell::ProtectiveSeparationDistance(s, block_speed[bi], v_k);
+      const double sp_max = safety::ProtectiveSeparationDistance(s, block_speed[bi], v_k);
       const bool outside = lower - v_k * s.speed_reduction_time >= sp_max;  // every pair: scales 1, no violation
       if (outside && lower >= best && lower - sp_max >= best_margin) continue;
       for (int l = blk.begin; l < blk.end; ++l) {
@@ -67,21 +67,21 @@ PointsSeparation EvaluatePointsSeparation(const collision::GaussianPoints& point
         const double centres = delta.norm();
         const double d = centres - r;
         const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
-        cell::SsmPair pair;
+        safety::SsmPair pair;
         if (s.directed) {
           // Coincident centres (u = 0) give S_p > 0 > d: a stop whatever the speeds.
           const Eigen::Vector3d v_h =
               m ? Eigen::Vector3d(m->velocity + speed_sigmas * std::sqrt(std::max(0.0, u.dot(m->covariance * u))) * u)
                 : Eigen::Vector3d(s.default_human_speed * u);
-          pair = cell::SsmPairRule(s, delta, r, v_h, v_WS.col(k));
+          pair = safety::SsmPairRule(s, delta, r, v_h, v_WS.col(k));
         } else {
           pair.separation = d;
           pair.v_h = speed_bound(input);
           pair.v_r = v_r_max;
-          pair.protective_separation = cell::ProtectiveSeparationDistance(s, pair.v_h, pair.v_r);
+          pair.protective_separation = safety::ProtectiveSeparationDistance(s, pair.v_h, pair.v_r);
           pair.margin = d - pair.protective_separation;
-          pair.stop_scale = cell::SpeedScaleFor(s, d, pair.v_h, pair.v_r);
-          pair.slow_scale = cell::SpeedScaleFor(s, d - pair.v_r * s.speed_reduction_time, pair.v_h, pair.v_r);
+          pair.stop_scale = safety::SpeedScaleFor(s, d, pair.v_h, pair.v_r);
+          pair.slow_scale = safety::SpeedScaleFor(s, d - pair.v_r * s.speed_reduction_time, pair.v_h, pair.v_r);
         }
         out.slow_scale = std::min(out.slow_scale, pair.slow_scale);
         out.stop_scale = std::min(out.stop_scale, pair.stop_scale);

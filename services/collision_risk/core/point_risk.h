@@ -6,7 +6,7 @@
 //
 // Separation: S is the surface distance from a robot sphere to a point's
 // sphere (radius r_p, around the point's mean); each pair is judged by the
-// monitor's pair rule (cell::SsmPairRule: S_p, retreat, speed reduction).
+// monitor's pair rule (safety::SsmPairRule: S_p, retreat, speed reduction).
 // v_h, the point's speed towards the robot sphere along the unit vector u
 // from the point to the sphere: for a point of a tracked part (the cloud
 // service's motion estimate, velocity v with covariance C)
@@ -30,7 +30,7 @@
 #include <Eigen/Core>
 
 #include "iplan/cell/human_points.h"
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/collision/point_bound.h"
 #include "iplan/core/name_value.h"
 
@@ -79,7 +79,7 @@ struct PointsSeparation {
   int binding_point = -1;           ///< input index of the binding point
   bool binding_tracked = false;     ///< the binding point's speed was measured
   bool retreating = false;          ///< the binding pair is inside S_p, its robot sphere moving away (margin 0)
-  /// Speed reduction (cell::SsmPair): the smallest slow and stop scales over the pairs.
+  /// Speed reduction (safety::SsmPair): the smallest slow and stop scales over the pairs.
   double slow_scale = 1.0, stop_scale = 1.0;
   double margin() const { return retreating ? 0.0 : binding_separation - protective_separation; }
 };
@@ -90,7 +90,7 @@ struct PointsSeparation {
 /// bound per block).
 PointsSeparation EvaluatePointsSeparation(const collision::GaussianPoints& points, const cell::HumanPoints& seen,
                                           const Eigen::Matrix3Xd& p_WS, const std::vector<double>& radii,
-                                          const Eigen::Matrix3Xd& v_WS, const cell::SsmParams& ssm,
+                                          const Eigen::Matrix3Xd& v_WS, const safety::SsmParams& ssm,
                                           double speed_sigmas);
 
 }  // namespace iplan::collision_risk

@@ -186,7 +186,7 @@ void RiskMonitor::EvaluateSeparation(int64_t now_ns, const Inputs& in, RiskRepor
   // Undirected speeds of nobody (what is reported when nobody is seen).
   r.human_speed = s.default_human_speed;
   r.robot_speed = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
-  r.protective_separation = cell::ProtectiveSeparationDistance(s, r.human_speed, r.robot_speed);
+  r.protective_separation = safety::ProtectiveSeparationDistance(s, r.human_speed, r.robot_speed);
   if (!in.person) return;
   collision::CalcForwardKinematics(robot_, state_->second, &data_);
   SeparationSearch search;
@@ -226,7 +226,7 @@ void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure,
   const bool measured = may_measure && MeasuredJointVelocities(history, &v_joints);
   const double v_h_max = measured ? v_joints.colwise().norm().maxCoeff() : s.default_human_speed;
   const double v_r_max = v_robot.cols() > 0 ? v_robot.colwise().norm().maxCoeff() : 0.0;
-  const double sp_undirected = cell::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
+  const double sp_undirected = safety::ProtectiveSeparationDistance(s, v_h_max, v_r_max);
   const Eigen::Matrix3Xd& joints = history.back().second;
   SeparationSearch& f = *search;
   for (int h = 0; h < body_.num_spheres(); ++h) {
@@ -240,14 +240,14 @@ void RiskMonitor::SearchPerson(const SkeletonHistory& history, bool may_measure,
       const double d = centres - robot_spheres[k].radius - human_radius;
       double v_h = v_h_max, v_r = v_r_max, sp = sp_undirected, margin = d - sp_undirected;
       bool retreating = false;
-      double slow_scale = cell::SpeedScaleFor(s, d - v_r_max * s.speed_reduction_time, v_h_max, v_r_max);
-      double stop_scale = cell::SpeedScaleFor(s, d, v_h_max, v_r_max);
+      double slow_scale = safety::SpeedScaleFor(s, d - v_r_max * s.speed_reduction_time, v_h_max, v_r_max);
+      double stop_scale = safety::SpeedScaleFor(s, d, v_h_max, v_r_max);
       if (s.directed) {
-        // The pair rule the planner predicts (cell::SsmPairRule). Without a
+        // The pair rule the planner predicts (safety::SsmPairRule). Without a
         // measured speed the person comes at the default speed, straight
         // at the robot sphere.
         const Eigen::Vector3d u = centres > 1e-9 ? Eigen::Vector3d(delta / centres) : Eigen::Vector3d::Zero();
-        const cell::SsmPair pair = cell::SsmPairRule(s, delta, robot_spheres[k].radius + human_radius,
+        const safety::SsmPair pair = safety::SsmPairRule(s, delta, robot_spheres[k].radius + human_radius,
                                                      measured ? v_c : Eigen::Vector3d(s.default_human_speed * u),
                                                      v_robot.col(ki));
         v_h = pair.v_h;
@@ -435,7 +435,7 @@ void RiskMonitor::DecideVerdict(int64_t now_ns, const Inputs& in, RiskReport* ou
                              r.hold_bound - r.horizon_bound >= params_.bound_retreat_gain;
   // Inside S_p at the trajectory's speed, but not at min_speed_scale of it:
   // the robot is slowed down, not stopped (ISO/TS 15066 speed reduction).
-  const cell::SsmParams& s = params_.ssm;
+  const safety::SsmParams& s = params_.ssm;
   const bool reducible = s.speed_reduction && r.stop_scale >= s.min_speed_scale;
   if (!seen && params_.person_required) {
     r.verdict = Verdict::kProtectiveStop;

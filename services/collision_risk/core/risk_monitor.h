@@ -21,7 +21,7 @@
 // Retreat (SsmParams::retreat_speed): a pair inside S_p whose robot sphere
 // moves away from the human sphere at retreat_speed or faster does not stop
 // the robot (it binds with margin 0: SLOW_DOWN, "retreating"); the planner
-// predicts the same rule (cell::SsmPairRule), so that a robot in the
+// predicts the same rule (safety::SsmPairRule), so that a robot in the
 // person's way can get out of it.
 // Verdict: PROTECTIVE_STOP when the separation is below S_p, or the bound
 // reaches 1 - delta_CL within the stop horizon, or the robot state is
@@ -59,7 +59,7 @@
 
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/cell/people.h"
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/cell/status.h"
 #include "iplan/cell/timed_prediction.h"
 #include "iplan/collision/human_model.h"
@@ -71,7 +71,7 @@
 namespace iplan::collision_risk {
 
 /// ISO/TS 15066 speed and separation monitoring parameters (iplan/cell/ssm.h).
-using SsmParams = cell::SsmParams;
+using SsmParams = safety::SsmParams;
 
 struct RiskParams {
   double delta_cl = 0.95;          ///< a waypoint is safe when its bound < 1 - delta_cl
@@ -131,15 +131,15 @@ struct RiskReport {
   cell::BodyId max_body_id = 0;          ///< person of the largest share of max_bound (0: none)
   int num_people = 0;                    ///< persons with a fresh skeleton
   int num_predicted = 0;                 ///< persons with a fresh prediction (terms of the union bound)
-  cell::Separation min_separation;       ///< m; nullopt when no person is seen
+  safety::Separation min_separation;       ///< m; nullopt when no person is seen
   std::string separation_robot_link, separation_human_segment;
   double protective_separation = 0;      ///< m, S_p of the binding pair (smallest separation - S_p)
   double human_speed = 0;                ///< m/s used for that S_p (towards the robot when directed)
   double robot_speed = 0;                ///< m/s used for that S_p (towards the person when directed)
-  cell::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
-  cell::Separation separation_margin;    ///< m, binding_separation - protective_separation (0 for a retreat); < 0 stops
+  safety::Separation binding_separation;   ///< m, separation of the binding pair; nullopt when no person is seen
+  safety::Separation separation_margin;    ///< m, binding_separation - protective_separation (0 for a retreat); < 0 stops
   /// A retreat, not a stop: the binding pair is inside S_p, its robot
-  /// sphere moving away (cell::SsmPair), or the trajectory lowers the bound
+  /// sphere moving away (safety::SsmPair), or the trajectory lowers the bound
   /// within the stop horizon against standing still (bound_retreat_gain).
   /// A supervisor resumes a retreat at once (no resume delay).
   bool retreating = false;

@@ -1,7 +1,7 @@
 // The risk monitor's verdicts from each layer, its ISO/TS 15066 arithmetic,
 // and its refusal of inputs it cannot map.
-#include "core/risk_monitor.h"
-#include "risk_config.h"
+#include "services/collision_risk/core/risk_monitor.h"
+#include "services/collision_risk/risk_config.h"
 
 #include <gtest/gtest.h>
 
@@ -209,7 +209,7 @@ TEST_F(RiskMonitorTest, StoppedRobotBesideAStillPersonMayMoveAwayButNotCloser) {
   EXPECT_EQ(closer.reason.rfind("speed reduced to ", 0), 0u) << closer.reason;
   EXPECT_GE(closer.speed_scale, monitor_.params().ssm.min_speed_scale);
   EXPECT_LT(closer.speed_scale, 1.0);
-  EXPECT_LE(cell::ProtectiveSeparationDistance(monitor_.params().ssm, closer.human_speed,
+  EXPECT_LE(safety::ProtectiveSeparationDistance(monitor_.params().ssm, closer.human_speed,
                                                closer.speed_scale * closer.robot_speed),
             closer.binding_separation.value() -
                 closer.robot_speed * monitor_.params().ssm.speed_reduction_time + 1e-9);

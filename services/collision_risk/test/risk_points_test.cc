@@ -5,7 +5,7 @@
 
 #include <iostream>
 
-#include "core/risk_monitor.h"
+#include "services/collision_risk/core/risk_monitor.h"
 
 namespace iplan::collision_risk {
 namespace {
@@ -223,7 +223,7 @@ TEST(PointsSeparation, ATrackedPointLetsTheRobotSlowDownAnUntrackedOneStopsIt) {
   const Eigen::Matrix3Xd p_WS = Eigen::Matrix3Xd::Zero(3, 1);
   Eigen::Matrix3Xd v_WS(3, 1);
   v_WS.col(0) = Eigen::Vector3d(0.5, 0, 0);
-  const cell::SsmParams ssm;
+  const safety::SsmParams ssm;
   cell::HumanPoints tracked = seen;
   tracked.motion_of = {0};
   tracked.motions.push_back({Eigen::Vector3d::Zero(), 1e-4 * Eigen::Matrix3d::Identity()});

@@ -1,4 +1,4 @@
-#include "core/intent_estimator.h"
+#include "services/intent/core/intent_estimator.h"
 
 #include <cmath>
 #include <stdexcept>

@@ -1,4 +1,4 @@
-#include "core/depth_camera.h"
+#include "services/perception/core/depth_camera.h"
 
 #include <algorithm>
 #include <cmath>

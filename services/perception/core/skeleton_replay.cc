@@ -1,4 +1,4 @@
-#include "core/skeleton_replay.h"
+#include "services/perception/core/skeleton_replay.h"
 
 #include <algorithm>
 #include <cmath>

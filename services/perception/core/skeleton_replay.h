@@ -15,7 +15,7 @@
 
 #include <Eigen/Geometry>
 
-#include "core/synthetic_person.h"
+#include "services/perception/core/synthetic_person.h"
 #include "iplan/intent/skeleton_data.h"
 
 namespace iplan::perception {

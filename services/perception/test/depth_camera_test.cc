@@ -5,7 +5,7 @@
 #include <cmath>
 #include <vector>
 
-#include "core/depth_camera.h"
+#include "services/perception/core/depth_camera.h"
 
 namespace iplan::perception {
 namespace {

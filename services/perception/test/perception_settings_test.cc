@@ -1,6 +1,6 @@
 // Section perception, declared once (perception_settings.h): the shipped
 // file, the conversions to the cores' parameters, and refusals by key.
-#include "perception_settings.h"
+#include "services/perception/perception_settings.h"
 
 #include <fstream>
 

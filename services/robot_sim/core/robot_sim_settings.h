@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/robot_simulator.h"
+#include "services/robot_sim/core/robot_simulator.h"
 #include "iplan/core/name_value.h"
 #include "iplan/safety/permit_gate.h"
 

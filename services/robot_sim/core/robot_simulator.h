@@ -15,7 +15,7 @@
 #include <Eigen/Core>
 
 #include "iplan/cell/joint_trajectory.h"
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 
@@ -89,7 +89,7 @@ class RobotSimulator {
   const std::vector<std::string>& joint_names() const { return robot_joints_; }
   int contacts() const { return contacts_; }
   /// Smallest separation UpdateContacts has seen (m); nullopt before the first.
-  const cell::Separation& min_separation_seen() const { return min_separation_seen_; }
+  const safety::Separation& min_separation_seen() const { return min_separation_seen_; }
   /// s the last stop took (or takes) from its command to rest.
   double last_stop_duration() const { return last_stop_duration_; }
   /// Max over the last stop of the end-effector (last sphere) travel after the stop command (m).
@@ -115,7 +115,7 @@ class RobotSimulator {
   double last_stop_duration_ = 0;
   bool touching_ = false;
   int contacts_ = 0;
-  cell::Separation min_separation_seen_;
+  safety::Separation min_separation_seen_;
 };
 
 }  // namespace iplan::robot_sim

@@ -1,8 +1,8 @@
-#include "core/robot_simulator.h"
+#include "services/robot_sim/core/robot_simulator.h"
 
 #include <gtest/gtest.h>
 
-#include "core/robot_sim_settings.h"
+#include "services/robot_sim/core/robot_sim_settings.h"
 #include "iplan/core/params.h"
 
 namespace iplan::robot_sim {

@@ -1,4 +1,4 @@
-#include "core/human_graph.h"
+#include "services/supervisor/core/human_graph.h"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "core/supervisor_settings.h"
+#include "services/supervisor/core/supervisor_settings.h"
 
 namespace iplan::supervisor {
 namespace {

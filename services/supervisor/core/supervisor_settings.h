@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-#include "core/task_planner.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/core/name_value.h"
 
 namespace iplan::supervisor {

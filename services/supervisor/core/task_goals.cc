@@ -1,4 +1,4 @@
-#include "core/task_goals.h"
+#include "services/supervisor/core/task_goals.h"
 
 #include <algorithm>
 #include <cmath>

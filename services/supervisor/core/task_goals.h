@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "core/task_planner.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/planning/planner.h"
 
 namespace iplan::supervisor {

@@ -25,7 +25,7 @@
 #include <string>
 #include <vector>
 
-#include "core/human_graph.h"
+#include "services/supervisor/core/human_graph.h"
 #include "iplan/core/name_value.h"
 
 namespace iplan::supervisor {

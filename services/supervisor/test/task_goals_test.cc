@@ -6,8 +6,8 @@
 
 #include <gtest/gtest.h>
 
-#include "core/task_goals.h"
-#include "core/task_planner.h"
+#include "services/supervisor/core/task_goals.h"
+#include "services/supervisor/core/task_planner.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/scene.h"
 #include "iplan/collision/self_collision.h"

@@ -1,4 +1,4 @@
-#include "core/escape.h"
+#include "services/trajopt/core/escape.h"
 
 #include <algorithm>
 #include <chrono>

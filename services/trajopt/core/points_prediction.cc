@@ -1,4 +1,4 @@
-#include "core/points_prediction.h"
+#include "services/trajopt/core/points_prediction.h"
 
 #include <algorithm>
 #include <cmath>
@@ -52,7 +52,7 @@ std::string PointsPredictionParams::Validate() const {
 
 std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPredictionParams& params,
                                                                 const cell::HumanPoints& seen,
-                                                                const cell::SsmParams& ssm) {
+                                                                const safety::SsmParams& ssm) {
   if (seen.size() == 0) return std::nullopt;
   double size = params.sphere_size;
   std::map<std::tuple<int, long, long, long>, Cell> cells = Coarsen(seen, size);

@@ -36,7 +36,7 @@
 #include <string>
 
 #include "iplan/cell/human_points.h"
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/collision/trajectory_bound.h"
 #include "iplan/core/name_value.h"
 
@@ -73,6 +73,6 @@ struct PointsPredictionParams {
 /// seen). Allocates.
 std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPredictionParams& params,
                                                                 const cell::HumanPoints& seen,
-                                                                const cell::SsmParams& ssm);
+                                                                const safety::SsmParams& ssm);
 
 }  // namespace iplan::trajopt

@@ -24,8 +24,8 @@
 
 #include <Eigen/Core>
 
-#include "core/escape.h"
-#include "core/points_prediction.h"
+#include "services/trajopt/core/escape.h"
+#include "services/trajopt/core/points_prediction.h"
 #include "iplan/cell/human_points.h"
 #include "iplan/cell/joint_trajectory.h"
 #include "iplan/cell/people.h"

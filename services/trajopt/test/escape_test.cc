@@ -1,7 +1,7 @@
 // Escaping (core/escape.h): when no safe plan exists and standing still is
 // what the bound forbids, the robot takes the plan that gets it out of the
 // person's predicted way, as the monitor's bound retreat lets it.
-#include "core/escape.h"
+#include "services/trajopt/core/escape.h"
 
 #include <algorithm>
 #include <limits>

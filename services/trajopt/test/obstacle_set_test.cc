@@ -1,4 +1,4 @@
-#include "core/obstacle_set.h"
+#include "services/trajopt/core/obstacle_set.h"
 
 #include <cmath>
 

@@ -3,7 +3,7 @@
 // velocities with growing covariance; and the replanner planning against
 // them when no skeleton prediction exists: points on the goal hold the
 // robot until they leave, points coming at the idle robot make it yield.
-#include "core/points_prediction.h"
+#include "services/trajopt/core/points_prediction.h"
 
 #include <algorithm>
 #include <cmath>
@@ -11,7 +11,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/replanner.h"
+#include "services/trajopt/core/replanner.h"
 #include "iplan/planning/planner_params.h"
 #include "replanner_fixture.h"
 
@@ -40,7 +40,7 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
   AddBall(&seen, {1.4, 0.3, 1.0}, 0.06, -1);   // something not tracked
   ASSERT_EQ(seen.Check(), std::nullopt);
   PointsPredictionParams params;  // 0.2 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
-  const cell::SsmParams ssm;  // T_r + T_s = 0.4 s, 1.6 m/s default
+  const safety::SsmParams ssm;  // T_r + T_s = 0.4 s, 1.6 m/s default
   // The shipped default (as collision risk's): the tracked hand too stays where seen, grown by 1.6 m/s x 0.4 s.
   EXPECT_FALSE(params.tracked_speeds);
   const std::optional<collision::HumanPrediction> untracked = BuildPointsPrediction(params, seen, ssm);
@@ -96,11 +96,11 @@ TEST(PointsPrediction, ManySpheresCoarsenTheGrid) {
   AddBall(&seen, {1.2, 0.0, 0.9}, 0.45, -1);  // a person-sized ball: ~30 cells of 0.2 m on its surface
   PointsPredictionParams params;
   params.max_spheres = 10;
-  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen, cell::SsmParams{});
+  const std::optional<collision::HumanPrediction> hp = BuildPointsPrediction(params, seen, safety::SsmParams{});
   ASSERT_TRUE(hp.has_value());
   EXPECT_LE(hp->num_spheres(), 10);
   params.max_spheres = 48;
-  EXPECT_GT(BuildPointsPrediction(params, seen, cell::SsmParams{})->num_spheres(), 10);
+  EXPECT_GT(BuildPointsPrediction(params, seen, safety::SsmParams{})->num_spheres(), 10);
   params.sphere_size = 0;
   EXPECT_EQ(params.Validate(), "human_points.sphere_size must be > 0 m");
 }

@@ -14,7 +14,7 @@
 
 #include <gtest/gtest.h>
 
-#include "core/replanner.h"
+#include "services/trajopt/core/replanner.h"
 #include "iplan/planning/planner_params.h"
 
 namespace iplan::trajopt {

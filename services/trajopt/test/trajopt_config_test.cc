@@ -1,7 +1,7 @@
 // Section trajopt read from its declaration (TrajoptSettings, then
 // ReplannerParams): the documented defaults, the cell's own file, bad values
 // named with the file.
-#include "trajopt_config.h"
+#include "services/trajopt/trajopt_config.h"
 
 #include <fstream>
 

@@ -8,7 +8,7 @@
 #include <utility>
 #include <vector>
 
-#include "iplan/cell/ssm.h"
+#include "iplan/safety/ssm.h"
 #include "iplan/core/name_value.h"
 
 namespace iplan::planning {
@@ -104,7 +104,7 @@ struct PlannerParams {
   double human_separation = 0.0;
   /// Predicting the separation monitor (ISO/TS 15066 SSM): with
   /// predict_ssm, every free waypoint within ssm_horizon of waypoint 0 is
-  /// judged by the monitor's own pair rule (cell::SsmPairRule, with `ssm`,
+  /// judged by the monitor's own pair rule (safety::SsmPairRule, with `ssm`,
   /// the monitor's parameters) against the predicted person: each action at
   /// its mean, moving as its mean moves between prediction steps, and the
   /// robot sphere moving as the plan moves it to the next waypoint. A
@@ -115,7 +115,7 @@ struct PlannerParams {
   /// so that plans keep clear of that, slow down near the person and, when
   /// the person comes towards the robot, get out of their way.
   bool predict_ssm = false;
-  cell::SsmParams ssm;
+  safety::SsmParams ssm;
   double ssm_margin = 0.03;          ///< m, >= 0
   double ssm_activation = 0.05;      ///< m, >= ssm_margin
   double ssm_horizon = 1.0;          ///< s, > 0

@@ -1,0 +1,100 @@
+#include "iplan/adapters/cloud_adapters.h"
+
+#include <cmath>
+#include <cstring>
+
+
+namespace iplan::services {
+namespace {
+
+// Offsets of x, y, z; why not when the layout is unusable.
+std::optional<std::string> CoordinateOffsets(const msg::PointCloud2& m, uint32_t offset[3]) {
+  static const char* const kNames[3] = {"x", "y", "z"};
+  if (m.is_bigendian) return std::string("big-endian clouds are not supported");
+  if (m.point_step < 12) return "point_step " + std::to_string(m.point_step) + " is under 12 bytes (x, y, z float32)";
+  bool seen[3] = {false, false, false};
+  for (const msg::PointField& f : m.fields) {
+    for (int k = 0; k < 3; ++k) {
+      if (f.name != kNames[k]) continue;
+      if (seen[k]) return "field '" + f.name + "' appears twice";
+      seen[k] = true;
+      if (f.datatype != msg::PointField::FLOAT32) {
+        return "field '" + f.name + "' has datatype " + std::to_string(f.datatype) + ", expected FLOAT32 (7)";
+      }
+      if (f.count != 1) return "field '" + f.name + "' has count " + std::to_string(f.count) + ", expected 1";
+      if (uint64_t{f.offset} + 4 > m.point_step) {
+        return "field '" + f.name + "' at offset " + std::to_string(f.offset) + " reaches past point_step " +
+               std::to_string(m.point_step);
+      }
+      offset[k] = f.offset;
+    }
+  }
+  for (int k = 0; k < 3; ++k) {
+    if (!seen[k]) return std::string("no field '") + kNames[k] + "'";
+  }
+  return std::nullopt;
+}
+
+}  // namespace
+
+std::optional<std::string> FromPointCloud2(const msg::PointCloud2& m, cloud::Cloud* out) {
+  uint32_t offset[3] = {0, 0, 0};
+  if (auto why = CoordinateOffsets(m, offset)) return why;
+  // The framework checked row_step * height == data.size() and point_step * width <= row_step.
+  if (uint64_t{m.row_step} * m.height != m.data.size() || uint64_t{m.point_step} * m.width > m.row_step) {
+    return std::string("data size does not match row_step, point_step, width and height");
+  }
+  out->width = static_cast<int>(m.width);
+  out->height = static_cast<int>(m.height);
+  out->points.resize(std::size_t{m.width} * m.height);
+  out->rgba.clear();
+  out->label.clear();
+  std::size_t i = 0;
+  for (uint32_t row = 0; row < m.height; ++row) {
+    const uint8_t* p = m.data.data() + std::size_t{row} * m.row_step;
+    for (uint32_t col = 0; col < m.width; ++col, ++i, p += m.point_step) {
+      float v[3];
+      int nan = 0;
+      for (int k = 0; k < 3; ++k) {
+        std::memcpy(&v[k], p + offset[k], sizeof(float));  // little-endian host (x86, arm64)
+        if (std::isnan(v[k])) {
+          ++nan;
+        } else if (!std::isfinite(v[k])) {
+          return "point " + std::to_string(i) + " has an infinite coordinate";
+        }
+      }
+      if (nan != 0 && nan != 3) return "point " + std::to_string(i) + " has some coordinates NaN, not all";
+      if (nan == 3 && m.is_dense) return "point " + std::to_string(i) + " is NaN in a cloud marked is_dense";
+      out->points[i] = Eigen::Vector3f(v[0], v[1], v[2]);
+    }
+  }
+  return std::nullopt;
+}
+
+void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id,
+                   msg::PointCloud2* out) {
+  out->header.stamp = stamp;
+  out->header.frame_id = frame_id;
+  out->height = static_cast<uint32_t>(c.height);
+  out->width = static_cast<uint32_t>(c.width);
+  out->fields.resize(3);
+  static const char* const kNames[3] = {"x", "y", "z"};
+  for (int k = 0; k < 3; ++k) {
+    out->fields[k].name = kNames[k];
+    out->fields[k].offset = static_cast<uint32_t>(4 * k);
+    out->fields[k].datatype = msg::PointField::FLOAT32;
+    out->fields[k].count = 1;
+  }
+  out->is_bigendian = false;
+  out->point_step = 12;
+  out->row_step = 12 * out->width;
+  out->data.resize(c.points.size() * 12);
+  bool dense = true;
+  for (std::size_t i = 0; i < c.points.size(); ++i) {
+    std::memcpy(out->data.data() + 12 * i, c.points[i].data(), 12);
+    dense = dense && c.points[i].allFinite();
+  }
+  out->is_dense = dense;
+}
+
+}  // namespace iplan::services

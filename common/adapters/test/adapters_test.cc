@@ -1,0 +1,79 @@
+// Trajectories as they go out (ToTrajectory with TrajectoryOutput) and how a
+// receiver reads their start (TrajectoryStartNs): planned stamps, ROS 2's
+// "zero stamp = start on receipt", the minimum duration of a hold, and
+// velocities from the positions.
+#include <gtest/gtest.h>
+
+#include "iplan/adapters/adapters.h"
+#include "iplan/msg/time.h"
+
+namespace iplan::services {
+namespace {
+
+double Seconds(const msg::Duration& d) { return d.sec + 1e-9 * d.nanosec; }
+
+TEST(ToTrajectory, AHoldLastsTheMinimumDurationAtTheSameStep) {
+  Eigen::MatrixXd q(2, 2);
+  q << 0.5, 0.5, -1.0, -1.0;  // hold: 2 points over 0.1 s
+  TrajectoryOutput out;
+  out.min_duration = 1.0;
+  const int64_t start = 1'700'000'000'123'000'000;
+  const msg::JointTrajectory t = ToTrajectory(start, {"a", "b"}, q, 0.1, out, start + 5'000'000);
+  EXPECT_EQ(msg::ToNanoseconds(t.header.stamp), start);
+  ASSERT_EQ(t.points.size(), 11u);
+  for (std::size_t i = 0; i < t.points.size(); ++i) {
+    EXPECT_NEAR(Seconds(t.points[i].time_from_start), 0.1 * static_cast<double>(i), 1e-9);
+    EXPECT_EQ(t.points[i].positions, (std::vector<double>{0.5, -1.0}));
+    EXPECT_EQ(t.points[i].velocities, (std::vector<double>{0.0, 0.0}));
+  }
+}
+
+TEST(ToTrajectory, ZeroStampRetimesFromPublicationAndDropsWhatIsPast) {
+  Eigen::MatrixXd q(1, 5);
+  q << 0.0, 0.1, 0.3, 0.6, 1.0;  // segment speeds 1, 2, 3, 4 rad/s at dt 0.1
+  TrajectoryOutput out;
+  out.zero_stamp = true;
+  const int64_t start = 1'700'000'000'000'000'000;
+  const int64_t published = start + 30'000'000;  // 30 ms after waypoint 0
+  const msg::JointTrajectory t = ToTrajectory(start, {"a"}, q, 0.1, out, published);
+  EXPECT_EQ(t.header.stamp.sec, 0);
+  EXPECT_EQ(t.header.stamp.nanosec, 0u);
+  ASSERT_EQ(t.points.size(), 4u);  // waypoint 0 is already past
+  const std::vector<double> times = {0.07, 0.17, 0.27, 0.37};
+  const std::vector<double> speeds = {1.5, 2.5, 3.5, 4.0};  // central inside, one-sided at the end
+  for (std::size_t i = 0; i < 4; ++i) {
+    EXPECT_NEAR(Seconds(t.points[i].time_from_start), times[i], 1e-9) << i;
+    EXPECT_DOUBLE_EQ(t.points[i].positions.at(0), q(0, static_cast<Eigen::Index>(i + 1)));
+    EXPECT_NEAR(t.points[i].velocities.at(0), speeds[i], 1e-9) << i;
+  }
+}
+
+TEST(ToTrajectory, WithoutVelocitiesTheyAreEmptyAndTheEndIsHeldStill) {
+  Eigen::MatrixXd q(1, 3);
+  q << 0.0, 0.2, 0.4;
+  TrajectoryOutput out;
+  out.velocities = false;
+  const msg::JointTrajectory plain = ToTrajectory(0, {"a"}, q, 0.1, out, 0);
+  ASSERT_EQ(plain.points.size(), 3u);
+  for (const auto& p : plain.points) EXPECT_TRUE(p.velocities.empty());
+  out.velocities = true;
+  out.min_duration = 0.35;  // 0.2 s planned: held at 0.3 and 0.4 s
+  const msg::JointTrajectory held = ToTrajectory(0, {"a"}, q, 0.1, out, 0);
+  ASSERT_EQ(held.points.size(), 5u);
+  EXPECT_NEAR(held.points[0].velocities.at(0), 2.0, 1e-9);
+  EXPECT_NEAR(held.points[1].velocities.at(0), 2.0, 1e-9);
+  for (std::size_t i = 2; i < 5; ++i) {
+    EXPECT_EQ(held.points[i].velocities.at(0), 0.0) << i;  // the robot stops at the end and stays
+    EXPECT_DOUBLE_EQ(held.points[i].positions.at(0), 0.4);
+  }
+}
+
+TEST(TrajectoryStartNs, ZeroStampMeansReceipt) {
+  msg::JointTrajectory t;
+  EXPECT_EQ(TrajectoryStartNs(t, 42), 42);
+  t.header.stamp = msg::TimeFromNanoseconds(1'700'000'000'000'000'007);
+  EXPECT_EQ(TrajectoryStartNs(t, 42), 1'700'000'000'000'000'007);
+}
+
+}  // namespace
+}  // namespace iplan::services

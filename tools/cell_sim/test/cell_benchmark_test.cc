@@ -1,0 +1,125 @@
+// The episode benchmark's draws and figures on the shipped cell
+// (config/): an episode is the same whatever the number of episodes and
+// for a seed, its person's actions follow the task graph's human_graph and
+// cover the whole run, a setup without the person's graph is refused by
+// name, and the summary's ratios and the share of the oracle's gain are
+// computed as documented. Drawing needs no trained intent model (only
+// running does), so the setup carries an empty one.
+#include "tools/cell_sim/core/cell_benchmark.h"
+
+#include <cmath>
+#include <memory>
+
+#include <gtest/gtest.h>
+
+#include "tools/cell_sim/cell_config.h"
+
+namespace iplan::cell_sim {
+namespace {
+
+class CellBenchmarkTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() { cell_ = new CellConfig(LoadCellConfig(std::string(IPLAN_SOURCE_DIR) + "/config", 1)); }
+  static void TearDownTestSuite() { delete cell_; }
+
+  CellBenchmarkSetup Setup() const {
+    CellBenchmarkSetup s = cell_->MakeCellSetup();
+    s.base.intent_model = std::make_shared<const intent::IntentModel>();
+    s.episode_limit = 60;
+    return s;
+  }
+
+  static CellConfig* cell_;
+};
+
+CellConfig* CellBenchmarkTest::cell_ = nullptr;
+
+TEST_F(CellBenchmarkTest, EpisodesAreDrawnFromTheSeedAndTheIndexAlone) {
+  const CellBenchmarkSetup setup = Setup();
+  ASSERT_EQ(setup.Validate(), "");
+  ASSERT_EQ(setup.graph.tasks.size(), 5u);
+  const std::vector<EpisodeSpec> few = MakeCellEpisodes(setup, 2, 1), many = MakeCellEpisodes(setup, 6, 1);
+  const std::vector<EpisodeSpec> other = MakeCellEpisodes(setup, 2, 2);
+  ASSERT_EQ(few.size(), 2u);
+  ASSERT_EQ(many.size(), 6u);
+  for (std::size_t i = 0; i < few.size(); ++i) {
+    EXPECT_EQ(few[i].index, static_cast<int>(i));
+    EXPECT_EQ(few[i].noise_seed, many[i].noise_seed);
+    EXPECT_EQ(few[i].person_seed, many[i].person_seed);
+    ASSERT_EQ(few[i].actions.size(), many[i].actions.size());
+    for (std::size_t k = 0; k < few[i].actions.size(); ++k) {
+      EXPECT_EQ(few[i].actions[k].action, many[i].actions[k].action);
+      EXPECT_EQ(few[i].actions[k].duration, many[i].actions[k].duration);
+    }
+  }
+  EXPECT_NE(few[0].noise_seed, other[0].noise_seed);
+  EXPECT_NE(few[0].noise_seed, few[1].noise_seed);
+  const double stream = setup.base.loop.task_start + setup.episode_limit + 1.0;  // at least
+  for (const EpisodeSpec& e : many) {
+    SCOPED_TRACE("episode " + std::to_string(e.index));
+    ASSERT_FALSE(e.actions.empty());
+    EXPECT_LE(e.actions.front().start, 0.0);       // part way through the first action
+    EXPECT_GT(e.actions.front().end(), 0.0);
+    EXPECT_GE(e.actions.back().end(), stream);     // the person acts for the whole run
+    for (const auto& a : e.actions) {
+      const int i = setup.graph.human_graph.Find(a.action);
+      ASSERT_GE(i, 0) << a.action;
+      const auto& range = setup.graph.human_graph.actions[static_cast<std::size_t>(i)].second.duration;
+      EXPECT_GE(a.duration, range[0]);
+      EXPECT_LE(a.duration, range[1]);
+    }
+  }
+}
+
+TEST_F(CellBenchmarkTest, ASetupWithoutThePersonsGraphIsRefusedByName) {
+  CellBenchmarkSetup setup = Setup();
+  setup.graph.human_graph = supervisor::HumanGraph{};
+  EXPECT_EQ(setup.Validate(), "the task graph has no human_graph (the person's actions cannot be drawn)");
+  EXPECT_THROW(MakeCellEpisodes(setup, 1, 1), std::invalid_argument);
+  setup = Setup();
+  setup.base.person.script.clear();
+  setup.base.person.actions.pop_back();  // the synthetic person cannot idle
+  EXPECT_EQ(setup.Validate(), "the synthetic person has no action 'idle' of the human graph");
+  setup = Setup();
+  EXPECT_THROW(MakeCellEpisodes(setup, 0, 1), std::invalid_argument);
+}
+
+TEST_F(CellBenchmarkTest, TheSummaryPairsEveryPredictorWithNone) {
+  auto run = [](Predictor p, double time, double idle, int stops, int done) {
+    CellEpisodeResult r;
+    r.predictor = p;
+    r.episode_time = time;
+    r.robot_idle = idle;
+    r.protective_stops = stops;
+    r.tasks_done = done;
+    r.complete = done == 5;
+    return r;
+  };
+  const std::vector<Predictor> predictors = {Predictor::kModel, Predictor::kNone, Predictor::kOracle};
+  const std::vector<std::vector<CellEpisodeResult>> results = {
+      {run(Predictor::kModel, 18, 1, 0, 5), run(Predictor::kNone, 20, 2, 2, 5), run(Predictor::kOracle, 16, 0.5, 0, 5)},
+      {run(Predictor::kModel, 30, 3, 1, 4), run(Predictor::kNone, 24, 4, 3, 5), run(Predictor::kOracle, 20, 1, 0, 5)}};
+  const std::vector<CellSummary> s = SummarizeCell(predictors, results, 5);
+  ASSERT_EQ(s.size(), 3u);
+  EXPECT_EQ(s[0].predictor, Predictor::kModel);
+  EXPECT_EQ(s[0].episodes, 2);
+  EXPECT_EQ(s[0].complete, 1);
+  EXPECT_EQ(s[0].tasks_done, 9);
+  EXPECT_EQ(s[0].tasks_total, 10);
+  EXPECT_EQ(s[0].protective_stops, 1);
+  EXPECT_DOUBLE_EQ(s[0].robot_idle_total, 4.0);
+  EXPECT_DOUBLE_EQ(s[0].episode_time.median, 18.0);  // nearest rank of {18, 30}
+  EXPECT_DOUBLE_EQ(s[1].episode_time.median, 20.0);
+  EXPECT_TRUE(s[0].has_reference);
+  EXPECT_DOUBLE_EQ(s[0].episode_time_ratio, 18.0 / 20.0);
+  EXPECT_DOUBLE_EQ(s[0].robot_idle_ratio, 1.0 / 2.0);
+  EXPECT_DOUBLE_EQ(s[0].episode_time_paired_ratio.median, 18.0 / 20.0);  // of {0.9, 1.25}
+  EXPECT_DOUBLE_EQ(s[1].episode_time_ratio, 1.0);
+  // The model recovers (20 - 18) / (20 - 16) of the oracle's gain; nothing
+  // to recover when the oracle gains nothing.
+  EXPECT_DOUBLE_EQ(GainRecovered(20, 18, 16), 0.5);
+  EXPECT_TRUE(std::isnan(GainRecovered(20, 18, 21)));
+}
+
+}  // namespace
+}  // namespace iplan::cell_sim
