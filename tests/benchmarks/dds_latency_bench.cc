@@ -224,16 +224,29 @@ std::string TypeOf(const std::string& m) {
   return m == "skeleton" ? msg::TypeName<msg::HumanSkeleton>::kDds : msg::TypeName<msg::HumanPrediction>::kDds;
 }
 
-// ------------------------------------------------------------------ echo role
-template <class T>
-int FrameworkEcho(idds::Vendor vendor, int domain, double seconds) {
+// A framework node on a participant of its own, without diagnostics.
+struct BenchNode {
+  std::unique_ptr<idds::Participant> participant;
+  std::unique_ptr<framework::Node> node;
+};
+
+BenchNode MakeBenchNode(idds::Vendor vendor, int domain, const std::string& name) {
   idds::ParticipantOptions o;
   o.vendor = vendor;
   o.domain_id = domain;
-  auto p = idds::Participant::Create(o);
+  BenchNode b;
+  b.participant = idds::Participant::Create(o);
   framework::NodeOptions no;
   no.diagnostics_period = 0;
-  framework::Node node("echo", *p, no);
+  b.node = std::make_unique<framework::Node>(name, *b.participant, no);
+  return b;
+}
+
+// ------------------------------------------------------------------ echo role
+template <class T>
+int FrameworkEcho(idds::Vendor vendor, int domain, double seconds) {
+  BenchNode bench = MakeBenchNode(vendor, domain, "echo");
+  framework::Node& node = *bench.node;
   auto& w = node.Advertise(framework::Topic<T>{"rt/bench/pong", BenchQos(5)});
   node.Subscribe(framework::Topic<T>{"rt/bench/ping", BenchQos(5)},
                  std::function<void(const T&, const idds::SampleInfo&)>([&](const T& m, const idds::SampleInfo&) { w.Write(m); }),
@@ -274,13 +287,8 @@ int Echo(const Case& c, int domain, double seconds) {
 // Returns one-way latencies in microseconds.
 template <class T>
 std::vector<double> FrameworkPing(idds::Vendor vendor, int domain, const T& m, int warmup, int n) {
-  idds::ParticipantOptions o;
-  o.vendor = vendor;
-  o.domain_id = domain;
-  auto p = idds::Participant::Create(o);
-  framework::NodeOptions no;
-  no.diagnostics_period = 0;
-  framework::Node node("ping", *p, no);
+  BenchNode bench = MakeBenchNode(vendor, domain, "ping");
+  framework::Node& node = *bench.node;
   auto& w = node.Advertise(framework::Topic<T>{"rt/bench/ping", BenchQos(5)});
   int got = 0;
   node.Subscribe(framework::Topic<T>{"rt/bench/pong", BenchQos(5)},

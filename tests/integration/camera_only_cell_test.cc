@@ -24,13 +24,13 @@
 #include <Eigen/Core>
 #include <gtest/gtest.h>
 
-#include "core/synthetic_person.h"
-#include "depth_source.h"
+#include "services/perception/core/synthetic_person.h"
+#include "services/perception/depth_source.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
 #include "iplan/framework/service_file.h"
-#include "perception_settings.h"
+#include "services/perception/perception_settings.h"
 #include "service_cell.h"
 #include "test_messages.h"
 #include "test_node.h"
@@ -42,9 +42,7 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
-const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 
-const std::vector<std::string>& kRobotJoints = kPandaJoints;
 const std::vector<double>& kReady = kPandaReady;
 
 // The scripted person: the demo cell's synthetic person doing `action`,

@@ -19,7 +19,7 @@
 #include <map>
 #include <thread>
 
-#include "common/cloud_adapters.h"
+#include "iplan/adapters/cloud_adapters.h"
 #include "iplan/cloud/cloud.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/framework/node.h"
@@ -31,7 +31,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
-const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 
 struct Observer {
   explicit Observer(int domain, dds::Vendor vendor = dds::Vendor::kCyclone) : t("observer", vendor, domain) {

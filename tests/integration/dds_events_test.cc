@@ -13,6 +13,7 @@
 #include "iplan/framework/node.h"
 #include "iplan/framework/topics.h"
 #include "test_paths.h"
+#include "vendor_pairings.h"
 
 namespace iplan::testing {
 namespace {
@@ -20,11 +21,6 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-struct Pairing {
-  std::string writer;
-  std::string reader;
-};
-void PrintTo(const Pairing& p, std::ostream* os) { *os << p.writer << " -> " << p.reader; }
 
 class DdsEvents : public ::testing::TestWithParam<Pairing> {
  protected:
@@ -248,11 +244,7 @@ TEST_P(DdsEvents, BackwardsStampsAndWrongSizesAreRejected) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(AllPairings, DdsEvents,
-                         ::testing::Values(Pairing{"fastdds", "fastdds"}, Pairing{"fastdds", "cyclonedds"},
-                                           Pairing{"cyclonedds", "fastdds"},
-                                           Pairing{"cyclonedds", "cyclonedds"}),
-                         [](const auto& info) { return info.param.writer + "_to_" + info.param.reader; });
+INSTANTIATE_TEST_SUITE_P(AllPairings, DdsEvents, AllVendorPairings(), PairingName);
 
 }  // namespace
 }  // namespace iplan::testing

@@ -3,15 +3,11 @@
 #include <gtest/gtest.h>
 
 #include "test_paths.h"
+#include "vendor_pairings.h"
 
 namespace iplan::testing {
 namespace {
 
-struct Pairing {
-  std::string writer;
-  std::string reader;
-};
-void PrintTo(const Pairing& p, std::ostream* os) { *os << p.writer << " -> " << p.reader; }
 
 class DdsInterop : public ::testing::TestWithParam<Pairing> {};
 
@@ -33,11 +29,7 @@ TEST_P(DdsInterop, EveryTypeRoundTripsFieldByField) {
   EXPECT_EQ(*pub_rc, 0) << pub.Stdout() << pub.Stderr();
 }
 
-INSTANTIATE_TEST_SUITE_P(AllPairings, DdsInterop,
-                         ::testing::Values(Pairing{"fastdds", "fastdds"}, Pairing{"fastdds", "cyclonedds"},
-                                           Pairing{"cyclonedds", "fastdds"},
-                                           Pairing{"cyclonedds", "cyclonedds"}),
-                         [](const auto& info) { return info.param.writer + "_to_" + info.param.reader; });
+INSTANTIATE_TEST_SUITE_P(AllPairings, DdsInterop, AllVendorPairings(), PairingName);
 
 }  // namespace
 }  // namespace iplan::testing

@@ -43,7 +43,6 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
-const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 
 std::string List(const std::vector<double>& v) {
   std::string s = "[";
@@ -67,7 +66,6 @@ std::vector<std::string> DepthPerception(std::vector<std::string> more) {
 
 // ---------------------------------------------------------------- 1. person
 
-const std::vector<std::string>& kRobotJoints = kPandaJoints;
 const std::vector<double>& kReady = kPandaReady;
 const std::vector<double> kReach = {0, 0.3, 0, -1.5, 0, 1.9, 0.785};
 // The person walks into the camera's view kPersonAfter s after perception's activation; the arm starts its one
@@ -80,18 +78,7 @@ std::vector<double> PlannedAt(double t) {
   for (std::size_t j = 0; j < 7; ++j) q[j] = (1 - u) * kReady[j] + u * kReach[j];
   return q;
 }
-msg::JointTrajectory Reaching(const msg::Time& start) {
-  msg::JointTrajectory t;
-  t.header.stamp = start;
-  t.joint_names = kRobotJoints;
-  for (int i = 0; i <= 10 * static_cast<int>(kRunFor); ++i) {
-    msg::JointTrajectoryPoint pt;
-    pt.positions = PlannedAt(0.1 * i);
-    pt.time_from_start = msg::DurationFromSeconds(0.1 * i);
-    t.points.push_back(pt);
-  }
-  return t;
-}
+msg::JointTrajectory Reaching(const msg::Time& start) { return SampledTrajectory(start, PlannedAt, kRunFor); }
 
 // Robot spheres at q against body spheres: smallest surface distance, m.
 double Distance(const collision::RobotModel& robot, const std::vector<double>& q, const std::vector<Eigen::Vector3d>& c,

@@ -27,7 +27,6 @@ namespace {
 using namespace std::chrono_literals;
 using Clock = std::chrono::steady_clock;
 
-const std::vector<std::string>& kRobotJoints = kPandaJoints;
 const std::vector<double>& kReady = kPandaReady;
 constexpr double kVoxel = 0.02;  // m, the points' grid (r_p = 1 cm)
 
@@ -67,18 +66,7 @@ std::vector<double> ReachAt(double t) {
   for (std::size_t j = 0; j < 7; ++j) q[j] = (1 - u) * kReady[j] + u * kReach[j];
   return q;
 }
-msg::JointTrajectory Reaching(const msg::Time& start) {
-  msg::JointTrajectory t;
-  t.header.stamp = start;
-  t.joint_names = kRobotJoints;
-  for (int i = 0; i <= 300; ++i) {
-    msg::JointTrajectoryPoint pt;
-    pt.positions = ReachAt(0.1 * i);
-    pt.time_from_start = msg::DurationFromSeconds(0.1 * i);
-    t.points.push_back(pt);
-  }
-  return t;
-}
+msg::JointTrajectory Reaching(const msg::Time& start) { return SampledTrajectory(start, ReachAt, 30.0); }
 
 struct State {
   double t;                    // s since the walk started

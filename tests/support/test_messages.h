@@ -1,7 +1,9 @@
 // Messages the multi-process tests build again and again.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
+#include <functional>
 #include <string>
 #include <vector>
 
@@ -56,6 +58,23 @@ inline msg::TaskCommand JointGoalCommand(uint32_t task_id, const std::string& ta
   c.retreat_positions = retreat;
   c.time_limit = time_limit_s;
   return c;
+}
+
+/// A trajectory of the Panda's joints from `start`: q_at(t) every `step` s
+/// for t in [0, duration] (s, rad).
+inline msg::JointTrajectory SampledTrajectory(const msg::Time& start, const std::function<std::vector<double>(double)>& q_at,
+                                              double duration, double step = 0.1) {
+  msg::JointTrajectory t;
+  t.header.stamp = start;
+  t.joint_names = kPandaJoints;
+  const int n = static_cast<int>(std::lround(duration / step));
+  for (int i = 0; i <= n; ++i) {
+    msg::JointTrajectoryPoint pt;
+    pt.positions = q_at(step * i);
+    pt.time_from_start = msg::DurationFromSeconds(step * i);
+    t.points.push_back(pt);
+  }
+  return t;
 }
 
 /// The permit a test grants in the supervisor's place (source "test"),

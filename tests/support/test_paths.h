@@ -21,6 +21,8 @@ using core::Process;
 
 /// build/bin/<name>.
 inline std::string BinPath(const std::string& name) { return std::string(IPLAN_BIN_DIR) + "/" + name; }
+/// The shipped configuration folder, config/ of the source tree.
+inline const std::string kConfig = std::string(IPLAN_SOURCE_DIR) + "/config";
 /// build/tests/<name>.
 inline std::string TestBinPath(const std::string& name) { return std::string(IPLAN_BIN_DIR) + "/../tests/" + name; }
 

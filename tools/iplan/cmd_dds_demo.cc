@@ -22,10 +22,10 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
-#include "supervisor/core/supervisor_settings.h"
-#include "supervisor/core/task_goals.h"
-#include "supervisor/core/task_planner.h"
-#include "trajopt/trajopt_config.h"
+#include "services/supervisor/core/supervisor_settings.h"
+#include "services/supervisor/core/task_goals.h"
+#include "services/supervisor/core/task_planner.h"
+#include "services/trajopt/trajopt_config.h"
 #include "dds_cell_model.h"
 #include "dds_common.h"
 #include "dds_demo_security.h"
@@ -311,15 +311,21 @@ class DemoRun {
     }
   }
 
-  void PrintSummary(const CellMonitor& mon, double contacts) const {
-    const auto lat = core::Summarize(mon.latency_ms_);
-    const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
+  // The completed episodes and the robot's waiting time over all (s).
+  static std::pair<std::vector<const Episode*>, double> Tally(const CellMonitor& mon) {
     std::vector<const Episode*> done;
     double waiting_total = 0;
     for (const auto& [n, e] : mon.episodes()) {
       waiting_total += e.waiting;
       if (e.done) done.push_back(&e);
     }
+    return {done, waiting_total};
+  }
+
+  void PrintSummary(const CellMonitor& mon, double contacts) const {
+    const auto lat = core::Summarize(mon.latency_ms_);
+    const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
+    const auto [done, waiting_total] = Tally(mon);
     std::cout << "\nSummary (" << Fixed(elapsed_, 0) << " s)\n"
               << "  episodes completed            " << done.size() << " / " << o_.episodes << "\n"
               << "  tasks completed               " << mon.succeeded_tasks_ << " (failed or cancelled: " << mon.failed_tasks_
@@ -377,12 +383,7 @@ class DemoRun {
     const auto intent_lat = core::Summarize(mon.intent_ms_), queue_lat = core::Summarize(mon.queue_ms_),
                planning_lat = core::Summarize(mon.planning_ms_);
     const double min_true_sep = mon.DiagNumber("robot_sim", "min_true_separation_m", -1);
-    std::vector<const Episode*> done;
-    double waiting_total = 0;
-    for (const auto& [n, e] : mon.episodes()) {
-      waiting_total += e.waiting;
-      if (e.done) done.push_back(&e);
-    }
+    const auto [done, waiting_total] = Tally(mon);
     nlohmann::json j;
     j["domain"] = domain_;
     j["predictor"] = o_.predictor;

@@ -21,6 +21,7 @@
 
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/pipeline.h"
+#include "iplan/core/process.h"
 #include "iplan/core/stats.h"
 
 namespace {
@@ -44,11 +45,7 @@ const std::vector<Cloud>& Clouds() {
   return clouds;
 }
 
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+using iplan::core::ThreadCpuSeconds;
 
 // Runs `process` on every cloud in turn, one cloud per iteration, and
 // reports the per-cloud percentiles.
@@ -96,10 +93,7 @@ BENCHMARK(BM_Textbook)->Iterations(14 * kRounds)->UseManualTime()->Unit(benchmar
 int main(int argc, char** argv) {
   // One core: the pipelines are single-threaded; pinning keeps the cache
   // and the figures comparable.
-  cpu_set_t one;
-  CPU_ZERO(&one);
-  CPU_SET(sched_getcpu(), &one);
-  sched_setaffinity(0, sizeof one, &one);
+  iplan::core::PinToCurrentCpu();
   if (Clouds().size() != 14) {
     std::fprintf(stderr, "cloud_bench: expected the 14 mOSD learn scans, found %zu\n", Clouds().size());
     return 2;

@@ -6,14 +6,11 @@
 #include <stdexcept>
 
 #include "iplan/cloud/camera.h"
+#include "iplan/core/params.h"
 
 namespace iplan::cloud {
 namespace {
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+std::string Num(double v) { return core::ParamText(v); }
 }  // namespace
 
 std::string CameraIntrinsics::Validate() const {

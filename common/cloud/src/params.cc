@@ -8,16 +8,13 @@
 #include <yaml-cpp/yaml.h>
 
 #include "iplan/cloud/pipeline.h"
+#include "iplan/core/params.h"
 #include "iplan/core/yaml.h"
 
 namespace iplan::cloud {
 namespace {
 
-std::string Num(double v) {
-  std::ostringstream s;
-  s << v;
-  return s.str();
-}
+std::string Num(double v) { return core::ParamText(v); }
 
 template <typename T>
 T Read(const YAML::Node& node, const std::string& key, const std::string& path) {

@@ -420,7 +420,7 @@ TEST(LoadCloudParams, StrictKeysTypesAndValues) {
   ExpectLoadError("stride: two\n", "key 'stride' has a value of the wrong type: 'two'");
   ExpectLoadError("crop_max: [1, 2]\n", "key 'crop_max' needs 3 numbers [x, y, z], got 2");
   ExpectLoadError("stride: 0\n", "stride must be in 1..8, got 0");
-  ExpectLoadError("crop_min: [0, 0, 3]\n", "crop_min must be below crop_max on every axis, got axis 2: 3 .. 2.5");
+  ExpectLoadError("crop_min: [0, 0, 3]\n", "crop_min must be below crop_max on every axis, got axis 2: 3.0 .. 2.5");
   ExpectLoadError("- 1\n", "cloud params must be a map");
   const std::string twice = WriteTemp("twice.yaml", "stride: 2\nstride: 3\n");
   try {

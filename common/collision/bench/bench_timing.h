@@ -8,6 +8,8 @@
 #include <functional>
 #include <vector>
 
+#include "iplan/core/stats.h"
+
 namespace iplan::collision {
 
 using Clock = std::chrono::steady_clock;
@@ -16,13 +18,8 @@ struct Stats {
   double median, min, max;
 };
 
-// CPU time of this thread (s): the machine is shared, and time while the
-// thread is descheduled is not the code's cost. Wall time is kept alongside.
-inline double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+// CPU time of this thread (s); wall time is kept alongside.
+using core::ThreadCpuSeconds;
 
 inline double g_last_wall_median = 0.0;
 

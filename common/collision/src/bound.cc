@@ -52,25 +52,37 @@ bool FactorizeGaussian(const Eigen::Vector3d& mean, const Eigen::Matrix3d& sigma
   return true;
 }
 
-double EvaluatePairLogBound(const FactorizedGaussian& g, const Eigen::Vector3d& b,
-                            double R) {
-  const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b);
-  const double dist2 = dv.squaredNorm();
-  const double log_volume = std::log(BallVolume(R));
-  if (dist2 <= R * R) return log_volume + g.log_peak_density;
+namespace {
+
+// The secular equation's root lambda for one pair outside the ball: dv the
+// mean's offset from the ball's centre in the eigenbasis, |dv| = dist > R (m).
+double SolveOnePair(const FactorizedGaussian& g, const Eigen::Vector3d& dv, double dist, double R,
+                    int* iterations) {
   double d[3][1], s[3][1], inv_s[3][1], lambda[1];
   for (int i = 0; i < 3; ++i) {
     d[i][0] = dv[i];
     s[i][0] = g.eigenvalues[i];
     inv_s[i][0] = g.inverse_eigenvalues[i];
   }
-  const double dist[1] = {std::sqrt(dist2)};
+  const double dists[1] = {dist};
   const double Rs[1] = {R};
   const bool need[1] = {true};
-  SolveSecularLanes<1>(d, s, inv_s, dist, Rs, need, lambda, nullptr);
+  SolveSecularLanes<1>(d, s, inv_s, dists, Rs, need, lambda, iterations);
+  return lambda[0];
+}
+
+}  // namespace
+
+double EvaluatePairLogBound(const FactorizedGaussian& g, const Eigen::Vector3d& b,
+                            double R) {
+  const Eigen::Vector3d dv = g.eigenvectors.transpose() * (g.mean - b);
+  const double dist2 = dv.squaredNorm();
+  const double log_volume = std::log(BallVolume(R));
+  if (dist2 <= R * R) return log_volume + g.log_peak_density;
+  const double lambda = SolveOnePair(g, dv, std::sqrt(dist2), R, nullptr);
   const double dd[3] = {dv[0], dv[1], dv[2]};
   const double ss[3] = {g.eigenvalues[0], g.eigenvalues[1], g.eigenvalues[2]};
-  return LogBoundAt(dd, ss, lambda[0], log_volume, g.log_peak_density);
+  return LogBoundAt(dd, ss, lambda, log_volume, g.log_peak_density);
 }
 
 void EvaluatePairLogBounds(const FactorizedGaussian& g,
@@ -121,17 +133,7 @@ PairBound EvaluatePairBound(const FactorizedGaussian& g, const Eigen::Vector3d& 
     out.lambda = 0.0;
     out.log_bound = log_volume + g.log_peak_density;
   } else {
-    double d[3][1], s[3][1], inv_s[3][1], lambda[1];
-    for (int i = 0; i < 3; ++i) {
-      d[i][0] = dv[i];
-      s[i][0] = g.eigenvalues[i];
-      inv_s[i][0] = g.inverse_eigenvalues[i];
-    }
-    const double dist[1] = {std::sqrt(dist2)};
-    const double Rs[1] = {R};
-    const bool need[1] = {true};
-    SolveSecularLanes<1>(d, s, inv_s, dist, Rs, need, lambda, &out.iterations);
-    out.lambda = lambda[0];
+    out.lambda = SolveOnePair(g, dv, std::sqrt(dist2), R, &out.iterations);
     // y_i = d_i / a_i with a_i = 1 + lambda s_i, from one division.
     const double a0 = 1.0 + out.lambda * g.eigenvalues[0];
     const double a1 = 1.0 + out.lambda * g.eigenvalues[1];

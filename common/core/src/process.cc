@@ -1,6 +1,7 @@
 #include "iplan/core/process.h"
 
 #include <fcntl.h>
+#include <sched.h>
 #include <signal.h>
 #include <sys/prctl.h>
 #include <sys/wait.h>
@@ -171,6 +172,13 @@ std::string ExecutableDir() {
   if (n <= 0) return ".";
   std::string path(buf, static_cast<std::size_t>(n));
   return path.substr(0, path.rfind('/'));
+}
+
+bool PinToCurrentCpu() {
+  cpu_set_t one;
+  CPU_ZERO(&one);
+  CPU_SET(sched_getcpu(), &one);
+  return sched_setaffinity(0, sizeof one, &one) == 0;
 }
 
 }  // namespace iplan::core

@@ -1,6 +1,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <string>
 
 #include <gtest/gtest.h>
@@ -24,6 +25,29 @@ class PlannerTest : public ::testing::Test {
         planner_(robot_, scene_params_, PlannerParams{}),
         scene_(scene_params_),
         body_(collision::HumanBodyParams::DefaultUpperBody()) {}
+
+  // The sweep most cases plan: the gripper pointing down at 0.30 m, across
+  // the table from (0.45, -0.35) to (0.45, 0.15), as joint start and goal.
+  PlanningRequest AcrossTheTable() const {
+    const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+    const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+    EXPECT_TRUE(s.success && g.success);
+    PlanningRequest req;
+    req.start_q = s.q;
+    req.goal = Goal::Joint(g.q);
+    return req;
+  }
+
+  // From Ready to a pose on the shelf while a person's hand reaches across
+  // its way (the prediction is the fixture's shelf_reach_).
+  PlanningRequest ToTheShelfPastAReach() {
+    shelf_reach_.emplace(testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15));
+    PlanningRequest req;
+    req.start_q = Ready();
+    req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
+    req.people = {{&*shelf_reach_, 0.1, 0.0}};
+    return req;
+  }
 
   // Independent check with FCL of the static clearance at 10x the waypoint
   // resolution (linear interpolation), allowed pairs excluded.
@@ -58,6 +82,7 @@ class PlannerTest : public ::testing::Test {
   Planner planner_;
   collision::StaticScene scene_;
   collision::HumanBodyModel body_;
+  std::optional<collision::HumanPrediction> shelf_reach_;
 };
 
 TEST_F(PlannerTest, JointGoalIsValid) {
@@ -100,14 +125,9 @@ TEST_F(PlannerTest, PoseGoalsBetweenTableTopPosesAreValid) {
 TEST_F(PlannerTest, PersonAcrossThePathIsAvoidedOrWaitedFor) {
   // Start on the right of the table, goal on the left; the person's hand
   // reaches to the middle of the straight-line path and stays there.
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   // Without the person, the straight path crosses the hand's region.
   const PlanningResult free_r = planner_.Plan(req);
   ASSERT_TRUE(free_r.success());
@@ -156,16 +176,11 @@ std::vector<double> PersonBounds(const collision::RobotModel& robot, const colli
 TEST_F(PlannerTest, TwoPeopleAreBoundedByTheSumOfTheirBounds) {
   // The person of PersonAcrossThePath, and a second one reaching from the
   // other side of the path (torso 0.3 m further along y).
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   const collision::HumanPrediction a =
       testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
   const collision::HumanPrediction b = testing::MakeReachingPrediction(
       body_, {{0.52, -0.15, 0.35}}, 15, 0.02, 0.05, Eigen::Vector3d(0.05, -0.3, 0.0));
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&a, 0.1, 0.0}, {&b, 0.1, 0.0}};
   const PlanningResult r = planner_.Plan(req);
   ASSERT_EQ(static_cast<int>(r.bounds.size()), r.positions.cols());
@@ -187,16 +202,11 @@ TEST_F(PlannerTest, TwoPeopleAreBoundedByTheSumOfTheirBounds) {
 }
 
 TEST_F(PlannerTest, APersonFarAwayChangesNothing) {
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   const collision::HumanPrediction near =
       testing::MakeReachingPrediction(body_, {{0.50, -0.02, 0.30}, {0.55, 0.0, 0.25}}, 15, 0.02, 0.05);
   const collision::HumanPrediction far = testing::MakeReachingPrediction(
       body_, {{3.0, 0.0, 0.3}}, 15, 0.02, 0.05, Eigen::Vector3d(3.0, 0.0, 0.0));
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&near, 0.1, 0.0}};
   const PlanningResult one = planner_.Plan(req);
   req.people = {{&far, 0.1, 0.0}, {&near, 0.1, 0.0}};
@@ -226,15 +236,10 @@ TEST_F(PlannerTest, RefusesAPersonWithoutAPrediction) {
 }
 
 TEST_F(PlannerTest, PersonStandingOnTheGoalForcesWaitsAndAReportedDelay) {
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   // The hand rests on the goal pose for the whole prediction.
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.45, 0.15, 0.30}}, 15, 0.03, 0.03);
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult r = planner_.Plan(req);
   EXPECT_FALSE(r.success());
@@ -255,17 +260,12 @@ TEST_F(PlannerTest, SeparationKeepOutHoldsPlansAwayFromThePredictedPerson) {
   // A hand held still 0.30 m beside the middle of the straight path: far
   // enough for a negligible collision bound, too close for the ISO/TS 15066
   // protective separation the keep-out stands for.
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   collision::HumanPrediction hand(1, 31, {0.05});
   hand.set_action_probability(0, 1.0);
   for (int k = 0; k < 31; ++k)
     ASSERT_TRUE(hand.SetSphere(0, k, 0, {0.75, -0.10, 0.30}, 0.0004 * Eigen::Matrix3d::Identity()));
   hand.UpdateSummaries();
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&hand, 0.1, 0.0}};
   const PlanningResult off = planner_.Plan(req);
   ExpectValid(off, req.start_q);
@@ -290,12 +290,7 @@ TEST_F(PlannerTest, SeparationKeepOutHoldsPlansAwayFromThePredictedPerson) {
 }
 
 TEST_F(PlannerTest, SameSeedIsBitIdenticalForAnyThreadCount) {
-  PlanningRequest req;
-  req.start_q = Ready();
-  req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
-  const collision::HumanPrediction pred =
-      testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
-  req.people = {{&pred, 0.1, 0.0}};
+  const PlanningRequest req = ToTheShelfPastAReach();
   const PlanningResult a = planner_.Plan(req, 6, 1, 42);
   const PlanningResult b = planner_.Plan(req, 6, 3, 42);
   const PlanningResult c = planner_.Plan(req, 6, 6, 42);
@@ -320,15 +315,10 @@ TEST_F(PlannerTest, EarlyStopIsBitIdenticalForAnyThreadCountAndValid) {
   PlannerParams p;
   p.early_stop_interval = 2;
   const Planner planner(robot_, scene_params_, p);
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   // The person reaches on their own side of the table.
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.80, 0.0, 0.25}, {0.85, -0.2, 0.2}}, 15);
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult a = planner.Plan(req, 6, 1, 42);
   ASSERT_TRUE(a.success()) << a.reason;
@@ -350,12 +340,7 @@ TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
   PlannerParams p;
   p.early_stop_interval = 2;
   const Planner planner(robot_, scene_params_, p);
-  PlanningRequest req;
-  req.start_q = Ready();
-  req.goal = Goal::Pose({0.35, -0.40, 0.65}, DownOrientation(0.3));
-  const collision::HumanPrediction pred =
-      testing::MakeReachingPrediction(body_, {{0.5, -0.2, 0.4}, {0.6, 0.2, 0.3}}, 15);
-  req.people = {{&pred, 0.1, 0.0}};
+  const PlanningRequest req = ToTheShelfPastAReach();
   const PlanningResult a = planner.Plan(req, 4, 2, 42);
   const PlanningResult b = planner_.Plan(req, 4, 2, 42);
   ASSERT_FALSE(a.success());
@@ -368,14 +353,9 @@ TEST_F(PlannerTest, EarlyStopChangesNothingWhenNoOptimiserIsEverSafe) {
 TEST_F(PlannerTest, AnExhaustedBudgetStopsTheOptimisersAndInsertsNoWait) {
   // The person standing on the goal: without a budget the planner inserts
   // waits (PersonStandingOnTheGoalForcesWaitsAndAReportedDelay).
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
   const collision::HumanPrediction pred =
       testing::MakeReachingPrediction(body_, {{0.45, 0.15, 0.30}}, 15, 0.02, 0.02);
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  PlanningRequest req = AcrossTheTable();
   req.people = {{&pred, 0.1, 0.0}};
   const PlanningResult unlimited = planner_.Plan(req);
   EXPECT_FALSE(unlimited.budget_exhausted);

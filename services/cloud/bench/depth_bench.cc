@@ -16,14 +16,15 @@
 #include <ctime>
 #include <functional>
 
-#include "core/cloud_stage.h"
-#include "core/depth_camera.h"
+#include "services/cloud/core/cloud_stage.h"
+#include "services/perception/core/depth_camera.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/scene.h"
+#include "iplan/core/process.h"
 #include "iplan/core/stats.h"
-#include "core/cloud_settings.h"
+#include "services/cloud/core/cloud_settings.h"
 #include "iplan/framework/service_file.h"
-#include "perception_settings.h"
+#include "services/perception/perception_settings.h"
 
 namespace {
 
@@ -78,11 +79,7 @@ const Cell& TheCell() {
   return cell;
 }
 
-double ThreadCpuSeconds() {
-  timespec ts;
-  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
-  return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
-}
+using iplan::core::ThreadCpuSeconds;
 
 void Run(benchmark::State& state, const std::function<void(int frame)>& step) {
   std::vector<double> cpu, wall;
@@ -148,10 +145,7 @@ BENCHMARK(BM_PipelineOnly)->Iterations(kFrames)->UseManualTime()->Unit(benchmark
 }  // namespace
 
 int main(int argc, char** argv) {
-  cpu_set_t one;
-  CPU_ZERO(&one);
-  CPU_SET(sched_getcpu(), &one);
-  sched_setaffinity(0, sizeof one, &one);
+  iplan::core::PinToCurrentCpu();
   benchmark::Initialize(&argc, argv);
   if (benchmark::ReportUnrecognizedArguments(argc, argv)) return 2;
   benchmark::RunSpecifiedBenchmarks();

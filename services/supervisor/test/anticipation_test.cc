@@ -15,26 +15,17 @@
 
 #include <gtest/gtest.h>
 
-#include "core/human_graph.h"
-#include "core/task_planner.h"
+#include "services/supervisor/core/human_graph.h"
+#include "services/supervisor/core/task_planner.h"
+#include "services/supervisor/test/test_graphs.h"
 
 namespace iplan::supervisor {
 namespace {
 
-HumanGraph Person() {
-  HumanGraph g;
-  g.start = {{"reach_bin", 0.5}, {"assemble", 0.5}};
-  g.actions = {{"reach_bin", {{2.0, 4.0}, {{"assemble", 0.8}, {"reach_bin", 0.2}}}},
-               {"assemble", {{1.0, 3.0}, {{"reach_bin", 1.0}}}}};
-  return g;
-}
+HumanGraph Person() { return testing::SmallPerson(); }
 
 TaskGraph Graph() {
-  TaskGraph g;
-  g.human_actions = {"reach_bin", "assemble"};
-  g.tasks = {{"pick_left", {0.1}, {}, {"reach_bin"}},
-             {"pick_right", {0.2}, {}, {}},
-             {"place", {0.3}, {"pick_left", "pick_right"}, {"assemble"}}};
+  TaskGraph g = testing::SmallGraph();
   g.human_graph = Person();
   return g;
 }

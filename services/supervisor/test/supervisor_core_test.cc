@@ -14,23 +14,17 @@
 
 #include "iplan/core/params.h"
 
-#include "core/safety_monitor.h"
-#include "core/supervisor_settings.h"
-#include "core/task_planner.h"
+#include "services/supervisor/core/safety_monitor.h"
+#include "services/supervisor/core/supervisor_settings.h"
+#include "services/supervisor/core/task_planner.h"
+#include "services/supervisor/test/test_graphs.h"
 #include "iplan/core/atomic_file.h"
 #include "iplan/core/checksum.h"
 
 namespace iplan::supervisor {
 namespace {
 
-TaskGraph Graph() {
-  TaskGraph g;
-  g.human_actions = {"reach_bin", "assemble"};
-  g.tasks = {{"pick_left", {0.1}, {}, {"reach_bin"}},
-             {"pick_right", {0.2}, {}, {}},
-             {"place", {0.3}, {"pick_left", "pick_right"}, {"assemble"}}};
-  return g;
-}
+TaskGraph Graph() { return testing::SmallGraph(); }
 
 std::string TempPath(const std::string& name) {
   return (std::filesystem::temp_directory_path() / ("iplan-sup-" + std::to_string(getpid()) + "-" + name)).string();

@@ -58,4 +58,9 @@ class Process {
 /// The folder of the running executable (from /proc/self/exe).
 std::string ExecutableDir();
 
+/// Pins the calling thread (and threads it starts later) to the CPU it runs
+/// on now: single-threaded benchmarks keep their cache and comparable
+/// figures. Returns false when the kernel refuses.
+bool PinToCurrentCpu();
+
 }  // namespace iplan::core

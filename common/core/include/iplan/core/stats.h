@@ -17,4 +17,8 @@ Summary Summarize(std::vector<double> values);
 /// The q-quantile (0..1) by nearest rank of already sorted values.
 double QuantileSorted(const std::vector<double>& sorted, double q);
 
+/// CPU time of the calling thread (s): what benchmarks quote beside wall
+/// time, since on a shared machine time descheduled is not the code's cost.
+double ThreadCpuSeconds();
+
 }  // namespace iplan::core
