@@ -10,6 +10,7 @@
 #include <deque>
 #include <optional>
 
+#include "iplan/adapters/adapters.h"
 #include "iplan/adapters/cloud_adapters.h"
 #include "services/cloud/core/cloud_stage.h"
 #include "services/cloud/core/cloud_settings.h"
@@ -169,8 +170,7 @@ class CloudService : public framework::Service {
       g.mean.x = h.mean.x();
       g.mean.y = h.mean.y();
       g.mean.z = h.mean.z();
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) g.covariance[static_cast<std::size_t>(3 * r + c)] = h.covariance(r, c);
+      g.covariance = services::ToWireCovariance(h.covariance);
       g.motion = h.motion >= 0 && static_cast<std::size_t>(h.motion) < msg::Limits::kPointMotions
                      ? static_cast<uint32_t>(h.motion + 1)
                      : 0;
@@ -184,8 +184,7 @@ class CloudService : public framework::Service {
       m.velocity.x = e.velocity.x();
       m.velocity.y = e.velocity.y();
       m.velocity.z = e.velocity.z();
-      for (int r = 0; r < 3; ++r)
-        for (int c = 0; c < 3; ++c) m.velocity_covariance[static_cast<std::size_t>(3 * r + c)] = e.velocity_covariance(r, c);
+      m.velocity_covariance = services::ToWireCovariance(e.velocity_covariance);
       human_.motions.push_back(m);
     }
     std::string err;

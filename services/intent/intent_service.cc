@@ -16,6 +16,7 @@
 
 #include "services/intent/core/intent_estimator.h"
 #include "services/intent/core/intent_settings.h"
+#include "iplan/adapters/adapters.h"
 #include "iplan/core/params.h"
 #include "iplan/framework/service.h"
 #include "iplan/intent/baseline_predictors.h"
@@ -155,18 +156,19 @@ class IntentService : public framework::Service {
     const double stamp = msg::ToSeconds(s.header.stamp);
     if (it->second.buffered_frames() > 0 && !(stamp > last_baseline_stamp_[s.body_id])) it->second.Reset();
     last_baseline_stamp_[s.body_id] = stamp;
-    baseline_mixture_.actions.clear();
     it->second.Update(stamp, p, &baseline_mixture_);
     if (baseline_covariance_ == "model") {
       // The model's uncertainty around the baseline's mean: per step and
       // joint the probability-weighted covariance of the model's components
       // (without the spread of their means), so a comparison with the model
       // differs in the mean forecast only.
-      auto& g = baseline_mixture_.actions.at(0).joints;
+      std::vector<Eigen::Matrix3d>& g = baseline_mixture_.covariances.at(0);
       for (std::size_t k = 0; k < g.size(); ++k) {
         Eigen::Matrix3d c = Eigen::Matrix3d::Zero();
-        for (const auto& a : mixture_.actions) c += a.probability * a.joints.at(k).covariance;
-        g[k].covariance = c;
+        for (std::size_t a = 0; a < mixture_.probabilities.size(); ++a) {
+          c += mixture_.probabilities[a] * mixture_.covariances[a].at(k);
+        }
+        g[k] = c;
       }
     }
   }
@@ -179,28 +181,12 @@ class IntentService : public framework::Service {
     belief_.header.frame_id = s.header.frame_id;
     belief_.observation_stamp = s.header.stamp;
     belief_.body_id = s.body_id;
-    belief_.probabilities.resize(mixture_.actions.size());
-    prediction_.header.stamp = now;
+        prediction_.header.stamp = now;
     prediction_.header.frame_id = s.header.frame_id;
     prediction_.observation_stamp = s.header.stamp;
     prediction_.body_id = s.body_id;
-    for (std::size_t c = 0; c < mixture_.actions.size(); ++c) belief_.probabilities[c] = mixture_.actions[c].probability;
-    const intent::MixturePrediction& predicted = predictor_ == "model" ? mixture_ : baseline_mixture_;
-    prediction_.actions.resize(predicted.actions.size());
-    for (std::size_t c = 0; c < predicted.actions.size(); ++c) {
-      const intent::ActionHypothesis& h = predicted.actions[c];
-      msg::ActionPrediction& a = prediction_.actions[c];
-      a.action = predictor_ == "model" ? model_->actions[c] : h.action;
-      a.probability = h.probability;
-      a.joints.resize(h.joints.size());
-      for (std::size_t k = 0; k < h.joints.size(); ++k) {  // both step-major
-        const intent::JointGaussian& g = h.joints[k];
-        a.joints[k].mean = {g.mean.x(), g.mean.y(), g.mean.z()};
-        for (int r = 0; r < 3; ++r) {
-          for (int q = 0; q < 3; ++q) a.joints[k].covariance[3 * r + q] = g.covariance(r, q);
-        }
-      }
-    }
+    belief_.probabilities = mixture_.probabilities;
+    services::FillPrediction(predictor_ == "model" ? mixture_ : baseline_mixture_, &prediction_);
     std::string err;
     if (!belief_writer_->Write(belief_, &err) && !warned_write_) {
       node.log().error("action belief not published: {}", err);
@@ -225,13 +211,13 @@ class IntentService : public framework::Service {
   dds::Writer<msg::ActionBelief>* belief_writer_ = nullptr;
   dds::Writer<msg::HumanPrediction>* prediction_writer_ = nullptr;
   SkeletonFrame frame_;               // reused
-  intent::MixturePrediction mixture_; // reused
+  collision::JointMixture mixture_;   // reused
   std::string predictor_ = "model";  // model, constant-position, constant-velocity
   intent::BaselinePredictorParams baseline_;
   std::string baseline_covariance_ = "model";  // model: the model's covariances; growth: the baseline's own
   std::map<std::uint32_t, intent::BaselinePredictor> baselines_;
   std::map<std::uint32_t, double> last_baseline_stamp_;  // s, newest frame per body
-  intent::MixturePrediction baseline_mixture_;  // reused
+  collision::JointMixture baseline_mixture_;  // reused
   msg::ActionBelief belief_;          // reused
   msg::HumanPrediction prediction_;   // reused
   std::map<std::string, uint64_t> rejected_;

@@ -7,6 +7,16 @@
 
 namespace iplan::services {
 
+std::array<double, 9> ToWireCovariance(const Eigen::Matrix3d& c) {
+  std::array<double, 9> w;
+  Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(w.data()) = c;
+  return w;
+}
+
+Eigen::Matrix3d FromWireCovariance(const std::array<double, 9>& w) {
+  return Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(w.data());
+}
+
 collision::JointMixture ToJointMixture(const msg::HumanPrediction& m) {
   collision::JointMixture in;
   in.t0_ns = msg::ToNanoseconds(m.observation_stamp);
@@ -22,7 +32,7 @@ collision::JointMixture ToJointMixture(const msg::HumanPrediction& m) {
     covs.reserve(a.joints.size());
     for (const auto& g : a.joints) {
       means.emplace_back(g.mean.x, g.mean.y, g.mean.z);
-      covs.push_back(Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(g.covariance.data()));
+      covs.push_back(FromWireCovariance(g.covariance));
     }
     in.means.push_back(std::move(means));
     in.covariances.push_back(std::move(covs));
@@ -30,8 +40,22 @@ collision::JointMixture ToJointMixture(const msg::HumanPrediction& m) {
   return in;
 }
 
+void FillPrediction(const collision::JointMixture& in, msg::HumanPrediction* m) {
+  m->actions.resize(in.actions.size());
+  for (std::size_t c = 0; c < in.actions.size(); ++c) {
+    msg::ActionPrediction& a = m->actions[c];
+    a.action = in.actions[c];
+    a.probability = in.probabilities[c];
+    a.joints.resize(in.means[c].size());
+    for (std::size_t k = 0; k < in.means[c].size(); ++k) {  // both step-major
+      const Eigen::Vector3d& mean = in.means[c][k];
+      a.joints[k].mean = {mean.x(), mean.y(), mean.z()};
+      a.joints[k].covariance = ToWireCovariance(in.covariances[c][k]);
+    }
+  }
+}
+
 cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
-  using RowMajor = Eigen::Matrix<double, 3, 3, Eigen::RowMajor>;
   cell::HumanPoints p;
   p.stamp_ns = msg::ToNanoseconds(m.header.stamp);
   p.voxel_size = m.voxel_size;
@@ -41,7 +65,7 @@ cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
   for (std::size_t i = 0; i < m.points.size(); ++i) {
     const msg::PointGaussian& g = m.points[i];
     p.means.col(static_cast<Eigen::Index>(i)) = Eigen::Vector3d(g.mean.x, g.mean.y, g.mean.z);
-    p.covariances[i] = Eigen::Map<const RowMajor>(g.covariance.data());
+    p.covariances[i] = FromWireCovariance(g.covariance);
     tracked = tracked || g.motion > 0;
   }
   if (tracked) {
@@ -50,7 +74,7 @@ cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
   }
   for (const msg::PointMotion& pm : m.motions) {
     p.motions.push_back({Eigen::Vector3d(pm.velocity.x, pm.velocity.y, pm.velocity.z),
-                         Eigen::Map<const RowMajor>(pm.velocity_covariance.data())});
+                         FromWireCovariance(pm.velocity_covariance)});
   }
   return p;
 }

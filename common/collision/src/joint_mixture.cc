@@ -2,6 +2,41 @@
 
 namespace iplan::collision {
 
+void JointMixture::Resize(int num_actions, int steps, int num_joints) {
+  const std::size_t A = static_cast<std::size_t>(num_actions);
+  const std::size_t n = static_cast<std::size_t>(steps) * static_cast<std::size_t>(num_joints);
+  num_steps = steps;
+  actions.resize(A);
+  probabilities.resize(A);
+  means.resize(A);
+  covariances.resize(A);
+  for (std::size_t a = 0; a < A; ++a) {
+    means[a].resize(n, Eigen::Vector3d::Zero());
+    covariances[a].resize(n, Eigen::Matrix3d::Zero());
+  }
+}
+
+JointGaussian JointMixture::Combined(int step, int joint) const {
+  JointGaussian g;
+  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
+  for (int a = 0; a < num_actions(); ++a) {
+    const Eigen::Vector3d& mu = Mean(a, step, joint);
+    const double p = probabilities[static_cast<std::size_t>(a)];
+    g.mean += p * mu;
+    second += p * (Covariance(a, step, joint) + mu * mu.transpose());
+  }
+  g.covariance = second - g.mean * g.mean.transpose();
+  return g;
+}
+
+int JointMixture::MostLikely() const {
+  int best = 0;
+  for (int a = 1; a < num_actions(); ++a) {
+    if (probabilities[static_cast<std::size_t>(a)] > probabilities[static_cast<std::size_t>(best)]) best = a;
+  }
+  return best;
+}
+
 std::optional<std::string> BuildSpherePrediction(const HumanBodyModel& body, const JointMixture& in,
                                                  HumanPrediction* out) {
   const int A = static_cast<int>(in.actions.size());

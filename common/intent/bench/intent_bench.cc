@@ -90,7 +90,7 @@ int main(int argc, char** argv) {
                 model.forecasters[0].gp.num_pseudo_inputs(), config.horizon,
                 model.classifier.import_windows.size());
     const std::vector<Track> tracks = MakeTracks(data, config, 0.6);
-    MixturePrediction pred;
+    JointMixture pred;
     std::vector<double> ms;
     for (int round = 0; round < 5; ++round) {
       for (const Track& t : tracks) {

@@ -31,7 +31,7 @@ std::string BaselinePredictorParams::Validate() const {
 }
 
 void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorXd& stamps,
-                     const Eigen::MatrixXd& positions, MixturePrediction* out) {
+                     const Eigen::MatrixXd& positions, JointMixture* out) {
   if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument("baseline predictor: " + why);
   const Eigen::Index n = stamps.size();
   if (n < 1) throw std::invalid_argument("baseline predictor: no frames");
@@ -75,14 +75,10 @@ void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorX
     b = (dtau.transpose() * (block.rowwise() - a)) / stt;
   }
 
-  out->dt = 1.0 / params.rate;
-  out->horizon = params.horizon;
-  out->num_joints = J;
-  out->actions.resize(1);
-  ActionHypothesis& h = out->actions[0];
-  h.action = ToString(params.kind);
-  h.probability = 1.0;
-  h.joints.resize(static_cast<std::size_t>(params.horizon) * static_cast<std::size_t>(J));
+  out->time_step = 1.0 / params.rate;
+  out->Resize(1, params.horizon, J);
+  out->actions[0] = ToString(params.kind);
+  out->probabilities[0] = 1.0;
   // Constant velocity with one frame falls back to constant position, and
   // then grows as constant position does.
   const double scalar = fit ? params.acceleration_std : params.speed_std;
@@ -101,9 +97,9 @@ void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorX
     const double shape = fit ? 0.5 * t * t : t;
     for (int j = 0; j < J; ++j) {
       const double spread = (per_joint ? params.joint_growth[static_cast<std::size_t>(j)] : scalar) * shape;
-      JointGaussian& g = h.joints[static_cast<std::size_t>(k) * static_cast<std::size_t>(J) + static_cast<std::size_t>(j)];
-      g.mean = mean.segment<3>(3 * j).transpose();
-      g.covariance = (base + spread * spread) * Eigen::Matrix3d::Identity();
+      const std::size_t i = static_cast<std::size_t>(k) * static_cast<std::size_t>(J) + static_cast<std::size_t>(j);
+      out->means[0][i] = mean.segment<3>(3 * j).transpose();
+      out->covariances[0][i] = (base + spread * spread) * Eigen::Matrix3d::Identity();
     }
   }
 }
@@ -120,7 +116,7 @@ std::vector<double> CalibrateBaselineGrowth(const BaselinePredictorParams& param
   no_growth.joint_growth.assign(static_cast<std::size_t>(J), 0.0);
   Eigen::MatrixXd error = Eigen::MatrixXd::Zero(J, H);  // summed squared error per coordinate
   Eigen::VectorXd base = Eigen::VectorXd::Zero(H), count = Eigen::VectorXd::Zero(H);
-  MixturePrediction out;
+  JointMixture out;
   for (const SkeletonSequence& seq : data.sequences) {
     // The usable frames: every selected joint detected.
     std::vector<double> stamps;
@@ -150,9 +146,9 @@ std::vector<double> CalibrateBaselineGrowth(const BaselinePredictorParams& param
         const double u = next == seg ? 0.0 : (t - stamps[seg]) / (stamps[next] - stamps[seg]);
         const Eigen::VectorXd truth = (1 - u) * frames[seg] + u * frames[next];
         for (int j = 0; j < J; ++j) {
-          error(j, k) += (out.At(0, k, j).mean - truth.segment<3>(3 * j)).squaredNorm() / 3.0;
+          error(j, k) += (out.Mean(0, k, j) - truth.segment<3>(3 * j)).squaredNorm() / 3.0;
         }
-        base(k) += out.At(0, k, 0).covariance(0, 0);
+        base(k) += out.Covariance(0, k, 0)(0, 0);
         count(k) += 1;
       }
     }
@@ -184,7 +180,7 @@ void BaselinePredictor::Reset() {
   positions_.clear();
 }
 
-void BaselinePredictor::Update(double stamp, const Eigen::VectorXd& positions, MixturePrediction* out) {
+void BaselinePredictor::Update(double stamp, const Eigen::VectorXd& positions, JointMixture* out) {
   if (positions.size() != 3 * num_joints_) {
     throw std::invalid_argument("baseline predictor: frame has " + std::to_string(positions.size()) +
                                 " coordinates, expected " + std::to_string(3 * num_joints_));

@@ -81,21 +81,21 @@ void CoverageAdapter::Observe(double stamp, const Eigen::Ref<const Eigen::Vector
   }
 }
 
-void CoverageAdapter::Apply(MixturePrediction* pred) const {
-  if (pred->num_joints != num_joints_ || pred->horizon != horizon_) {
-    throw std::invalid_argument("CoverageAdapter::Apply: prediction of " + std::to_string(pred->num_joints) +
-                                " joints x " + std::to_string(pred->horizon) + " steps, expected " +
+void CoverageAdapter::Apply(JointMixture* pred) const {
+  if (pred->num_joints() != num_joints_ || pred->num_steps != horizon_) {
+    throw std::invalid_argument("CoverageAdapter::Apply: prediction of " + std::to_string(pred->num_joints()) +
+                                " joints x " + std::to_string(pred->num_steps) + " steps, expected " +
                                 std::to_string(num_joints_) + " x " + std::to_string(horizon_));
   }
-  for (ActionHypothesis& a : pred->actions) {
+  for (std::vector<Eigen::Matrix3d>& covariances : pred->covariances) {
     for (int k = 0; k < horizon_; ++k) {
-      for (int j = 0; j < num_joints_; ++j) a.joints[k * num_joints_ + j].covariance *= scale_(j);
+      for (int j = 0; j < num_joints_; ++j) covariances[k * num_joints_ + j] *= scale_(j);
     }
   }
 }
 
-void CoverageAdapter::Record(double stamp, const MixturePrediction& pred) {
-  if (pred.num_joints != num_joints_ || pred.horizon != horizon_) {
+void CoverageAdapter::Record(double stamp, const JointMixture& pred) {
+  if (pred.num_joints() != num_joints_ || pred.num_steps != horizon_) {
     throw std::invalid_argument("CoverageAdapter::Record: prediction of the wrong size");
   }
   Stored s;

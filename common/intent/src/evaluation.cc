@@ -34,7 +34,7 @@ double Percentile(std::vector<double> v, double q) {
 // PredictIntent, timing every call (the report's inference percentiles).
 struct TimedPredictor {
   const IntentModel& model;
-  MixturePrediction pred;
+  JointMixture pred;
   std::vector<double> times_ms;
 
   void operator()(const Eigen::MatrixXd& window) {
@@ -75,7 +75,7 @@ std::map<std::string, int> ActionIds(const IntentModel& model, const std::vector
 void ScoreAccuracy(const std::vector<Track>& tracks, const std::map<std::string, int>& action_id,
                    const EvalParams& params, TimedPredictor& timed_predict, EvalReport* report) {
   const IntentModel& model = timed_predict.model;
-  const MixturePrediction& pred = timed_predict.pred;
+  const JointMixture& pred = timed_predict.pred;
   EvalReport& r = *report;
   const int C = static_cast<int>(model.actions.size());
   const int T = model.config.window;
@@ -96,7 +96,7 @@ void ScoreAccuracy(const std::vector<Track>& tracks, const std::map<std::string,
       const int first = std::max(0, e - T + 1);
       const Eigen::MatrixXd window = t.positions.middleRows(first, e - first + 1);
       timed_predict(window);  // as the service: PredictIntent, then the filter
-      for (int c = 0; c < C; ++c) window_p(c) = pred.actions[c].probability;
+      for (int c = 0; c < C; ++c) window_p(c) = pred.probabilities[c];
       filter.UpdateWithWindow(window_p, window, T, e / rate);
       beliefs[e] = filter.probabilities();
     }
@@ -258,7 +258,7 @@ std::vector<int> HandIndices(const IntentModel& model) {
 // the intent service publishes it) and the lines through the recorded frames
 // up to e.
 void ForecastWindow(const Track& t, int e, const EvalParams& params, const IntentModel& model,
-                    const MixturePrediction& pred, WindowForecast* w) {
+                    const JointMixture& pred, WindowForecast* w) {
   const int J = static_cast<int>(model.config.joints.joints.size());
   const int H = model.config.horizon;
   w->combined.resize(static_cast<size_t>(H) * J);
@@ -324,14 +324,14 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
     BeliefFilter filter(static_cast<int>(model.actions.size()), model.classifier.belief);
     CoverageAdapter coverage(J, H, rate, params.coverage);
     Eigen::VectorXd window_p(static_cast<Eigen::Index>(model.actions.size()));
-    MixturePrediction& pred = timed_predict.pred;
+    JointMixture& pred = timed_predict.pred;
     for (int e = 0; e + H <= n - 1; ++e) {
       const int first = std::max(0, e - model.config.window + 1);
       const Eigen::MatrixXd window = t.positions.middleRows(first, e - first + 1);
       timed_predict(window);
-      for (Eigen::Index c = 0; c < window_p.size(); ++c) window_p(c) = pred.actions[c].probability;
+      for (Eigen::Index c = 0; c < window_p.size(); ++c) window_p(c) = pred.probabilities[c];
       filter.UpdateWithWindow(window_p, window, model.config.window, e / rate);
-      for (Eigen::Index c = 0; c < window_p.size(); ++c) pred.actions[c].probability = filter.probabilities()(c);
+      for (Eigen::Index c = 0; c < window_p.size(); ++c) pred.probabilities[c] = filter.probabilities()(c);
       coverage.Observe(e / rate, t.positions.row(e).transpose());
       coverage.Apply(&pred);
       coverage.Record(e / rate, pred);

@@ -64,44 +64,22 @@ void PredictResidual(const ActionForecaster& fc, const Eigen::VectorXd& x, Eigen
 
 }  // namespace detail
 
-JointGaussian MixturePrediction::Combined(int step, int joint) const {
-  JointGaussian g;
-  Eigen::Matrix3d second = Eigen::Matrix3d::Zero();
-  for (size_t c = 0; c < actions.size(); ++c) {
-    const JointGaussian& a = At(static_cast<int>(c), step, joint);
-    const double p = actions[c].probability;
-    g.mean += p * a.mean;
-    second += p * (a.covariance + a.mean * a.mean.transpose());
-  }
-  g.covariance = second - g.mean * g.mean.transpose();
-  return g;
-}
-
-int MixturePrediction::MostLikely() const {
-  int best = 0;
-  for (size_t c = 1; c < actions.size(); ++c) {
-    if (actions[c].probability > actions[best].probability) best = static_cast<int>(c);
-  }
-  return best;
-}
-
 Eigen::VectorXd ClassifyWindow(const IntentModel& model, const Eigen::MatrixXd& window) {
   const FeatureLayout layout(model.config.joints, model.config.features);
   return ClassifyPadded(model, layout, NormaliseWindow(model, window));
 }
 
 void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
-                   MixturePrediction* out) {
+                   JointMixture* out) {
   const FeatureLayout layout(model.config.joints, model.config.features);
   const Eigen::MatrixXd padded = NormaliseWindow(model, window);
   const Eigen::VectorXd p = ClassifyPadded(model, layout, padded);
   const int C = static_cast<int>(model.actions.size());
   const int J = layout.num_joints();
   const int H = model.config.horizon;
-  out->dt = 1.0 / model.config.rate;
-  out->horizon = H;
-  out->num_joints = J;
-  out->actions.resize(C);
+  out->time_step = 1.0 / model.config.rate;
+  out->joint_names = model.config.joints.joints;
+  out->Resize(C, H, J);
   const Eigen::VectorXd x = layout.ForecastInput(padded, model.config.rate, model.config.velocity_frames,
                                                  model.config.history_samples);
   Eigen::MatrixXd base;
@@ -112,21 +90,21 @@ void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
   Eigen::VectorXd mean, var, speeds;
   if (std::isfinite(model.forecast.motion_offset)) MeanJointSpeeds(padded, model.config.rate, &speeds);
   for (int c = 0; c < C; ++c) {
-    ActionHypothesis& hyp = out->actions[c];
-    hyp.action = model.actions[c];
-    hyp.probability = p(c);
-    hyp.joints.resize(static_cast<size_t>(H) * J);
+    out->actions[c] = model.actions[c];
+    out->probabilities[c] = p(c);
     detail::PredictResidual(model.forecasters[c], x, &mean, &var);
     for (int k = 0; k < H; ++k) {
       for (int j = 0; j < J; ++j) {
-        JointGaussian& g = hyp.joints[static_cast<size_t>(k) * J + j];
+        const size_t i = static_cast<size_t>(k) * J + j;
+        Eigen::Vector3d& mu = out->means[c][i];
+        Eigen::Matrix3d& sigma = out->covariances[c][i];
         const int o = (k * J + j) * 3;
         const double s = (scale.size() == 0 ? 1.0 : scale(k * J + j)) *
                          detail::ActivityFactor(model.forecast, speeds, j);
-        g.covariance.setZero();
+        sigma.setZero();
         for (int a = 0; a < 3; ++a) {
-          g.mean(a) = base(k, 3 * j + a) + w * mean(o + a);
-          g.covariance(a, a) = s * (var(o + a) + noise);
+          mu(a) = base(k, 3 * j + a) + w * mean(o + a);
+          sigma(a, a) = s * (var(o + a) + noise);
         }
       }
     }

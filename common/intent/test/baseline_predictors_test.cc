@@ -20,20 +20,20 @@ TEST(BaselinePredictors, ConstantVelocityExtrapolatesAStraightLineExactly) {
   BaselinePredictorParams params;
   params.kind = BaselineKind::kConstantVelocity;
   BaselinePredictor predictor(params, 2);
-  MixturePrediction out;
+  JointMixture out;
   double t = 10.0;
   for (int i = 0; i < 12; ++i, t += 1.0 / 30) predictor.Update(t, LinePose(t), &out);
   const double t0 = t - 1.0 / 30;
   ASSERT_EQ(out.actions.size(), 1u);
-  EXPECT_EQ(out.actions[0].action, "constant_velocity");
-  EXPECT_DOUBLE_EQ(out.actions[0].probability, 1.0);
-  EXPECT_EQ(out.horizon, 15);
-  EXPECT_EQ(out.num_joints, 2);
-  EXPECT_NEAR(out.dt, 1.0 / 15, 1e-15);
-  for (int k = 0; k < out.horizon; ++k) {
-    const Eigen::VectorXd truth = LinePose(t0 + (k + 1) * out.dt);
+  EXPECT_EQ(out.actions[0], "constant_velocity");
+  EXPECT_DOUBLE_EQ(out.probabilities[0], 1.0);
+  EXPECT_EQ(out.num_steps, 15);
+  EXPECT_EQ(out.num_joints(), 2);
+  EXPECT_NEAR(out.time_step, 1.0 / 15, 1e-15);
+  for (int k = 0; k < out.num_steps; ++k) {
+    const Eigen::VectorXd truth = LinePose(t0 + (k + 1) * out.time_step);
     for (int j = 0; j < 2; ++j) {
-      EXPECT_LT((out.At(0, k, j).mean - truth.segment<3>(3 * j)).norm(), 1e-9) << "step " << k << " joint " << j;
+      EXPECT_LT((out.Mean(0, k, j) - truth.segment<3>(3 * j)).norm(), 1e-9) << "step " << k << " joint " << j;
     }
   }
   // Only the fit window (0.25 s at 30 Hz: 8 frames) is kept.
@@ -51,35 +51,35 @@ TEST(BaselinePredictors, ConstantVelocityCovarianceGrowsAsStated) {
   stamps << 0.7, 0.8, 0.9, 1.0;
   Eigen::MatrixXd positions(4, 3);
   for (int i = 0; i < 4; ++i) positions.row(i) = LinePose(stamps(i)).head<3>().transpose();
-  MixturePrediction out;
+  JointMixture out;
   PredictBaseline(params, stamps, positions, &out);
   const double sn2 = 1e-4;
   for (int k : {0, 4, 9}) {
     const double t = (k + 1) * 0.1;
     const double accel = 0.5 * 1.0 * t * t;
     const double expected = sn2 + sn2 * (0.25 + (t + 0.15) * (t + 0.15) / 0.05) + accel * accel;
-    const Eigen::Matrix3d& c = out.At(0, k, 0).covariance;
+    const Eigen::Matrix3d& c = out.Covariance(0, k, 0);
     EXPECT_NEAR(c(0, 0), expected, 1e-12) << "step " << k;
     EXPECT_NEAR(c(2, 2), expected, 1e-12);
     EXPECT_DOUBLE_EQ(c(0, 1), 0.0);
   }
-  EXPECT_GT(out.At(0, 9, 0).covariance(0, 0), out.At(0, 0, 0).covariance(0, 0));
+  EXPECT_GT(out.Covariance(0, 9, 0)(0, 0), out.Covariance(0, 0, 0)(0, 0));
 }
 
 TEST(BaselinePredictors, ConstantPositionHoldsTheNewestObservation) {
   BaselinePredictorParams params;
   params.kind = BaselineKind::kConstantPosition;
   BaselinePredictor predictor(params, 2);
-  MixturePrediction out;
+  JointMixture out;
   double t = 0.0;
   for (int i = 0; i < 10; ++i, t += 1.0 / 30) predictor.Update(t, LinePose(t), &out);
   const Eigen::VectorXd last = LinePose(t - 1.0 / 30);
-  EXPECT_EQ(out.actions[0].action, "constant_position");
-  for (int k = 0; k < out.horizon; ++k) {
+  EXPECT_EQ(out.actions[0], "constant_position");
+  for (int k = 0; k < out.num_steps; ++k) {
     for (int j = 0; j < 2; ++j) {
-      EXPECT_EQ(out.At(0, k, j).mean, Eigen::Vector3d(last.segment<3>(3 * j))) << "step " << k;
+      EXPECT_EQ(out.Mean(0, k, j), Eigen::Vector3d(last.segment<3>(3 * j))) << "step " << k;
       const double s = 0.25 * (k + 1) / 15.0;
-      EXPECT_NEAR(out.At(0, k, j).covariance(1, 1), 1e-4 + s * s, 1e-15);
+      EXPECT_NEAR(out.Covariance(0, k, j)(1, 1), 1e-4 + s * s, 1e-15);
     }
   }
 }
@@ -87,10 +87,10 @@ TEST(BaselinePredictors, ConstantPositionHoldsTheNewestObservation) {
 TEST(BaselinePredictors, ConstantVelocityWithOneFrameHoldsAndIsStillUsable) {
   BaselinePredictorParams params;
   BaselinePredictor predictor(params, 2);
-  MixturePrediction out;
+  JointMixture out;
   predictor.Update(3.0, LinePose(3.0), &out);
-  EXPECT_EQ(out.At(0, 14, 1).mean, Eigen::Vector3d(LinePose(3.0).segment<3>(3)));
-  EXPECT_GT(out.At(0, 14, 1).covariance(0, 0), 1e-4);
+  EXPECT_EQ(out.Mean(0, 14, 1), Eigen::Vector3d(LinePose(3.0).segment<3>(3)));
+  EXPECT_GT(out.Covariance(0, 14, 1)(0, 0), 1e-4);
 }
 
 TEST(BaselinePredictors, PerJointGrowthReplacesTheScalar) {
@@ -100,11 +100,11 @@ TEST(BaselinePredictors, PerJointGrowthReplacesTheScalar) {
   Eigen::VectorXd stamps(1);
   stamps << 2.0;
   Eigen::MatrixXd positions = LinePose(2.0).transpose();
-  MixturePrediction out;
+  JointMixture out;
   PredictBaseline(params, stamps, positions, &out);
   const double t = 15 / 15.0;
-  EXPECT_NEAR(out.At(0, 14, 0).covariance(0, 0), 1e-4, 1e-15);
-  EXPECT_NEAR(out.At(0, 14, 1).covariance(0, 0), 1e-4 + 0.25 * t * t, 1e-15);
+  EXPECT_NEAR(out.Covariance(0, 14, 0)(0, 0), 1e-4, 1e-15);
+  EXPECT_NEAR(out.Covariance(0, 14, 1)(0, 0), 1e-4 + 0.25 * t * t, 1e-15);
   params.joint_growth = {0.1};
   EXPECT_THROW(PredictBaseline(params, stamps, positions, &out), std::invalid_argument);
 }
@@ -152,7 +152,7 @@ TEST(BaselinePredictors, RefusesBadInputNamingIt) {
   bad.window = 0;
   EXPECT_THROW(BaselinePredictor(bad, 1), std::invalid_argument);
   BaselinePredictor predictor(BaselinePredictorParams{}, 2);
-  MixturePrediction out;
+  JointMixture out;
   predictor.Update(1.0, LinePose(1.0), &out);
   try {
     predictor.Update(1.0, LinePose(1.0), &out);

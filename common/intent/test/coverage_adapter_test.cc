@@ -11,15 +11,15 @@ namespace {
 
 // A one-joint, one-action prediction of `horizon` steps: mean at the origin,
 // isotropic covariance sigma^2 I.
-MixturePrediction Still(int horizon, double sigma) {
-  MixturePrediction p;
-  p.horizon = horizon;
-  p.num_joints = 1;
-  p.dt = 0.1;
-  p.actions.resize(1);
-  p.actions[0].probability = 1.0;
-  p.actions[0].joints.resize(horizon);
-  for (JointGaussian& g : p.actions[0].joints) g.covariance = sigma * sigma * Eigen::Matrix3d::Identity();
+JointMixture Still(int horizon, double sigma) {
+  JointMixture p;
+  p.time_step = 0.1;
+  p.Resize(1, horizon, 1);
+  p.probabilities[0] = 1.0;
+  for (int k = 0; k < horizon; ++k) {
+    p.means[0][k].setZero();
+    p.covariances[0][k] = sigma * sigma * Eigen::Matrix3d::Identity();
+  }
   return p;
 }
 
@@ -48,10 +48,10 @@ std::pair<double, double> RunPerson(double truth, double model, double seconds, 
       ++scored;
       log_scale += std::log(a.variance_scales()(0));
     }
-    MixturePrediction p = Still(H, model);
+    JointMixture p = Still(H, model);
     a.Apply(&p);
     a.Record(t, p);
-    published.emplace_back(t, p.actions[0].joints[0].covariance);
+    published.emplace_back(t, p.covariances[0][0]);
   }
   return {static_cast<double>(inside) / std::max<long>(1, scored), std::exp(log_scale / std::max<long>(1, scored))};
 }
@@ -84,7 +84,7 @@ TEST(CoverageAdapterTest, ResetForgetsAndBadInputIsRefused) {
   CoverageAdapter a(1, 4, 10.0);
   for (int f = 0; f < 100; ++f) {
     a.Observe(f / 10.0, Eigen::Vector3d::Zero());
-    MixturePrediction p = Still(4, 1.0);
+    JointMixture p = Still(4, 1.0);
     a.Apply(&p);
     a.Record(f / 10.0, p);
   }
@@ -92,7 +92,7 @@ TEST(CoverageAdapterTest, ResetForgetsAndBadInputIsRefused) {
   a.Reset();
   EXPECT_EQ(a.variance_scales()(0), 1.0);
   EXPECT_THROW(a.Observe(11.0, Eigen::VectorXd::Zero(6)), std::invalid_argument);
-  MixturePrediction wrong = Still(5, 1.0);
+  JointMixture wrong = Still(5, 1.0);
   EXPECT_THROW(a.Apply(&wrong), std::invalid_argument);
   EXPECT_THROW(CoverageAdapter(0, 4, 10.0), std::invalid_argument);
   CoverageAdapterParams bad;

@@ -99,12 +99,12 @@ TEST_F(IntentModelTest, ClassifiesAndForecastsHeldOutSequences) {
   // The lifting wrist moves at constant speed then stops: the model must beat
   // holding the pose at the last horizon step.
   EXPECT_LT(r.error_model.back(), r.error_const_position.back());
-  MixturePrediction pred;
+  JointMixture pred;
   PredictIntent(*model_, test.sequences[0].positions.topRows(3), &pred);
   double sum = 0.0;
-  for (const ActionHypothesis& h : pred.actions) sum += h.probability;
+  for (double q : pred.probabilities) sum += q;
   EXPECT_NEAR(sum, 1.0, 1e-12);
-  EXPECT_EQ(pred.actions[0].joints.size(), 5u * 6u);
+  EXPECT_EQ(pred.means[0].size(), 5u * 6u);
   EXPECT_THROW(PredictIntent(*model_, Eigen::MatrixXd::Zero(3, 17), &pred), std::invalid_argument);
 }
 
@@ -126,15 +126,15 @@ TEST_F(IntentModelTest, SaveLoadRoundTripsBitExactly) {
   EXPECT_EQ(odd_loaded.classifier.belief.time_constant, std::numeric_limits<double>::infinity());
   EXPECT_EQ(odd_loaded.classifier.belief.min_probability, 0.02);
   EXPECT_TRUE(odd_loaded.classifier.belief.motion_weighted);
-  MixturePrediction a, b;
+  JointMixture a, b;
   const Eigen::MatrixXd window = data_->sequences[5].positions.topRows(12);
   PredictIntent(*model_, window, &a);
   PredictIntent(loaded, window, &b);
   for (size_t c = 0; c < a.actions.size(); ++c) {
-    EXPECT_EQ(a.actions[c].probability, b.actions[c].probability);
-    for (size_t k = 0; k < a.actions[c].joints.size(); ++k) {
-      EXPECT_EQ(a.actions[c].joints[k].mean, b.actions[c].joints[k].mean);
-      EXPECT_EQ(a.actions[c].joints[k].covariance, b.actions[c].joints[k].covariance);
+    EXPECT_EQ(a.probabilities[c], b.probabilities[c]);
+    for (size_t k = 0; k < a.means[c].size(); ++k) {
+      EXPECT_EQ(a.means[c][k], b.means[c][k]);
+      EXPECT_EQ(a.covariances[c][k], b.covariances[c][k]);
     }
   }
 }
@@ -262,14 +262,14 @@ TEST_F(IntentModelTest, ForecastSettingsRoundTripAndFormat2And3FilesStillLoad) {
   EXPECT_TRUE(std::isinf(old.forecast.motion_offset));
   IntentModel legacy = m0;
   legacy.forecast = old.forecast;
-  MixturePrediction a, b;
+  JointMixture a, b;
   const Eigen::MatrixXd window = data_->sequences[2].positions.topRows(12);
   PredictIntent(old, window, &a);
   PredictIntent(legacy, window, &b);
   for (size_t c = 0; c < a.actions.size(); ++c) {
-    for (size_t k = 0; k < a.actions[c].joints.size(); ++k) {
-      EXPECT_EQ(a.actions[c].joints[k].mean, b.actions[c].joints[k].mean);
-      EXPECT_EQ(a.actions[c].joints[k].covariance, b.actions[c].joints[k].covariance);
+    for (size_t k = 0; k < a.means[c].size(); ++k) {
+      EXPECT_EQ(a.means[c][k], b.means[c][k]);
+      EXPECT_EQ(a.covariances[c][k], b.covariances[c][k]);
     }
   }
   // Re-saved, it becomes a format-4 file with the same predictions.
@@ -342,7 +342,7 @@ TEST(ForecasterTest, ResidualForecasterExtrapolatesConstantVelocityMotion) {
   // Windows with a full history (shorter ones are padded by holding the
   // first frame, which slows the fitted line down).
   const std::vector<Track> tracks = MakeTracks(test, model.config, p.max_gap);
-  MixturePrediction pred;
+  JointMixture pred;
   double model_error = 0.0, hold_error = 0.0;
   int count = 0;
   for (const Track& t : tracks) {
@@ -478,17 +478,17 @@ IntentModelConfig OneJointConfig(const std::vector<std::string>& torso) {
   return c;
 }
 
-void ExpectFinitePrediction(const MixturePrediction& pred, int horizon) {
-  ASSERT_EQ(pred.num_joints, 1);
-  ASSERT_EQ(pred.horizon, horizon);
+void ExpectFinitePrediction(const JointMixture& pred, int horizon) {
+  ASSERT_EQ(pred.num_joints(), 1);
+  ASSERT_EQ(pred.num_steps, horizon);
   double sum = 0.0;
-  for (const ActionHypothesis& h : pred.actions) {
-    sum += h.probability;
-    ASSERT_EQ(h.joints.size(), static_cast<size_t>(horizon));
-    for (const JointGaussian& g : h.joints) {
-      EXPECT_TRUE(g.mean.allFinite());
-      EXPECT_TRUE(g.covariance.allFinite());
-      EXPECT_GT(g.covariance.diagonal().minCoeff(), 0.0);
+  for (int a = 0; a < pred.num_actions(); ++a) {
+    sum += pred.probabilities[a];
+    ASSERT_EQ(pred.means[a].size(), static_cast<size_t>(horizon));
+    for (int k = 0; k < horizon; ++k) {
+      EXPECT_TRUE(pred.Mean(a, k, 0).allFinite());
+      EXPECT_TRUE(pred.Covariance(a, k, 0).allFinite());
+      EXPECT_GT(pred.Covariance(a, k, 0).diagonal().minCoeff(), 0.0);
     }
   }
   EXPECT_NEAR(sum, 1.0, 1e-9);
@@ -505,7 +505,7 @@ TEST(OneJointModelTest, WristOnlyModelTrainsPredictsAndEvaluates) {
     const IntentModel model = TrainIntentModel(train, OneJointConfig(torso), SmallParams());
     EXPECT_EQ(model.config.joints.torso, torso);
     EXPECT_EQ(model.actions.size(), 9u);
-    MixturePrediction pred;
+    JointMixture pred;
     PredictIntent(model, test.sequences[0].positions.topRows(10), &pred);
     ExpectFinitePrediction(pred, 5);
     PredictIntent(model, test.sequences[3].positions.topRows(1), &pred);  // a single frame

@@ -66,7 +66,7 @@ struct Problem {
   // One predicted person: the prediction and the step of each waypoint (planner.h).
   struct Person {
     const collision::HumanPrediction* prediction = nullptr;
-    double dt = 0.1, start = 0.0;
+    double time_step = 0.1, start = 0.0;  // s
     std::vector<int> steps;
   };
   std::vector<Person> people;  // empty: nobody

@@ -46,7 +46,7 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
     const PersonPrediction& person = req.people[p];
     const std::string who = "person " + std::to_string(p) + ": ";
     if (!person.spheres) Bad(who + "prediction is null");
-    if (!(person.dt > 0.0) || !std::isfinite(person.dt)) Bad(who + "dt must be > 0, got " + std::to_string(person.dt));
+    if (!(person.time_step > 0.0) || !std::isfinite(person.time_step)) Bad(who + "time_step must be > 0 s, got " + std::to_string(person.time_step));
     if (!std::isfinite(person.start)) Bad(who + "start must be finite, got " + std::to_string(person.start));
   }
   if (!req.obstacles.empty()) {
@@ -100,7 +100,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
         std::to_string(at.n) + " intervals");
   at.qdot0 = req.start_qdot.size() != 0 ? req.start_qdot : Eigen::VectorXd::Zero(nq);
   at.q_goal = q_goal;
-  for (const PersonPrediction& person : req.people) at.people.push_back({person.spheres, person.dt, person.start, {}});
+  for (const PersonPrediction& person : req.people) at.people.push_back({person.spheres, person.time_step, person.start, {}});
   at.base.resize(nq, at.n + 1);
   if (warm && stretched) {
     // The frozen prefix, then straight to the goal over the stretched time.
@@ -170,7 +170,7 @@ void PlannerModel::SetSteps(Problem* at) const {
     person.steps.assign(at->n + 1, 0);
     const int last = person.prediction->num_steps() - 1;
     for (int i = 0; i <= at->n; ++i) {
-      const double s = std::round((i * at->dt - person.start) / person.dt);
+      const double s = std::round((i * at->dt - person.start) / person.time_step);
       person.steps[i] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(last)));
     }
   }

@@ -95,7 +95,7 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
             if (t_next > t_prev) {
               for (int a = 0; a < hp.num_actions(); ++a)
                 v_h_max = std::max(v_h_max, (hp.sphere(a, t_next, l).mean - hp.sphere(a, t_prev, l).mean).norm());
-              v_h_max /= person.dt * (t_next - t_prev);
+              v_h_max /= person.time_step * (t_next - t_prev);
             }
             if (far >= reach + safety::ProtectiveSeparationDistance(s, v_h_max, v_r_max)) continue;
           }
@@ -105,7 +105,7 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
             const Eigen::Vector3d& mu = hp.sphere(a, t, l).mean;
             const Eigen::Vector3d v_h =
                 t_next > t_prev ? Eigen::Vector3d((hp.sphere(a, t_next, l).mean - hp.sphere(a, t_prev, l).mean) /
-                                                  (person.dt * (t_next - t_prev)))
+                                                  (person.time_step * (t_next - t_prev)))
                                 : Eigen::Vector3d::Zero();
             for (int sp : link_groups[g]) {
               const Eigen::Vector3d delta = d.p_WS.col(sp) - mu;

@@ -231,7 +231,7 @@ TEST_F(PlannerTest, RefusesAPersonWithoutAPrediction) {
     planner_.Plan(req);
     ADD_FAILURE() << "dt 0 accepted";
   } catch (const std::invalid_argument& e) {
-    EXPECT_NE(std::string(e.what()).find("person 1: dt must be > 0"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("person 1: time_step must be > 0 s"), std::string::npos) << e.what();
   }
 }
 

@@ -55,7 +55,7 @@ int IntentEstimator::buffered_frames(std::uint32_t body_id) const {
   return it == bodies_.end() ? 0 : static_cast<int>(it->second.stamps.size());
 }
 
-FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixturePrediction* out) {
+FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::JointMixture* out) {
   if (!std::isfinite(frame.stamp)) return {FrameStatus::kStampNotIncreasing, "stamp is not finite"};
   // Model joints by name; joints the model does not use are ignored.
   std::fill(seen_.begin(), seen_.end(), 0);
@@ -109,14 +109,9 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, intent::MixtureP
   }
   BuildWindow(body);
   intent::PredictIntent(*model_, window_, out);
-  window_probabilities_.resize(static_cast<Eigen::Index>(out->actions.size()));
-  for (std::size_t c = 0; c < out->actions.size(); ++c) {
-    window_probabilities_(static_cast<Eigen::Index>(c)) = out->actions[c].probability;
-  }
+  window_probabilities_ = Eigen::Map<const Eigen::VectorXd>(out->probabilities.data(), out->num_actions());
   body.belief.UpdateWithWindow(window_probabilities_, window_, model_->config.window, frame.stamp);
-  for (std::size_t c = 0; c < out->actions.size(); ++c) {
-    out->actions[c].probability = body.belief.probabilities()(static_cast<Eigen::Index>(c));
-  }
+  for (int c = 0; c < out->num_actions(); ++c) out->probabilities[static_cast<std::size_t>(c)] = body.belief.probabilities()(c);
   // Score the body's earlier forecasts that mature now, then calibrate this one.
   body.coverage.Observe(frame.stamp, scratch_);
   body.coverage.Apply(out);

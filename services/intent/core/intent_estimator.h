@@ -105,7 +105,7 @@ class IntentEstimator {
   /// its action probabilities being the body's belief over its windows so far,
   /// and bodies unseen for longer than body_timeout before frame.stamp are
   /// dropped. A rejected frame changes nothing.
-  FrameResult Update(const SkeletonFrame& frame, intent::MixturePrediction* out);
+  FrameResult Update(const SkeletonFrame& frame, collision::JointMixture* out);
 
   /// Forgets bodies whose newest frame is older than now - body_timeout
   /// (now in the stamps' clock, s). Returns how many were dropped.

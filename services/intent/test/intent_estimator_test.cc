@@ -25,7 +25,7 @@ intent::TrainParams SmallTrainParams() {
 }
 
 using intent::IntentModel;
-using intent::MixturePrediction;
+using collision::JointMixture;
 
 const std::vector<std::string> kJoints = {"wrist_l", "wrist_r", "elbow_l", "elbow_r", "shoulder_l", "shoulder_r"};
 
@@ -112,16 +112,16 @@ Eigen::RowVectorXd ModelRow(const IntentModel& m, const Eigen::VectorXd& p) {
   return row;
 }
 
-void ExpectSamePrediction(const MixturePrediction& a, const MixturePrediction& b, double tol,
+void ExpectSamePrediction(const JointMixture& a, const JointMixture& b, double tol,
                           bool compare_probabilities = true) {
   ASSERT_EQ(a.actions.size(), b.actions.size());
   for (std::size_t c = 0; c < a.actions.size(); ++c) {
     if (compare_probabilities) {
-      EXPECT_NEAR(a.actions[c].probability, b.actions[c].probability, tol);
+      EXPECT_NEAR(a.probabilities[c], b.probabilities[c], tol);
     }
-    ASSERT_EQ(a.actions[c].joints.size(), b.actions[c].joints.size());
-    for (std::size_t k = 0; k < a.actions[c].joints.size(); ++k) {
-      EXPECT_LE((a.actions[c].joints[k].mean - b.actions[c].joints[k].mean).norm(), tol);
+    ASSERT_EQ(a.means[c].size(), b.means[c].size());
+    for (std::size_t k = 0; k < a.means[c].size(); ++k) {
+      EXPECT_LE((a.means[c][k] - b.means[c][k]).norm(), tol);
     }
   }
 }
@@ -132,7 +132,7 @@ TEST_F(IntentEstimatorTest, FramesAtTheModelRateGiveTheLibraryPredictionOfTheSam
   const int C = static_cast<int>(model_->actions.size());
   const double dt = 1.0 / model_->config.rate;
   Eigen::MatrixXd rows(0, 18);
-  MixturePrediction got, want;
+  JointMixture got, want;
   // The evaluation's recipe: per-window probabilities through the model's
   // belief filter, fed with the observed (unpadded) last T rows.
   intent::BeliefFilter belief(C, model_->classifier.belief);
@@ -145,17 +145,17 @@ TEST_F(IntentEstimatorTest, FramesAtTheModelRateGiveTheLibraryPredictionOfTheSam
     rows.conservativeResize(rows.rows() + 1, Eigen::NoChange);
     rows.row(rows.rows() - 1) = ModelRow(*model_, p);
     intent::PredictIntent(*model_, rows, &want);  // pads / takes the last T rows itself
-    for (int c = 0; c < C; ++c) window_p(c) = want.actions[c].probability;
+    for (int c = 0; c < C; ++c) window_p(c) = want.probabilities[c];
     belief.UpdateWithWindow(window_p, rows.bottomRows(std::min<Eigen::Index>(rows.rows(), T)), T, t);
     accumulated = belief.num_updates();
-    for (int c = 0; c < C; ++c) want.actions[c].probability = belief.probabilities()(c);
+    for (int c = 0; c < C; ++c) want.probabilities[c] = belief.probabilities()(c);
     ExpectSamePrediction(got, want, 1e-9);
   }
   // The partial window ending at frame T - 2 (the whole history then) and the
   // full windows ending at frames T - 1 ... T + 3.
   EXPECT_EQ(accumulated, 6);
-  EXPECT_EQ(got.horizon, model_->config.horizon);
-  EXPECT_EQ(got.num_joints, 6);
+  EXPECT_EQ(got.num_steps, model_->config.horizon);
+  EXPECT_EQ(got.num_joints(), 6);
   EXPECT_EQ(model_->actions[got.MostLikely()], "raise_right");
 }
 
@@ -166,7 +166,7 @@ TEST_F(IntentEstimatorTest, FasterFramesAreResampledToTheModelRate) {
   const double dt = 1.0 / model_->config.rate;
   const Eigen::VectorXd velocity = Eigen::VectorXd::LinSpaced(18, -0.2, 0.3);
   auto pose = [&](double t) -> Eigen::VectorXd { return Rest() + velocity * t; };
-  MixturePrediction got, want;
+  JointMixture got, want;
   double t = 0;
   for (int i = 0; i < 30; ++i) {
     t = i / 40.0;
@@ -178,13 +178,13 @@ TEST_F(IntentEstimatorTest, FasterFramesAreResampledToTheModelRate) {
   // Same forecasts; the probabilities are the belief over all windows so far.
   ExpectSamePrediction(got, want, 1e-9, /*compare_probabilities=*/false);
   double sum = 0;
-  for (const auto& h : got.actions) sum += h.probability;
+  for (double q : got.probabilities) sum += q;
   EXPECT_NEAR(sum, 1.0, 1e-9);
 }
 
 TEST_F(IntentEstimatorTest, ClassifiesARaisedLeftWristFromA30HzStream) {
   IntentEstimator est(model_, {});
-  MixturePrediction got;
+  JointMixture got;
   for (int i = 0; i < 40; ++i) ASSERT_TRUE(est.Update(Frame(2, i / 30.0, Pose(0, i / 30.0)), &got).accepted());
   EXPECT_EQ(model_->actions[got.MostLikely()], "raise_left");
   IntentEstimator still(model_, {});
@@ -194,9 +194,9 @@ TEST_F(IntentEstimatorTest, ClassifiesARaisedLeftWristFromA30HzStream) {
 
 TEST_F(IntentEstimatorTest, BadFramesAreRejectedWithAReasonAndChangeNothing) {
   IntentEstimator est(model_, {});
-  MixturePrediction out;
+  JointMixture out;
   ASSERT_TRUE(est.Update(Frame(1, 10.0, Rest()), &out).accepted());
-  const MixturePrediction before = out;
+  const JointMixture before = out;
 
   SkeletonFrame missing = Frame(1, 10.1, Rest());
   missing.joints.erase(missing.joints.begin() + 1);  // wrist_r
@@ -253,7 +253,7 @@ TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
   p.max_gap = 0.3;
   p.max_bodies = 2;
   IntentEstimator est(model_, p);
-  MixturePrediction out;
+  JointMixture out;
   ASSERT_TRUE(est.Update(Frame(1, 1.0, Rest()), &out).accepted());
   ASSERT_TRUE(est.Update(Frame(2, 0.9, Rest()), &out).accepted());  // own stamp history
   EXPECT_EQ(est.Update(Frame(3, 1.1, Rest()), &out).status, FrameStatus::kTooManyBodies);
@@ -267,7 +267,7 @@ TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
   // and so does its belief (the prediction is that of the single new frame).
   ASSERT_TRUE(est.Update(Frame(1, 1.5, Rest()), &out).accepted());
   EXPECT_EQ(est.buffered_frames(1), 1);
-  MixturePrediction single;
+  JointMixture single;
   intent::PredictIntent(*model_, ModelRow(*model_, Rest()), &single);
   ExpectSamePrediction(out, single, 1e-9);
   // A frame of body 3 two timeouts later drops body 1 (not seen since 1.5 s).
@@ -278,7 +278,7 @@ TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
 
 TEST_F(IntentEstimatorTest, HistoryIsBoundedByTheWindowSpan) {
   IntentEstimator est(model_, {});
-  MixturePrediction out;
+  JointMixture out;
   for (int i = 0; i < 300; ++i) ASSERT_TRUE(est.Update(Frame(1, i / 30.0, Rest()), &out).accepted());
   const double span = (model_->config.window - 1) / model_->config.rate;
   EXPECT_LE(est.buffered_frames(1), static_cast<int>(std::ceil(span * 30)) + 2);
@@ -311,7 +311,7 @@ TEST(OneJointEstimatorTest, AcceptsOneJointSkeletonsAndRejectsFramesWithoutIt) {
 
   const intent::SkeletonDataset played = only_wrist({"s02"});
   const intent::SkeletonSequence& seq = played.sequences.at(0);
-  MixturePrediction got;
+  JointMixture got;
   for (Eigen::Index i = 0; i < seq.positions.rows(); ++i) {
     SkeletonFrame f;
     f.body_id = 4;
@@ -320,15 +320,15 @@ TEST(OneJointEstimatorTest, AcceptsOneJointSkeletonsAndRejectsFramesWithoutIt) {
     f.joints.push_back({"wrist_l", Eigen::Vector3d(0.1, 0.2, 2.0)});  // not a model joint: ignored
     const FrameResult r = est.Update(f, &got);
     ASSERT_TRUE(r.accepted()) << r.reason;
-    ASSERT_EQ(got.num_joints, 1);
-    ASSERT_EQ(got.horizon, 4);
+    ASSERT_EQ(got.num_joints(), 1);
+    ASSERT_EQ(got.num_steps, 4);
     double sum = 0;
-    for (const auto& h : got.actions) {
-      sum += h.probability;
-      ASSERT_EQ(h.joints.size(), 4u);
-      for (const auto& g : h.joints) {
-        EXPECT_TRUE(g.mean.allFinite());
-        EXPECT_TRUE(g.covariance.allFinite());
+    for (int a = 0; a < got.num_actions(); ++a) {
+      sum += got.probabilities[a];
+      ASSERT_EQ(got.means[a].size(), 4u);
+      for (int k = 0; k < 4; ++k) {
+        EXPECT_TRUE(got.Mean(a, k, 0).allFinite());
+        EXPECT_TRUE(got.Covariance(a, k, 0).allFinite());
       }
     }
     EXPECT_NEAR(sum, 1.0, 1e-9);
@@ -336,7 +336,7 @@ TEST(OneJointEstimatorTest, AcceptsOneJointSkeletonsAndRejectsFramesWithoutIt) {
   // Forecasts are positions in the skeletons' frame: one step (1/15 s) ahead
   // the wrist is near where it is now.
   const Eigen::Vector3d now = seq.positions.bottomRows(1).transpose();
-  for (int a = 0; a < static_cast<int>(got.actions.size()); ++a) EXPECT_LE((got.At(a, 0, 0).mean - now).norm(), 0.3);
+  for (int a = 0; a < static_cast<int>(got.actions.size()); ++a) EXPECT_LE((got.Mean(a, 0, 0) - now).norm(), 0.3);
 
   // A skeleton without the model's joint is a counted rejection naming it.
   SkeletonFrame no_wrist;

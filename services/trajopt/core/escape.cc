@@ -36,7 +36,7 @@ double HoldBound(const planning::Planner& planner, const planning::PlanningReque
     collision::TrajectoryBoundWorkspace workspace(S, person.spheres->num_spheres());
     const int last = person.spheres->num_steps() - 1;
     for (int w = 0; w < n; ++w) {  // waypoint w + 1 at (w + 1) dt, its nearest step (planner.h)
-      const double s = std::round(((w + 1) * dt - person.start) / person.dt);
+      const double s = std::round(((w + 1) * dt - person.start) / person.time_step);
       traj.steps[static_cast<std::size_t>(w)] = static_cast<int>(std::clamp(s, 0.0, static_cast<double>(last)));
     }
     collision::EvaluateTrajectoryBound(*person.spheres, traj, collision::TrajectoryBoundParams{}, &workspace, &bounds);

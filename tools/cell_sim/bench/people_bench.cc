@@ -72,14 +72,14 @@ const Scene& GetScene() {
       p.seed += static_cast<uint64_t>(b);
       perception::SyntheticPerson person(p);
       intent_service::IntentEstimator estimator(s.model, s.cell.estimator);
-      intent::MixturePrediction mixture;
+      collision::JointMixture mixture;
       s.frames.emplace_back();
       s.predictions.emplace_back();
       for (int f = 0; f < kFrames; ++f) {
         intent_service::SkeletonFrame frame{1, f / kRate, ToObservation(person.Observe(f / kRate))};
         s.frames.back().push_back(frame.joints);
         if (!estimator.Update(frame, &mixture).accepted()) throw std::runtime_error("synthetic frame rejected");
-        s.predictions.back().push_back(ToJointMixture(mixture, s.joints, SimTimeNs(f / kRate)));
+        s.predictions.back().push_back(Stamped(mixture, s.joints, SimTimeNs(f / kRate)));
       }
     }
     return s;
@@ -125,7 +125,7 @@ void BM_Intent(benchmark::State& state) {
   const Scene& s = GetScene();
   const int n = static_cast<int>(state.range(0));
   intent_service::IntentEstimator estimator(s.model, s.cell.estimator);
-  intent::MixturePrediction out;
+  collision::JointMixture out;
   Timings timing;
   int64_t k = 0;
   for (auto _ : state) {

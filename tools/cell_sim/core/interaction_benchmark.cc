@@ -169,28 +169,10 @@ PersonStream MakePersonStream(const BenchmarkSetup& setup, const ScenarioSpec& s
 
 using namespace internal;
 
-collision::JointMixture ToJointMixture(const intent::MixturePrediction& m, const std::vector<std::string>& joints,
-                                       int64_t t0_ns) {
-  collision::JointMixture out;
-  out.t0_ns = t0_ns;
-  out.time_step = m.dt;
-  out.num_steps = m.horizon;
-  out.joint_names = joints;
-  for (const auto& a : m.actions) {
-    out.actions.push_back(a.action);
-    out.probabilities.push_back(a.probability);
-    std::vector<Eigen::Vector3d> means;
-    std::vector<Eigen::Matrix3d> covs;
-    means.reserve(a.joints.size());
-    covs.reserve(a.joints.size());
-    for (const auto& g : a.joints) {
-      means.push_back(g.mean);
-      covs.push_back(g.covariance);
-    }
-    out.means.push_back(std::move(means));
-    out.covariances.push_back(std::move(covs));
-  }
-  return out;
+collision::JointMixture Stamped(collision::JointMixture m, const std::vector<std::string>& joints, int64_t t0_ns) {
+  m.t0_ns = t0_ns;
+  m.joint_names = joints;
+  return m;
 }
 
 const char* ToString(Predictor p) {

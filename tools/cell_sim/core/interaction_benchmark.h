@@ -83,10 +83,9 @@
 
 namespace iplan::cell_sim {
 
-/// The intent library's prediction as the cell's joint-level mixture
-/// (collision::JointMixture) for the observation at t0_ns, joints named `joints`.
-collision::JointMixture ToJointMixture(const intent::MixturePrediction& m, const std::vector<std::string>& joints,
-                                       int64_t t0_ns);
+/// An intent core's prediction `m` as one of the observation at t0_ns (ns,
+/// simulated time), its joints named `joints`.
+collision::JointMixture Stamped(collision::JointMixture m, const std::vector<std::string>& joints, int64_t t0_ns);
 
 enum class Predictor { kNone, kConstantPosition, kConstantVelocity, kModel, kOracle };
 

@@ -63,7 +63,7 @@ class ModelTrack {
     frame_.stamp = static_cast<double>(t0) * 1e-9;
     for (std::size_t j = 0; j < joints_.size(); ++j) frame_.joints[j].position = seen.col(body_index_[j]);
     const intent_service::FrameResult r = estimator_.Update(frame_, &mixture_);
-    mixtures_.push_back(r.accepted() ? ToJointMixture(mixture_, joints_, t0) : collision::JointMixture{});
+    mixtures_.push_back(r.accepted() ? Stamped(mixture_, joints_, t0) : collision::JointMixture{});
     done_.push_back(r.accepted());
   }
 
@@ -72,7 +72,7 @@ class ModelTrack {
   std::vector<std::string> joints_;
   std::vector<int> body_index_;
   intent_service::SkeletonFrame frame_;
-  intent::MixturePrediction mixture_;
+  collision::JointMixture mixture_;
   std::vector<collision::JointMixture> mixtures_;
   std::vector<bool> done_;
 };
@@ -90,7 +90,7 @@ class BaselineSource {
       const Eigen::Matrix3Xd& seen = person_.observed[static_cast<std::size_t>(last_)];
       const Eigen::VectorXd p = Eigen::Map<const Eigen::VectorXd>(seen.data(), seen.size());
       predictor_.Update(person_.stamp(last_), p, &mixture_);
-      current_ = ToJointMixture(mixture_, person_.joint_names, SimTimeNs(person_.stamp(last_)));
+      current_ = Stamped(mixture_, person_.joint_names, SimTimeNs(person_.stamp(last_)));
     }
     return last_ == frame ? &current_ : nullptr;
   }
@@ -98,7 +98,7 @@ class BaselineSource {
  private:
   const PersonStream& person_;
   intent::BaselinePredictor predictor_;
-  intent::MixturePrediction mixture_;
+  collision::JointMixture mixture_;
   collision::JointMixture current_;
   int last_ = -1;
 };

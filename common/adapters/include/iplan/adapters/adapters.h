@@ -2,6 +2,7 @@
 // cores, shared by the services (the only place where both meet).
 #pragma once
 
+#include <array>
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -18,10 +19,21 @@
 
 namespace iplan::services {
 
-/// The joint-level mixture of a prediction message (covariances row-major).
+/// The wire's 3x3 covariance (and velocity covariance) layout, the one place
+/// that knows it: 9 values, row-major (idl/iplan_msgs.idl).
+std::array<double, 9> ToWireCovariance(const Eigen::Matrix3d& c);
+Eigen::Matrix3d FromWireCovariance(const std::array<double, 9>& w);
+
+/// The joint-level mixture of a prediction message.
 collision::JointMixture ToJointMixture(const msg::HumanPrediction& m);
 
-/// The people the depth camera sees (covariances row-major; a point's
+/// The other way: the mixture's actions, probabilities and Gaussians into
+/// `m`, reusing its storage. The header, the
+/// observation stamp, the body id, the joint names, the time step and the
+/// number of steps are the caller's (the intent service sets them once).
+void FillPrediction(const collision::JointMixture& in, msg::HumanPrediction* m);
+
+/// The people the depth camera sees (a point's
 /// `motion` k >= 1 is motions[k - 1], 0 not tracked). The boundary has
 /// checked the message (finite, covariances PSD, motion indices in range).
 cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m);

@@ -1,6 +1,6 @@
 // Baseline motion predictors: what a person's future looks like without a
 // learned model. They produce the same Gaussian-mixture type as the intent
-// model (MixturePrediction, one component of probability 1), so a planner or
+// model (JointMixture, one component of probability 1), so a planner or
 // monitor can take either, and the value of the model can be measured against
 // them (`iplan eval interaction`; later also offered by the intent service).
 //
@@ -75,7 +75,7 @@ struct BaselinePredictorParams {
 /// sizes, a column count that is not a multiple of 3, stamps that do not
 /// increase or non-finite values.
 void PredictBaseline(const BaselinePredictorParams& params, const Eigen::VectorXd& stamps,
-                     const Eigen::MatrixXd& positions, MixturePrediction* out);
+                     const Eigen::MatrixXd& positions, JointMixture* out);
 
 /// Fits joint_growth for `params` (kind, rate, horizon, window, noise) to the
 /// predictor's own errors on `data` (its sequences' frames in any frame,
@@ -102,7 +102,7 @@ class BaselinePredictor {
   /// positions (3 J, m, W) and writes the prediction from it to `*out`.
   /// Throws std::invalid_argument on a stamp not after the previous frame,
   /// a wrong size or non-finite values (the history is then unchanged).
-  void Update(double stamp, const Eigen::VectorXd& positions, MixturePrediction* out);
+  void Update(double stamp, const Eigen::VectorXd& positions, JointMixture* out);
   /// Forgets the history (a new person, or a tracking gap).
   void Reset();
   int buffered_frames() const { return static_cast<int>(stamps_.size()); }

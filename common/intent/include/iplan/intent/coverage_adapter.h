@@ -63,10 +63,10 @@ class CoverageAdapter {
 
   /// Multiplies the covariance of joint j, every step and component of
   /// `pred`, by s_j. `pred` must have num_joints joints and horizon steps.
-  void Apply(MixturePrediction* pred) const;
+  void Apply(JointMixture* pred) const;
 
   /// Stores `pred` (as published, after Apply) made at `stamp` for scoring.
-  void Record(double stamp, const MixturePrediction& pred);
+  void Record(double stamp, const JointMixture& pred);
 
   /// (J) the variance scales s_j.
   const Eigen::VectorXd& variance_scales() const { return scale_; }

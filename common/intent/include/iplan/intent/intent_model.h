@@ -16,6 +16,7 @@
 
 #include <Eigen/Core>
 
+#include "iplan/collision/joint_mixture.h"
 #include "iplan/intent/belief_filter.h"
 #include "iplan/intent/features.h"
 #include "iplan/intent/ivm.h"
@@ -177,38 +178,10 @@ struct IntentModel {
   ForecastSettings forecast;
 };
 
-/// A Gaussian for one joint at one future step: mean p_WJ (m) and covariance
-/// (m^2), frame W.
-struct JointGaussian {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
-};
-
-/// One mixture component.
-struct ActionHypothesis {
-  std::string action;
-  double probability = 0.0;  ///< p(action | window)
-  /// (horizon * J): Gaussian of joint j at future step k (k = 0: one frame
-  /// ahead) at index k * J + j.
-  std::vector<JointGaussian> joints;
-};
-
-/// The prediction for one window: a Gaussian mixture over actions.
-struct MixturePrediction {
-  double dt = 0.0;  ///< s between future steps (1 / rate).
-  int horizon = 0;
-  int num_joints = 0;
-  std::vector<ActionHypothesis> actions;  ///< (C), probabilities sum to 1.
-
-  const JointGaussian& At(int action, int step, int joint) const {
-    return actions[action].joints[step * num_joints + joint];
-  }
-  /// Moment-matched single Gaussian of the mixture for (step, joint):
-  /// mean = sum p_c mu_c, covariance = sum p_c (Sigma_c + mu_c mu_c^T) - mean mean^T.
-  JointGaussian Combined(int step, int joint) const;
-  /// Index of the most probable action.
-  int MostLikely() const;
-};
+/// The prediction for one window: a Gaussian mixture over actions, the
+/// cell's one prediction type (iplan/collision/joint_mixture.h).
+using collision::JointGaussian;
+using collision::JointMixture;
 
 /// Summary of a training run (for the CLI).
 struct TrainReport {
@@ -282,9 +255,12 @@ Eigen::VectorXd ClassifyWindow(const IntentModel& model, const Eigen::MatrixXd& 
 /// in ClassifyWindow). The action probabilities are those of this window
 /// alone; to combine successive windows of one person feed them to a
 /// BeliefFilter built with model.classifier.belief (as the evaluation and
-/// the intent service do) and use its probabilities. Reuses the storage in `out`. Throws as ClassifyWindow.
+/// the intent service do) and use its probabilities. Fills the actions, the
+/// probabilities, the joint names (the model's), time_step (1 / rate),
+/// num_steps (the horizon) and the Gaussians; t0_ns is the caller's. Reuses
+/// the storage in `out`. Throws as ClassifyWindow.
 /// Thread-safe.
 void PredictIntent(const IntentModel& model, const Eigen::MatrixXd& window,
-                   MixturePrediction* out);
+                   JointMixture* out);
 
 }  // namespace iplan::intent

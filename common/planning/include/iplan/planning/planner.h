@@ -74,8 +74,8 @@ struct PersonPrediction {
   /// Not owned, not null; its summaries must be up to date
   /// (HumanPrediction::UpdateSummaries).
   const collision::HumanPrediction* spheres = nullptr;
-  double dt = 0.1;     ///< time between prediction steps (s), > 0
-  double start = 0.0;  ///< time of step 0 minus time of waypoint 0 (s)
+  double time_step = 0.1;  ///< time between prediction steps (s), > 0
+  double start = 0.0;      ///< time of step 0 minus time of waypoint 0 (s)
 };
 
 struct PlanningRequest {
