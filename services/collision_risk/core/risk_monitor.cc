@@ -370,16 +370,23 @@ void RiskMonitor::ForEachPersonBound(int64_t now_ns, const BoundWaypoints& w, co
   }
 }
 
+// Whether the bound retreat applies: on, and the executing trajectory moves
+// the robot (by 1 mrad or more at some joint) at one of `times` (ns, in
+// order) within the stop horizon; a trajectory that holds it is no retreat.
+bool RiskMonitor::MovesWithinStopHorizon(int64_t now_ns, const std::vector<int64_t>& times) const {
+  if (params_.bound_retreat_gain <= 0 || trajectory_.empty()) return false;
+  double travel = 0;
+  for (std::size_t i = 0; i < times.size() && (times[i] - now_ns) * 1e-9 <= params_.stop_horizon; ++i)
+    travel = std::max(travel, (RobotConfigurationAt(times[i]) - state_->second).cwiseAbs().maxCoeff());
+  return travel >= 1e-3;
+}
+
 // The alternative to a stop: the robot held where it stands (DecideVerdict's
 // bound retreat), its largest bound within the stop horizon against the
 // trajectory's. Not evaluated when the trajectory holds the robot there.
 void RiskMonitor::CompareWithStandingStill(int64_t now_ns, const BoundWaypoints& w,
                                            collision::RobotSpheresTrajectory* traj, RiskReport* r) {
-  if (params_.bound_retreat_gain <= 0 || trajectory_.empty()) return;
-  double travel = 0;
-  for (std::size_t i = 0; i < w.times.size() && r->waypoint_times[i] <= params_.stop_horizon; ++i)
-    travel = std::max(travel, (RobotConfigurationAt(w.times[i]) - state_->second).cwiseAbs().maxCoeff());
-  if (travel < 1e-3) return;  // rad: a hold
+  if (!MovesWithinStopHorizon(now_ns, w.times)) return;
   const int S = static_cast<int>(robot_.spheres.size());
   collision::CalcForwardKinematics(robot_, state_->second, &data_);
   for (std::size_t i = 0; i < w.times.size(); ++i) traj->centres.middleCols(static_cast<Eigen::Index>(i) * S, S) = data_.p_WS;

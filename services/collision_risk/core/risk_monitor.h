@@ -144,8 +144,9 @@ struct RiskReport {
   /// A supervisor resumes a retreat at once (no resume delay).
   bool retreating = false;
   /// Largest bound within the stop horizon along the trajectory and with the
-  /// robot held where it stands; both 0 unless a prediction is fresh and the
-  /// trajectory moves the robot within the stop horizon.
+  /// robot held where it stands; both 0 unless a prediction (or, without
+  /// one, the depth camera's human points) is fresh and the trajectory
+  /// moves the robot within the stop horizon.
   double horizon_bound = 0, hold_bound = 0;
   /// ISO/TS 15066 speed reduction (SsmParams::speed_reduction): the
   /// fraction of the executing trajectory's speed the robot may run at, in
@@ -238,6 +239,7 @@ class RiskMonitor {
   };
   void ForEachPersonBound(int64_t now_ns, const BoundWaypoints& w, collision::RobotSpheresTrajectory* t,
                           const std::function<void(cell::BodyId, const cell::TimedPrediction&)>& use);
+  bool MovesWithinStopHorizon(int64_t now_ns, const std::vector<int64_t>& times) const;
   /// RiskReport::hold_bound and horizon_bound (the bound retreat).
   void CompareWithStandingStill(int64_t now_ns, const BoundWaypoints& w, collision::RobotSpheresTrajectory* traj,
                                 RiskReport* r);

@@ -96,6 +96,19 @@ void RiskMonitor::EvaluateBoundFromPoints(int64_t now_ns, RiskReport* out) {
   collision::GaussianPoints predicted;
   std::vector<collision::WaypointBound> one;
   bounds_.resize(static_cast<std::size_t>(W));
+  // The bound retreat's alternative (CompareWithStandingStill): the robot
+  // held where it stands, within the stop horizon, unless the trajectory
+  // holds it there anyway.
+  std::vector<int64_t> times(static_cast<std::size_t>(W));
+  for (int w = 0; w < W; ++w) times[static_cast<std::size_t>(w)] = now_ns + static_cast<int64_t>((w + 1) * pp.time_step * 1e9);
+  const bool compare = MovesWithinStopHorizon(now_ns, times);
+  Eigen::Matrix3Xd held;
+  if (compare) {
+    collision::CalcForwardKinematics(robot_, state_->second, &data_);
+    held = data_.p_WS;
+    r.hold_bound = 0;
+    r.horizon_bound = 0;
+  }
   for (int w = 0; w < W; ++w) {
     const double t = (w + 1) * pp.time_step;
     collision::CalcForwardKinematics(robot_, RobotConfigurationAt(now_ns + static_cast<int64_t>(t * 1e9)), &data_);
@@ -118,6 +131,12 @@ void RiskMonitor::EvaluateBoundFromPoints(int64_t now_ns, RiskReport* out) {
     }
     collision::EvaluatePointsBound(*at, traj, collision::PointsBoundParams{}, &one);
     bounds_[static_cast<std::size_t>(w)] = one.front();
+    if (compare && t <= params_.stop_horizon) {
+      r.horizon_bound = std::max(r.horizon_bound, std::clamp(one.front().bound, 0.0, 1.0));
+      traj.centres = held;
+      collision::EvaluatePointsBound(*at, traj, collision::PointsBoundParams{}, &one);
+      r.hold_bound = std::max(r.hold_bound, std::clamp(one.front().bound, 0.0, 1.0));
+    }
   }
   for (std::size_t w = 0; w < bounds_.size(); ++w) {
     const auto& b = bounds_[w];

@@ -274,5 +274,48 @@ TEST_F(RiskPointsTest, MotionsThatDoNotFitThePointsAreRefused) {
   EXPECT_EQ(monitor_.UpdateHumanPoints(p), std::nullopt);
 }
 
+// The bound retreat (issue 25) holds for a person seen only as points too:
+// a hand held still 2 cm from the arm's front (bound 1 standing still) and
+// a trajectory that pulls the arm back over 0.6 s (bound 0.27 at 0.1 s,
+// then nothing): let go, slowed, not stopped by the bound; with the gain 0
+// (off) the bound stops it, as it did before points had the retreat.
+TEST_F(RiskPointsTest, ATrajectoryPullingBackFromThePointsIsARetreatNotAStop) {
+  const int64_t t = 100 * kSec;
+  const std::vector<double> back = {0, -1.3, 0, -2.9, 0, 2.2, 0.785};
+  collision::RobotData d(robot_);
+  collision::CalcForwardKinematics(robot_, Eigen::Map<const Eigen::VectorXd>(back.data(), 7), &d);
+  ASSERT_LT(d.p_WS(0, front_), spheres_(0, front_) - 0.08) << "the front sphere pulls back by 8 cm";
+  for (double gain : {0.05, 0.0}) {
+    SCOPED_TRACE("gain " + std::to_string(gain));
+    RiskParams params = WithTrackedSpeeds();
+    params.bound_retreat_gain = gain;
+    RiskMonitor m(robot_, collision::HumanBodyParams::DefaultUpperBody(), params);
+    ASSERT_EQ(m.UpdateRobotState(t, kRobotJoints, kReady), std::nullopt);
+    ASSERT_EQ(m.UpdateTrajectory(t, kRobotJoints, {0.0, 0.6}, {kReady, back}), std::nullopt);
+    // A hand held still 2 cm in front (sigma 1 cm), tracked: the
+    // separation layer sees the arm pull back (a retreat inside S_p).
+    cell::HumanPoints p;
+    p.stamp_ns = t;
+    p.voxel_size = 0.01;
+    p.means = spheres_.col(front_) + Eigen::Vector3d(robot_.spheres[front_].radius + 0.005 + 0.02, 0, 0);
+    p.covariances = {1e-4 * Eigen::Matrix3d::Identity()};
+    p.motion_of = {0};
+    p.motions.push_back({Eigen::Vector3d::Zero(), 1e-4 * Eigen::Matrix3d::Identity()});
+    ASSERT_EQ(m.UpdateHumanPoints(p), std::nullopt);
+    const RiskReport r = m.Evaluate(t);
+    EXPECT_EQ(r.max_human_segment, "points");
+    if (gain > 0) {
+      EXPECT_GE(r.hold_bound, 1 - params.delta_cl) << "standing still is what the bound forbids";
+      EXPECT_LE(r.horizon_bound, r.hold_bound - gain);
+      EXPECT_EQ(r.verdict, Verdict::kSlowDown) << r.reason;
+      EXPECT_TRUE(r.retreating) << r.reason;
+      EXPECT_EQ(r.reason.rfind("retreating from the predicted person: ", 0), 0u) << r.reason;
+    } else {
+      EXPECT_EQ(r.hold_bound, 0.0);
+      EXPECT_EQ(r.verdict, Verdict::kProtectiveStop) << r.reason;
+    }
+  }
+}
+
 }  // namespace
 }  // namespace iplan::collision_risk
