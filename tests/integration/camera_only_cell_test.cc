@@ -31,7 +31,7 @@
 #include "iplan/framework/node.h"
 #include "iplan/framework/service_file.h"
 #include "services/perception/perception_settings.h"
-#include "service_cell.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -102,8 +102,8 @@ struct CellRun {
 class CameraOnlyCell {
  public:
   CameraOnlyCell(const std::string& tag, dds::Vendor vendor, int offset, const ScriptedPerson& person)
-      : cell_(tag, UniqueDomain(offset), vendor),
-        tc_("test_cell", vendor, cell_.domain),
+      : cell_(tag, vendor, offset, "", /*with_intent=*/false),
+        tc_("test_cell", vendor, cell_.domain()),
         person_(person),
         body_(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml")) {
     framework::Node& node = *tc_.node;
@@ -125,12 +125,11 @@ class CameraOnlyCell {
     framework::ConfigSection section = file.Section("perception");
     const framework::Result r = depth_.Configure(section, s.depth, node);
     EXPECT_TRUE(r.ok) << r.reason;
-    cell_.Start("iplan-robot-sim", "robot_sim.yaml", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]"});
+    cell_.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]"});
     // The measured point speeds (off by default: docs/perception-clouds.md, "Not done (issue 29)").
-    cell_.Start("iplan-collision-risk", "collision_risk.yaml", {"--set", "collision_risk.human_points.tracked_speeds=true"});
-    cell_.Start("iplan-trajopt", "trajopt.yaml",
-                {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--set", "trajopt.human_points.tracked_speeds=true"});
-    cell_.Start("iplan-cloud", "cloud.yaml", {"--set", "cloud.noise.focal_px=262.5"});
+    cell_.Start("collision_risk", {"--set", "collision_risk.human_points.tracked_speeds=true"});
+    cell_.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--set", "trajopt.human_points.tracked_speeds=true"});
+    cell_.Start("cloud", {"--set", "cloud.noise.focal_px=262.5"});
     start_ = Clock::now();
     depth_.Activate(node, [this] { return std::vector<std::vector<perception::JointSample>>{person_.At(Since())}; });
     node.AddTimer(std::chrono::milliseconds(33), [this] { PublishTruth(); });
@@ -240,7 +239,7 @@ class CameraOnlyCell {
     run.truths.push_back({t, BodyAt(t)});
   }
 
-  ServiceCell cell_;
+  CellHarness cell_;
   TestNode tc_;
   const ScriptedPerson& person_;
   collision::HumanBodyModel body_;

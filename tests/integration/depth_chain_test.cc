@@ -32,7 +32,7 @@
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
 #include "robot_distance.h"
-#include "service_cell.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -53,13 +53,11 @@ std::string List(const Eigen::Vector3d& v) { return List(std::vector<double>{v.x
 
 collision::RobotModel Panda() { return collision::LoadRobotModelFromYaml(kConfig + "/robots/panda.yaml"); }
 
-// The services under test (tests/support/service_cell.h), on Cyclone DDS.
-using Cell = ServiceCell;
 
-// The depth path's perception: the simulated camera (10 Hz, the shipped rate) and the person's truth.
+// The depth path's perception: the simulated camera (10 Hz, the shipped rate); the harness adds the
+// synthetic person and its truth.
 std::vector<std::string> DepthPerception(std::vector<std::string> more) {
-  std::vector<std::string> a = {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true", "--set",
-                                "perception.depth.provider=simulated"};
+  std::vector<std::string> a = {"--set", "perception.depth.provider=simulated"};
   a.insert(a.end(), more.begin(), more.end());
   return a;
 }
@@ -136,20 +134,19 @@ void ObservePerson(framework::Node& node, const collision::HumanBodyModel& body,
 // perception (no skeleton; the person walks into the camera's view at kPersonAfter), cloud, collision risk and the
 // robot; this process plays trajopt: one reach of the arm, kRobotLead s before the person comes.
 PersonRun RunPerson(const collision::HumanBodyModel& body, const Eigen::Vector3d& target) {
-  Cell cell("depth-person", UniqueDomain(97));
-  TestNode sc("scripted_cell", dds::Vendor::kCyclone, cell.domain);
+  CellHarness cell("depth-person", dds::Vendor::kCyclone, 97, "", /*with_intent=*/false);
+  TestNode sc("scripted_cell", dds::Vendor::kCyclone, cell.domain());
   framework::Node& node = *sc.node;
   auto& traj = node.Advertise(framework::topics::RobotTrajectory());
   Clock::time_point t0{};
   PersonRun run;
   ObservePerson(node, body, &t0, &run);
   const std::string entitled = "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]";
-  cell.Start("iplan-robot-sim", "robot_sim.yaml", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]", "--set", entitled});
-  cell.Start("iplan-collision-risk", "collision_risk.yaml", {"--set", entitled});
-  cell.Start("iplan-cloud", "cloud.yaml", {});
+  cell.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]", "--set", entitled});
+  cell.Start("collision_risk", {"--set", entitled});
+  cell.Start("cloud");
   const auto launched = Clock::now();
-  cell.Start("iplan-perception", "perception.yaml",
-             DepthPerception({"--set", "perception.publish_skeleton=false", "--set", "perception.synthetic.start=loop", "--set",
+  cell.Start("perception", DepthPerception({"--set", "perception.publish_skeleton=false", "--set", "perception.synthetic.start=loop", "--set",
                               "perception.synthetic.variation=0", "--set", "perception.synthetic.actions.reach_parts.target=" + List(target),
                               "--set", "perception.synthetic.actions.reach_parts.period=6.0", "--set",
                               "perception.synthetic.script=[reach_parts]", "--set", "perception.synthetic.durations=[6.0]", "--set",
@@ -289,11 +286,11 @@ void Sweep(framework::Node& node, dds::Writer<msg::TaskCommand>& cmd, dds::Write
 // robot_sim, trajopt, cloud, perception (the box appears kBoxAppears s after its activation); once the cloud service
 // reports the box, the sweep.
 BoxRun RunBox(const collision::SceneObject& box) {
-  Cell cell("depth-box", UniqueDomain(98));
+  CellHarness cell("depth-box", dds::Vendor::kCyclone, 98, "", /*with_intent=*/false);
   const Eigen::Vector3d centre = box.X_WO.translation();
-  const std::string box_file = (cell.dir / "box.yaml").string();
+  const std::string box_file = (cell.dir() / "box.yaml").string();
   std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: " << List(centre) << ", size: " << List(box.size) << "}\n";
-  TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain);
+  TestNode tc("test_cell", dds::Vendor::kCyclone, cell.domain());
   framework::Node& node = *tc.node;
   auto& cmd = node.Advertise(framework::topics::TaskCommand());
   auto& permit = node.Advertise(framework::topics::SafetyPermit("test_cell"));
@@ -314,13 +311,11 @@ BoxRun RunBox(const collision::SceneObject& box) {
                    run.arrays.push_back({since(), b});
                    run.last = a;
                  }), any);
-  cell.Start("iplan-robot-sim", "robot_sim.yaml",
-             {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
-  cell.Start("iplan-trajopt", "trajopt.yaml", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]"});
-  cell.Start("iplan-cloud", "cloud.yaml", {});
+  cell.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
+  cell.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]"});
+  cell.Start("cloud");
   // No person in this test (human_body ""): the box is the only change in the scene.
-  cell.Start("iplan-perception", "perception.yaml",
-             DepthPerception({"--set", "perception.depth.simulated.human_body=\"\"", "--set",
+  cell.Start("perception", DepthPerception({"--set", "perception.depth.simulated.human_body=\"\"", "--set",
                               "perception.depth.simulated.added_scenes=[" + box_file + "]", "--set",
                               "perception.depth.simulated.added_after=" + std::to_string(kBoxAppears)}));
   while (since() < 40 && (run.arrays.empty() || !run.arrays.back().box)) node.SpinOnce(10ms);

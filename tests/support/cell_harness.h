@@ -1,8 +1,11 @@
-// The whole cell for multi-process fault and attack tests: the six services
-// as separate processes with the shipped configuration (config/), the
-// synthetic person of the demo cell, one DDS vendor, a domain and a state
-// folder of their own, and an observer participant in the test process that
-// records joint states, permits, task outcomes and diagnostics.
+// The cell for multi-process tests, the one harness they share: the six
+// services (or the few a test needs: the depth path's tests start the cloud
+// service, collision risk, trajopt and the robot simulator) as separate
+// processes with the shipped configuration (config/) and the test's extra
+// arguments, the synthetic person of the demo cell, one DDS vendor, a
+// domain and a state folder of their own, and an observer participant in
+// the test process that records joint states, permits, task outcomes and
+// diagnostics.
 //
 // Unlike `iplan demo`, every process is the test's own, so a test can kill,
 // freeze (SIGSTOP) and restart any of them.
@@ -54,7 +57,10 @@ class CellHarness {
   /// every service starts with --insecure (unsecured on purpose). Either
   /// way the processes get IPLAN_SECURITY set to it (or emptied), so the
   /// environment the test runs in cannot change the cell.
-  CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset, const std::string& security_dir = "")
+  /// A test of a few services without intent (the depth path) passes
+  /// `with_intent` false: no model is prepared, and starting intent fails.
+  CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset, const std::string& security_dir = "",
+              bool with_intent = true)
       : vendor_(vendor), domain_(UniqueDomain(domain_offset)), security_(security_dir) {
     dir_ = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
     std::filesystem::remove_all(dir_);
@@ -62,15 +68,17 @@ class CellHarness {
     config_dir_ = std::string(IPLAN_SOURCE_DIR) + "/config";
     // The cell's intent model, trained from the synthetic person on first
     // use and cached (as `iplan demo` does).
-    Process prep({BinPath("iplan"), "demo", "--prepare-only", "--config-dir", config_dir_, "--state-dir", dir_.string()});
-    const auto rc = prep.Wait(std::chrono::seconds(300));
-    const std::string out = prep.Stdout();
-    const auto at = out.find("model path: ");
-    if (!rc || *rc != 0 || at == std::string::npos) {
-      ADD_FAILURE() << "cannot prepare the cell's intent model:\n" << out << prep.Stderr();
-      return;
+    if (with_intent) {
+      Process prep({BinPath("iplan"), "demo", "--prepare-only", "--config-dir", config_dir_, "--state-dir", dir_.string()});
+      const auto rc = prep.Wait(std::chrono::seconds(300));
+      const std::string out = prep.Stdout();
+      const auto at = out.find("model path: ");
+      if (!rc || *rc != 0 || at == std::string::npos) {
+        ADD_FAILURE() << "cannot prepare the cell's intent model:\n" << out << prep.Stderr();
+        return;
+      }
+      model_ = out.substr(at + 12, out.find('\n', at) - at - 12);
     }
-    model_ = out.substr(at + 12, out.find('\n', at) - at - 12);
     observer_ = std::make_unique<TestNode>("observer", vendor, domain_, security_);
     framework::Node& node = *observer_->node;
     using SI = const dds::SampleInfo&;
@@ -128,6 +136,9 @@ class CellHarness {
   const std::string& security() const { return security_; }
   framework::Node& node() { return *observer_->node; }
   int domain() const { return domain_; }
+  /// The cell's folder: the services' logs (kept when the test failed) and
+  /// whatever files the test writes for them.
+  const std::filesystem::path& dir() const { return dir_; }
   std::string q_table() const { return (dir_ / "q_table.bin").string(); }
   /// The intent model the cell's intent service loads.
   const std::string& model() const { return model_; }
@@ -151,7 +162,13 @@ class CellHarness {
                              dds::ToString(vendor), "--domain", std::to_string(domain_)});
     if (security_.empty()) argv.push_back("--insecure");
     if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
-    if (svc == "intent") argv.insert(argv.end(), {"--set", "intent.model=" + model_});
+    if (svc == "intent") {
+      if (model_.empty()) {
+        ADD_FAILURE() << "intent started in a cell made without it";
+        return;
+      }
+      argv.insert(argv.end(), {"--set", "intent.model=" + model_});
+    }
     if (svc == "perception") {
       argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true"});
     }
@@ -164,6 +181,18 @@ class CellHarness {
   }
   void StartAll() {
     for (const auto& s : Services()) Start(s);
+  }
+  /// Stops every service started; each must exit 0 on SIGTERM.
+  void Stop() {
+    for (auto& [name, p] : procs_) {
+      if (!p) continue;
+      p->Signal(SIGCONT);
+      p->Signal(SIGTERM);
+    }
+    for (auto& [name, p] : procs_) {
+      if (p) EXPECT_EQ(p->Wait(std::chrono::seconds(10)), 0) << name << ":\n" << p->Stderr();
+    }
+    procs_.clear();
   }
   Process& operator[](const std::string& svc) { return *procs_.at(svc); }
   std::string Logs(const std::string& svc) const {
