@@ -12,6 +12,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/framework/node.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -68,12 +69,14 @@ msg::HumanPrediction PredictionFrom(const msg::Time& stamp, const Eigen::Vector3
 }
 
 std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
-  const int domain = UniqueDomain(41 + static_cast<int>(sc.velocity.norm() * 10));
+  CellHarness services("collision-risk-service", dds::Vendor::kCyclone, 41 + static_cast<int>(sc.velocity.norm() * 10), "",
+                       /*with_intent=*/false);
+  const int domain = services.domain();
   // The test plays robot, trajectory optimiser, perception and intent from
   // one participant: entitle it to write what trajopt and intent write.
-  Process svc({BinPath("iplan-collision-risk"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
-               "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]", "--set",
-               "node.entitled_writers./iplan/human/prediction=[scripted_cell]"});
+  services.SetVendor("collision_risk", dds::Vendor::kFastDds);
+  services.Start("collision_risk", {"--set", "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]", "--set",
+                                    "node.entitled_writers./iplan/human/prediction=[scripted_cell]"});
   TestNode cell("scripted_cell", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
   auto& js = node.Advertise(framework::topics::JointStates());
@@ -90,7 +93,7 @@ std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
   // Wait for the service to be up (its risk writer matches our reader).
   const auto up = Clock::now() + 20s;
   while (Clock::now() < up && js.MatchedReaders() == 0) node.SpinOnce(20ms);
-  EXPECT_GT(js.MatchedReaders(), 0) << svc.Stderr();
+  EXPECT_GT(js.MatchedReaders(), 0) << services.Logs("collision_risk");
 
   msg::JointTrajectory hold;
   hold.joint_names = kRobotJoints;
@@ -125,8 +128,7 @@ std::vector<msg::CollisionRisk> RunScenario(const Scenario& sc) {
     }
     node.SpinOnce(5ms);
   }
-  svc.Signal(SIGTERM);
-  EXPECT_EQ(svc.Wait(10s), 0) << svc.Stderr();
+  services.Stop();
   return risks;
 }
 

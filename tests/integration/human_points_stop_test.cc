@@ -17,6 +17,7 @@
 
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -98,15 +99,15 @@ struct Walk {
 // reaches), then the walk at 0.5 m/s to kFinalX, then 3 s standing there.
 // Times are s since the walk started.
 Walk RunWalk(const std::string& risk_vendor) {
-  const int domain = UniqueDomain(95);
+  CellHarness services("human-points-stop", dds::Vendor::kCyclone, 95, "", /*with_intent=*/false);
+  const int domain = services.domain();
   Walk w;
   std::vector<State>& states = w.states;
   std::vector<Risk>& risks = w.risks;
-  Process risk({BinPath("iplan-collision-risk"), "--dds", risk_vendor, "--domain", std::to_string(domain), "--set",
-                "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]"});
-  Process sim({BinPath("iplan-robot-sim"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
-               "robot_sim.permits.monitors=[iplan-collision_risk]", "--set",
-               "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]"});
+  services.SetVendor("collision_risk", dds::ParseVendor(risk_vendor));
+  services.Start("collision_risk", {"--set", "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]"});
+  services.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]", "--set",
+                               "node.entitled_writers./iplan/robot/trajectory=[scripted_cell]"});
   TestNode cell("scripted_cell", dds::Vendor::kCyclone, domain);
   TestNode cloud("iplan-cloud", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
@@ -129,7 +130,7 @@ Walk RunWalk(const std::string& risk_vendor) {
   while (Clock::now() < up && (traj.MatchedReaders() < 2 || points.MatchedReaders() == 0)) node.SpinOnce(20ms);
   // Both services read the trajectory (a Fast DDS reader also brings its
   // liveliness watch reader, docs/dds.md: 2 or more).
-  EXPECT_GE(traj.MatchedReaders(), 2) << risk.Stderr() << sim.Stderr();
+  EXPECT_GE(traj.MatchedReaders(), 2) << services.Logs("collision_risk") << services.Logs("robot_sim");
   traj.Write(Reaching(msg::Now()));
   const auto t0 = Clock::now();
   auto next_points = t0;
@@ -143,11 +144,8 @@ Walk RunWalk(const std::string& risk_vendor) {
     }
     node.SpinOnce(5ms);
   }
-  risk.Signal(SIGTERM);
-  sim.Signal(SIGTERM);
-  EXPECT_EQ(risk.Wait(10s), 0) << risk.Stderr();
-  EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
-  if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << risk.Stderr() << "\n";  // the monitor's log, to debug
+  services.Stop();
+  if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << services.Logs("collision_risk") << "\n";  // the monitor's log, to debug
   return w;
 }
 

@@ -17,6 +17,7 @@
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/static_scene.h"
 #include "iplan/framework/node.h"
+#include "cell_harness.h"
 #include "robot_distance.h"
 #include "test_messages.h"
 #include "test_node.h"
@@ -51,11 +52,12 @@ collision::RobotModel Panda() {
 // One task from kStart to kGoal; `box` (if any) is published
 // from 0.2 s after the command on.
 Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
-  const int domain = UniqueDomain(domain_offset);
-  Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
-               "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
-  Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
-               "node.entitled_writers./iplan/task/command=[test_cell]", "--log-level", "debug"});
+  CellHarness services("obstacle-avoidance", dds::Vendor::kCyclone, domain_offset, "", /*with_intent=*/false);
+  const int domain = services.domain();
+  services.SetVendor("robot_sim", dds::Vendor::kFastDds);
+  services.Start("robot_sim",
+                 {"--set", "robot_sim.permits.monitors=[test_cell]", "--set", "robot_sim.initial_positions=" + List(kStart)});
+  services.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--log-level", "debug"});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
   TestNode cloud("iplan-cloud", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
@@ -76,8 +78,8 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
   const auto up = Clock::now() + 30s;
   while (Clock::now() < up && (cmd.MatchedReaders() == 0 || obstacles.MatchedReaders() == 0)) node.SpinOnce(20ms);
   for (int i = 0; i < 20; ++i) node.SpinOnce(20ms);
-  EXPECT_GT(cmd.MatchedReaders(), 0) << opt.Stderr();
-  EXPECT_GT(obstacles.MatchedReaders(), 0) << opt.Stderr();
+  EXPECT_GT(cmd.MatchedReaders(), 0) << services.Logs("trajopt");
+  EXPECT_GT(obstacles.MatchedReaders(), 0) << services.Logs("trajopt");
 
   msg::TaskCommand c = testing::JointGoalCommand(7, "reach_goal", kGoal, 30);
   const auto start = Clock::now();
@@ -100,11 +102,8 @@ Episode RunEpisode(int domain_offset, const std::optional<msg::Obstacle>& box) {
     }
     node.SpinOnce(5ms);
   }
-  opt.Signal(SIGTERM);
-  sim.Signal(SIGTERM);
-  EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
-  EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
-  e.log = opt.Stderr();
+  services.Stop();
+  e.log = services.Logs("trajopt");
   if (std::getenv("IPLAN_TEST_VERBOSE")) std::cout << e.log << "\n";
   return e;
 }

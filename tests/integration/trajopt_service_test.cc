@@ -18,6 +18,7 @@
 
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -122,13 +123,14 @@ msg::TaskCommand StartCommand(const std::vector<double>& retreat) {
 // stands on the goal for `block_for_s`; `zero_stamp`: trajectories go out
 // the joint_trajectory_controller way (trajopt.output.zero_stamp).
 Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool zero_stamp = false) {
-  const int domain = UniqueDomain(61 + static_cast<int>(block_for_s * 10) + static_cast<int>(retreat.size()));
-  Process sim({BinPath("iplan-robot-sim"), "--dds", "fastdds", "--domain", std::to_string(domain), "--set",
-               "robot_sim.permits.monitors=[test_cell]"});
-  Process opt({BinPath("iplan-trajopt"), "--dds", "cyclonedds", "--domain", std::to_string(domain), "--set",
-               "node.entitled_writers./iplan/task/command=[test_cell]", "--set",
-               "node.entitled_writers./iplan/human/prediction=[test_cell]", "--set",
-               std::string("trajopt.output.zero_stamp=") + (zero_stamp ? "true" : "false")});
+  CellHarness services("trajopt-service", dds::Vendor::kCyclone,
+                       61 + static_cast<int>(block_for_s * 10) + static_cast<int>(retreat.size()), "", /*with_intent=*/false);
+  const int domain = services.domain();
+  services.SetVendor("robot_sim", dds::Vendor::kFastDds);
+  services.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[test_cell]"});
+  services.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--set",
+                             "node.entitled_writers./iplan/human/prediction=[test_cell]", "--set",
+                             std::string("trajopt.output.zero_stamp=") + (zero_stamp ? "true" : "false")});
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
   TestNode stranger("stranger", dds::Vendor::kCyclone, domain);
   framework::Node& node = *cell.node;
@@ -146,7 +148,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool
     node.SpinOnce(20ms);
   }
   for (int i = 0; i < 20; ++i) node.SpinOnce(20ms);
-  EXPECT_GT(cmd.MatchedReaders(), 0) << opt.Stderr();
+  EXPECT_GT(cmd.MatchedReaders(), 0) << services.Logs("trajopt");
 
   const Eigen::Vector3d goal_hand = GoalHand();
   msg::TaskCommand c = StartCommand(retreat);
@@ -181,10 +183,7 @@ Result RunTask(double block_for_s, const std::vector<double>& retreat = {}, bool
   cmd.Write(c);
   const auto diag_end = Clock::now() + 2s;
   while (Clock::now() < diag_end) node.SpinOnce(20ms);  // the simulator's next diagnostics, the repeat's answer
-  opt.Signal(SIGTERM);
-  sim.Signal(SIGTERM);
-  EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
-  EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
+  services.Stop();
   return r;
 }
 

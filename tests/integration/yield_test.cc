@@ -20,6 +20,7 @@
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/framework/node.h"
+#include "cell_harness.h"
 #include "test_messages.h"
 #include "test_node.h"
 #include "test_paths.h"
@@ -158,12 +159,12 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
   const Eigen::Index tool = static_cast<Eigen::Index>(robot.spheres.size()) - 1;
   const Eigen::Vector3d rest_tool = data.p_WS.col(tool);
 
-  const int domain = UniqueDomain(95);
-  const std::string d = std::to_string(domain);
-  Process sim({BinPath("iplan-robot-sim"), "--dds", "cyclonedds", "--domain", d, "--set",
-               "robot_sim.permits.monitors=[test_cell,iplan-collision_risk]"});
-  Process risk({BinPath("iplan-collision-risk"), "--dds", "cyclonedds", "--domain", d});
-  Process opt({BinPath("iplan-trajopt"), "--dds", "fastdds", "--domain", d});
+  CellHarness services("yield", dds::Vendor::kCyclone, 95, "", /*with_intent=*/false);
+  const int domain = services.domain();
+  services.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[test_cell,iplan-collision_risk]"});
+  services.Start("collision_risk");
+  services.SetVendor("trajopt", dds::Vendor::kFastDds);
+  services.Start("trajopt");
   TestNode cell("test_cell", dds::Vendor::kCyclone, domain);
   TestNode perception("iplan-perception", dds::Vendor::kCyclone, domain);
   TestNode intent("iplan-intent", dds::Vendor::kCyclone, domain);
@@ -177,7 +178,7 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
                                permit.MatchedReaders() == 0)) {
     node.SpinOnce(20ms);
   }
-  ASSERT_GE(prediction.MatchedReaders(), 2) << opt.Stderr() << risk.Stderr();
+  ASSERT_GE(prediction.MatchedReaders(), 2) << services.Logs("trajopt") << services.Logs("collision_risk");
 
   // The person's frames at 30 Hz, each with the true future of the walk (10
   // steps of 0.1 s) as the prediction; the supervisor's permit at 20 Hz.
@@ -200,12 +201,7 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
     }
     node.SpinOnce(2ms);
   }
-  opt.Signal(SIGTERM);
-  risk.Signal(SIGTERM);
-  sim.Signal(SIGTERM);
-  EXPECT_EQ(opt.Wait(10s), 0) << opt.Stderr();
-  EXPECT_EQ(risk.Wait(10s), 0) << risk.Stderr();
-  EXPECT_EQ(sim.Wait(10s), 0) << sim.Stderr();
+  services.Stop();
 
   ASSERT_GT(seen.states.size(), 100u);
   const Motion m = Measure(robot, body, rest_tool, walk, seen.states);
@@ -214,8 +210,8 @@ TEST(Yield, ARobotAtRestMovesOutOfTheWayOfAPersonComingAtIt) {
             << " m (standing still: 0.20 m); smallest robot-person separation " << separation
             << " m; collision-risk verdicts while walking: " << seen.stops << " protective stop(s), " << seen.slow_downs
             << " slow-down(s)\n";
-  EXPECT_GT(moved, 0.08) << "the arm did not get out of the way\n" << opt.Stderr();
-  EXPECT_GT(closest, 0.20 + 0.05) << opt.Stderr();
+  EXPECT_GT(moved, 0.08) << "the arm did not get out of the way\n" << services.Logs("trajopt");
+  EXPECT_GT(closest, 0.20 + 0.05) << services.Logs("trajopt");
   EXPECT_GT(separation, 0.0) << "the person touched the robot";
 }
 

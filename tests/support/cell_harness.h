@@ -182,7 +182,8 @@ class CellHarness {
   void StartAll() {
     for (const auto& s : Services()) Start(s);
   }
-  /// Stops every service started; each must exit 0 on SIGTERM.
+  /// Stops every service started; each must exit 0 on SIGTERM. Their logs
+  /// stay readable (Logs) until a service is started again.
   void Stop() {
     for (auto& [name, p] : procs_) {
       if (!p) continue;
@@ -192,7 +193,6 @@ class CellHarness {
     for (auto& [name, p] : procs_) {
       if (p) EXPECT_EQ(p->Wait(std::chrono::seconds(10)), 0) << name << ":\n" << p->Stderr();
     }
-    procs_.clear();
   }
   Process& operator[](const std::string& svc) { return *procs_.at(svc); }
   std::string Logs(const std::string& svc) const {
