@@ -57,12 +57,9 @@ class ObstaclesTest : public ::testing::Test {
 TEST_F(ObstaclesTest, ABoxInThePathOnTheTableIsPlannedAround) {
   // From the right of the table to the left at 0.30 m: the free path sweeps
   // the gripper through (0.45, -0.1).
-  const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
+  const std::optional<PlanningRequest> across = testing::AcrossTheTable(planner_);
+  ASSERT_TRUE(across.has_value());
+  PlanningRequest req = *across;
   const collision::SceneObject box = TableBox(0.45, -0.1, {0.12, 0.12, 0.32});
   const PlanningResult free_r = planner_.Plan(req);
   ASSERT_TRUE(free_r.success()) << free_r.reason;
@@ -72,15 +69,15 @@ TEST_F(ObstaclesTest, ABoxInThePathOnTheTableIsPlannedAround) {
   const PlanningResult r = planner_.Plan(req);
   ASSERT_TRUE(r.success()) << r.reason;
   EXPECT_EQ(r.positions.col(0), req.start_q);
-  EXPECT_EQ(r.positions.col(r.positions.cols() - 1), g.q);
+  EXPECT_EQ(r.positions.col(r.positions.cols() - 1), req.goal.q);
   EXPECT_EQ(CheckLimits(robot_, r.positions, r.dt, Eigen::VectorXd()), "");
   // ...and no sphere penetrates it along the plan that does (FCL, 10x the
   // waypoint resolution), which keeps min_clearance at the waypoints' substeps.
   EXPECT_GE(FclDistanceToBox(r.positions, box), 0.0);
   EXPECT_GE(r.min_clearance, planner_.params().min_clearance);
   // The planner's clearance with the box agrees with FCL at the goal.
-  EXPECT_NEAR(planner_.CalcClearance(g.q, {box}),
-              std::min(planner_.CalcClearance(g.q), FclDistanceToBox(g.q, box)), 1e-9);
+  EXPECT_NEAR(planner_.CalcClearance(req.goal.q, {box}),
+              std::min(planner_.CalcClearance(req.goal.q), FclDistanceToBox(req.goal.q, box)), 1e-9);
 }
 
 TEST_F(ObstaclesTest, AStartInsideABoxMovesOutWithoutGoingDeeper) {

@@ -26,16 +26,11 @@ class PlannerTest : public ::testing::Test {
         scene_(scene_params_),
         body_(collision::HumanBodyParams::DefaultUpperBody()) {}
 
-  // The sweep most cases plan: the gripper pointing down at 0.30 m, across
-  // the table from (0.45, -0.35) to (0.45, 0.15), as joint start and goal.
+  // The sweep most cases plan (testing::AcrossTheTable).
   PlanningRequest AcrossTheTable() const {
-    const IkResult s = planner_.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-    const IkResult g = planner_.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-    EXPECT_TRUE(s.success && g.success);
-    PlanningRequest req;
-    req.start_q = s.q;
-    req.goal = Goal::Joint(g.q);
-    return req;
+    const std::optional<PlanningRequest> req = testing::AcrossTheTable(planner_);
+    EXPECT_TRUE(req.has_value()) << "no IK solution for the sweep across the table";
+    return req.value_or(PlanningRequest{});
   }
 
   // From Ready to a pose on the shelf while a person's hand reaches across

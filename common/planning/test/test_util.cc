@@ -25,6 +25,16 @@ Eigen::Quaterniond DownOrientation(double yaw) {
                             Eigen::AngleAxisd(M_PI, Eigen::Vector3d::UnitX()));
 }
 
+std::optional<PlanningRequest> AcrossTheTable(const Planner& planner) {
+  const IkResult s = planner.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = planner.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  if (!s.success || !g.success) return std::nullopt;
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  return req;
+}
+
 std::vector<NamedPose> TableTopPoses() {
   return {
       {"table_centre", {0.50, 0.00, 0.30}},  {"table_left", {0.42, 0.15, 0.30}},

@@ -2,6 +2,7 @@
 // default cell, table-top poses, and synthetic predictions of a person.
 #pragma once
 
+#include <optional>
 #include <random>
 #include <vector>
 
@@ -11,6 +12,7 @@
 #include "iplan/collision/human_model.h"
 #include "iplan/collision/robot_model.h"
 #include "iplan/collision/scene.h"
+#include "iplan/planning/planner.h"
 
 namespace iplan::planning::testing {
 
@@ -29,6 +31,12 @@ struct NamedPose {
   Eigen::Vector3d p;
 };
 std::vector<NamedPose> TableTopPoses();
+
+/// The sweep many planner tests plan: the gripper pointing down at 0.30 m,
+/// across the table from (0.45, -0.35) to (0.45, 0.15) m (W), as a request
+/// from the start configuration to the joint goal, both from `planner`'s
+/// IK seeded at Ready(); nullopt when either has no IK solution.
+std::optional<PlanningRequest> AcrossTheTable(const Planner& planner);
 
 /// A person standing across the table from the robot (at x = 1.15 m)
 /// reaching with the right hand towards `reach_targets` (one action each,
