@@ -191,7 +191,9 @@ class CellHarness {
       p->Signal(SIGTERM);
     }
     for (auto& [name, p] : procs_) {
-      if (p) EXPECT_EQ(p->Wait(std::chrono::seconds(10)), 0) << name << ":\n" << p->Stderr();
+      if (p) {
+        EXPECT_EQ(p->Wait(std::chrono::seconds(10)), 0) << name << ":\n" << p->Stderr();
+      }
     }
   }
   Process& operator[](const std::string& svc) { return *procs_.at(svc); }
