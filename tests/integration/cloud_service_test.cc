@@ -23,7 +23,7 @@
 #include "iplan/cloud/cloud.h"
 #include "iplan/collision/human_model.h"
 #include "iplan/framework/node.h"
-#include "test_node.h"
+#include "cell_harness.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -31,38 +31,6 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
-
-struct Observer {
-  explicit Observer(int domain, dds::Vendor vendor = dds::Vendor::kCyclone) : t("observer", vendor, domain) {
-    framework::Node& n = *t.node;
-    framework::SubscribeOptions any{false};
-    n.Subscribe(framework::topics::Diagnostics(),
-                std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
-                  for (const auto& st : a.status)
-                    for (const auto& kv : st.values) diag[st.name][kv.key] = kv.value;
-                }),
-                any);
-  }
-  double Diag(const std::string& svc, const std::string& key) {
-    auto it = diag[svc].find(key);
-    return it == diag[svc].end() ? -1 : std::atof(it->second.c_str());
-  }
-  bool SpinUntil(const std::function<bool()>& done, std::chrono::seconds timeout) {
-    const auto end = Clock::now() + timeout;
-    while (!done() && Clock::now() < end) t.node->SpinOnce(std::chrono::milliseconds(5));
-    return done();
-  }
-  TestNode t;
-  std::map<std::string, std::map<std::string, std::string>> diag;
-};
-
-std::unique_ptr<Process> Start(const std::string& exe, const std::string& cfg, int domain, const std::string& log,
-                               std::vector<std::string> extra = {}, dds::Vendor vendor = dds::Vendor::kCyclone) {
-  std::vector<std::string> argv = {BinPath(exe), "--config", kConfig + "/" + cfg, "--dds", dds::ToString(vendor), "--domain",
-                                   std::to_string(domain)};
-  argv.insert(argv.end(), extra.begin(), extra.end());
-  return std::make_unique<Process>(argv, std::map<std::string, std::string>{}, false, log);
-}
 
 const msg::Obstacle* Find(const msg::ObstacleArray& a, const Eigen::Vector3d& c, double tol) {
   for (const auto& o : a.obstacles)
@@ -122,19 +90,17 @@ class CloudPathTest : public ::testing::TestWithParam<dds::Vendor> {};
 
 TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
   const dds::Vendor vendor = GetParam();
-  const int domain = UniqueDomain(vendor == dds::Vendor::kCyclone ? 41 : 42);
-  const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-test-" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
+  CellHarness cell("cloud-path", vendor, vendor == dds::Vendor::kCyclone ? 41 : 42, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
   // A box left on the table, besides the cell's parts bin.
   const Eigen::Vector3d box_centre(0.75, -0.2, 0.075), box_size(0.15, 0.15, 0.15);
-  const std::string box_file = (dir / "box.yaml").string();
-  std::ofstream(box_file) << "objects:\n  - {name: box, type: box, xyz: [0.75, -0.2, 0.075], size: [0.15, 0.15, 0.15]}\n";
-  Observer obs(domain, vendor);
+  const std::string box_file =
+      cell.WriteFile("box.yaml", "objects:\n  - {name: box, type: box, xyz: [0.75, -0.2, 0.075], size: [0.15, 0.15, 0.15]}\n");
   std::vector<msg::ObstacleArray> arrays;
   const collision::HumanBodyModel body(collision::LoadHumanBodyParams(kConfig + "/humans/upper_body.yaml"));
   Eigen::Matrix3Xd truth(3, body.num_joints());
   bool have_truth = false;
-  framework::Node& n = *obs.t.node;
+  framework::Node& n = cell.node();
   framework::SubscribeOptions any{false};
   n.Subscribe(framework::topics::Obstacles(),
               std::function<void(const msg::ObstacleArray&, SI)>([&](const msg::ObstacleArray& m, SI) { arrays.push_back(m); }), any);
@@ -155,38 +121,31 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
                 centres_at.push_back(c);
                 points.push_back(m);
               }), any);
-  auto robot = Start("iplan-robot-sim", "robot_sim.yaml", domain, (dir / "robot_sim").string(), {}, vendor);
-  auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
-                          {"--set", "perception.provider=synthetic", "--set", "perception.synthetic.start=loop", "--set",
-                           "perception.publish_truth=true", "--set", "perception.depth.provider=simulated", "--set",
-                           "perception.depth.rate_hz=10", "--set",
-                           "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"},
-                          vendor);
-  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string(), {}, vendor);
+  cell.Start("robot_sim");
+  cell.Start("perception", {"--set", "perception.synthetic.start=loop", "--set", "perception.depth.provider=simulated",
+                            "--set", "perception.depth.rate_hz=10", "--set",
+                            "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"});
+  cell.Start("cloud");
   // Clouds may come before the robot's joint states are matched (DDS
   // discovers topics in any order): those go unfiltered, and are counted.
   // From the first self-filtered cloud on, every cloud must be filtered.
-  ASSERT_TRUE(obs.SpinUntil([&] { return obs.diag["cloud"]["self_filter"] == "on"; }, std::chrono::seconds(60)))
-      << cloud->Stderr();
-  const double unfiltered_at_start = obs.Diag("cloud", "clouds_without_self_filter");
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.Diag("cloud", "self_filter") == "on"; }, std::chrono::seconds(60)))
+      << cell.Logs("cloud");
+  const double unfiltered_at_start = cell.DiagNumber("cloud", "clouds_without_self_filter", -1);
   EXPECT_LE(unfiltered_at_start, 10) << "clouds before the first joint state";
   arrays.clear();
   points.clear();
   centres_at.clear();
-  ASSERT_TRUE(obs.SpinUntil([&] { return arrays.size() >= 60 && points.size() >= 60; }, std::chrono::seconds(90)))
-      << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cloud->Stderr()
-      << perception->Stderr();
+  ASSERT_TRUE(cell.SpinUntil([&] { return arrays.size() >= 60 && points.size() >= 60; }, std::chrono::seconds(90)))
+      << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cell.Logs("cloud")
+      << cell.Logs("perception");
 
   CheckObstacles(arrays, box_centre, box_size);
   CheckHumanPoints(points, centres_at, body);
-  obs.SpinUntil([&] { return obs.Diag("cloud", "clouds") > 50; }, std::chrono::seconds(3));
-  EXPECT_GT(obs.Diag("cloud", "clouds"), 50);
-  EXPECT_EQ(obs.Diag("cloud", "clouds_without_self_filter"), unfiltered_at_start);
-  for (auto* p : {cloud.get(), perception.get(), robot.get()}) p->Signal(SIGTERM);
-  EXPECT_EQ(cloud->Wait(std::chrono::seconds(10)), 0) << cloud->Stderr();
-  EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
-  EXPECT_EQ(robot->Wait(std::chrono::seconds(10)), 0);
-  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+  cell.SpinUntil([&] { return cell.DiagNumber("cloud", "clouds") > 50; }, std::chrono::seconds(3));
+  EXPECT_GT(cell.DiagNumber("cloud", "clouds"), 50);
+  EXPECT_EQ(cell.DiagNumber("cloud", "clouds_without_self_filter", -1), unfiltered_at_start);
+  cell.Stop();
 }
 
 INSTANTIATE_TEST_SUITE_P(BothVendors, CloudPathTest, ::testing::Values(dds::Vendor::kCyclone, dds::Vendor::kFastDds),
@@ -195,7 +154,8 @@ INSTANTIATE_TEST_SUITE_P(BothVendors, CloudPathTest, ::testing::Values(dds::Vend
 // perception's PCD replay publishes the files of a folder in name order, each
 // cloud point for point the file's (x, y, z, NaN where the file has NaN).
 TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
-  const int domain = UniqueDomain(45);
+  CellHarness cell("pcd-replay", dds::Vendor::kCyclone, 45, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
   const std::string folder = std::string(IPLAN_SHARED_DIR) + "/data/pointclouds/mosd_learn";
   std::vector<std::string> files;
   for (const auto& e : std::filesystem::directory_iterator(folder))
@@ -204,9 +164,8 @@ TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
   ASSERT_GE(files.size(), 4u);
   std::vector<cloud::Cloud> truth;
   for (std::size_t i = 0; i < 4; ++i) truth.push_back(cloud::LoadPcd(files[i]));
-  Observer obs(domain);
   std::vector<int> which;  // index of the file each received cloud equals, -1 none
-  obs.t.node->Subscribe(framework::topics::DepthPoints(),
+  cell.node().Subscribe(framework::topics::DepthPoints(),
                         std::function<void(const msg::PointCloud2&, SI)>([&](const msg::PointCloud2& m, SI) {
                           cloud::Cloud c;
                           if (services::FromPointCloud2(m, &c)) return;
@@ -224,21 +183,18 @@ TEST(CloudServiceTest, PcdReplayPublishesTheFilesInOrder) {
                           which.push_back(match);
                         }),
                         framework::SubscribeOptions{false});
-  const auto dir = std::filesystem::temp_directory_path() / ("iplan-pcd-test-" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  auto perception = Start("iplan-perception", "perception.yaml", domain, (dir / "perception").string(),
-                          {"--set", "perception.depth.provider=pcd", "--set", "perception.depth.pcd.path=" + folder, "--set",
-                           "perception.depth.rate_hz=4", "--set", "perception.depth.pcd.loop=false"});
-  ASSERT_TRUE(obs.SpinUntil([&] { return which.size() >= 3 && which.back() == 3; }, std::chrono::seconds(30)))
-      << which.size() << " clouds\n" << perception->Stderr();
+  cell.Start("perception", {"--set", "perception.depth.provider=pcd", "--set", "perception.depth.pcd.path=" + folder,
+                            "--set", "perception.depth.rate_hz=4", "--set", "perception.depth.pcd.loop=false"});
+  ASSERT_TRUE(cell.SpinUntil([&] { return which.size() >= 3 && which.back() == 3; }, std::chrono::seconds(30)))
+      << which.size() << " clouds\n" << cell.Logs("perception");
   // Every received cloud is one of the files, in order (best effort: one may be lost).
   for (std::size_t i = 0; i < which.size(); ++i) {
     EXPECT_GE(which[i], 0) << i;
-    if (i > 0) EXPECT_GT(which[i], which[i - 1]) << i;
+    if (i > 0) {
+      EXPECT_GT(which[i], which[i - 1]) << i;
+    }
   }
-  perception->Signal(SIGTERM);
-  EXPECT_EQ(perception->Wait(std::chrono::seconds(10)), 0);
-  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+  cell.Stop();
 }
 
 // Bad configurations are refused with exit code 2 and the key named.
@@ -278,14 +234,13 @@ msg::PointCloud2 GoodCloud() {
 }
 
 TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
-  const int domain = UniqueDomain(43);
-  const auto dir = std::filesystem::temp_directory_path() / ("iplan-cloud-bad-" + std::to_string(getpid()));
-  std::filesystem::create_directories(dir);
-  Observer obs(domain);
-  auto cloud = Start("iplan-cloud", "cloud.yaml", domain, (dir / "cloud").string(), {"--set", "cloud.robot=\"\""});
-  auto& writer = obs.t.node->Advertise(framework::topics::DepthPoints());
-  ASSERT_TRUE(obs.SpinUntil([&] { return writer.MatchedReaders() > 0 && obs.Diag("cloud", "state") != -1; }, std::chrono::seconds(20)))
-      << cloud->Stderr();
+  CellHarness cell("cloud-bad", dds::Vendor::kCyclone, 43, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
+  cell.Start("cloud", {"--set", "cloud.robot=\"\""});
+  auto& writer = cell.node().Advertise(framework::topics::DepthPoints());
+  ASSERT_TRUE(cell.SpinUntil([&] { return writer.MatchedReaders() > 0 && !cell.Diag("cloud", "state").empty(); },
+                             std::chrono::seconds(20)))
+      << cell.Logs("cloud");
   std::vector<msg::PointCloud2> framework_bad, layout_bad;
   { auto m = GoodCloud(); m.data.resize(1100); framework_bad.push_back(m); }           // data vs row_step * height
   { auto m = GoodCloud(); m.width = 200; framework_bad.push_back(m); }                 // point_step * width > row_step
@@ -303,7 +258,7 @@ TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
     for (auto& m : *set) {
       m.header.stamp = msg::Now();
       writer.Write(m);
-      obs.SpinUntil([] { return false; }, std::chrono::seconds(0));
+      cell.SpinFor(std::chrono::milliseconds(0));
       std::this_thread::sleep_for(std::chrono::milliseconds(60));  // best-effort reader: one at a time
     }
   }
@@ -311,17 +266,15 @@ TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
   good.header.stamp = msg::Now();
   writer.Write(good);
   const double nf = static_cast<double>(framework_bad.size()), nl = static_cast<double>(layout_bad.size());
-  EXPECT_TRUE(obs.SpinUntil([&] {
-    return obs.Diag("cloud", "rejected/rt/iplan/depth/points") == nf && obs.Diag("cloud", "rejected_inputs/depth_points") == nl &&
-           obs.Diag("cloud", "clouds") == 1;
+  const auto diag = [&](const std::string& key) { return cell.DiagNumber("cloud", key, -1); };
+  EXPECT_TRUE(cell.SpinUntil([&] {
+    return diag("rejected/rt/iplan/depth/points") == nf && diag("rejected_inputs/depth_points") == nl && diag("clouds") == 1;
   }, std::chrono::seconds(15)))
-      << "framework rejections " << obs.Diag("cloud", "rejected/rt/iplan/depth/points") << " of " << nf
-      << ", layout rejections " << obs.Diag("cloud", "rejected_inputs/depth_points") << " of " << nl << ", processed "
-      << obs.Diag("cloud", "clouds") << "\n" << cloud->Stderr();
-  EXPECT_TRUE(cloud->Running());
-  cloud->Signal(SIGTERM);
-  EXPECT_EQ(cloud->Wait(std::chrono::seconds(10)), 0) << cloud->Stderr();
-  if (!::testing::Test::HasFailure()) std::filesystem::remove_all(dir);
+      << "framework rejections " << diag("rejected/rt/iplan/depth/points") << " of " << nf << ", layout rejections "
+      << diag("rejected_inputs/depth_points") << " of " << nl << ", processed " << diag("clouds") << "\n"
+      << cell.Logs("cloud");
+  EXPECT_TRUE(cell["cloud"].Running());
+  cell.Stop();
 }
 
 }  // namespace

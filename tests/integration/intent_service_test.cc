@@ -26,7 +26,7 @@
 #include "iplan/intent/model_io.h"
 #include "iplan/intent/skeleton_data.h"
 #include "iplan/msg/time.h"
-#include "test_node.h"
+#include "cell_harness.h"
 #include "test_paths.h"
 
 namespace iplan::testing {
@@ -81,24 +81,27 @@ class IntentServiceTest : public ::testing::Test {
     std::ofstream(path) << content;
     return path;
   }
-  // An intent configuration next to the model (relative model path).
-  static std::string IntentConfig(const std::string& name, const std::vector<std::string>& joints, double rate,
-                                  const std::string& model = "florence.model") {
+  // An intent configuration of the trained model (or `model`, relative to
+  // the file's folder).
+  static std::string IntentConfigText(const std::vector<std::string>& joints, double rate, const std::string& model = "") {
     std::string list;
     for (const auto& j : joints) list += (list.empty() ? "" : ", ") + j;
-    return Write(name, "node:\n  diagnostics_period: 0.2\nintent:\n  model: " + model + "\n  joints: [" + list +
-                           "]\n  rate_hz: " + std::to_string(rate) + "\n  body_timeout: 1.0\n");
+    return "node:\n  diagnostics_period: 0.2\nintent:\n  model: " + (model.empty() ? *dir_ + "/florence.model" : model) +
+           "\n  joints: [" + list + "]\n  rate_hz: " + std::to_string(rate) + "\n  body_timeout: 1.0\n";
+  }
+  static std::string IntentConfig(const std::string& name, const std::vector<std::string>& joints, double rate,
+                                  const std::string& model = "") {
+    return Write(name, IntentConfigText(joints, rate, model));
   }
 
   // A perception configuration replaying kPlayed once, moved into W.
-  static std::string ReplayConfig() {
+  static std::string ReplayConfigText() {
     std::string seqs;
     for (const auto& s : kPlayed) seqs += (seqs.empty() ? "" : ", ") + s;
-    return Write("perception.yaml",
-                 "node:\n  diagnostics_period: 0.2\nperception:\n  provider: replay\n  frame_id: world\n  replay:\n"
-                 "    file: " + kCsv + "\n    sequences: [" + seqs + "]\n    loop: false\n    rate: 1.0\n    pause: 0.3\n"
-                 "    start_delay: 2.0\n    joint_map:\n      wrist_l: hand_l\n      wrist_r: hand_r\n"
-                 "    transform:\n      translation: [0.5, -0.2, 0.1]\n      yaw: 0\n");
+    return "node:\n  diagnostics_period: 0.2\nperception:\n  provider: replay\n  frame_id: world\n  replay:\n"
+           "    file: " + kCsv + "\n    sequences: [" + seqs + "]\n    loop: false\n    rate: 1.0\n    pause: 0.3\n"
+           "    start_delay: 2.0\n    joint_map:\n      wrist_l: hand_l\n      wrist_r: hand_r\n"
+           "    transform:\n      translation: [0.5, -0.2, 0.1]\n      yaw: 0\n";
   }
 
   static std::string* dir_;
@@ -108,43 +111,6 @@ class IntentServiceTest : public ::testing::Test {
 std::string* IntentServiceTest::dir_ = nullptr;
 intent::IntentModel* IntentServiceTest::model_ = nullptr;
 intent::SkeletonDataset* IntentServiceTest::played_ = nullptr;
-
-// Latest diagnostics values of one service.
-struct Diagnostics {
-  std::map<std::string, std::map<std::string, std::string>> values;  // service -> key -> value
-  std::map<std::string, std::string> state;
-  void Subscribe(framework::Node& node) {
-    node.Subscribe(framework::topics::Diagnostics(),
-                   std::function<void(const msg::DiagnosticArray&, const dds::SampleInfo&)>(
-                       [this](const msg::DiagnosticArray& a, const dds::SampleInfo&) {
-                         for (const auto& s : a.status) {
-                           state[s.name] = s.message;
-                           for (const auto& kv : s.values) values[s.name][kv.key] = kv.value;
-                         }
-                       }));
-  }
-  std::string Get(const std::string& svc, const std::string& key) const {
-    const auto it = values.find(svc);
-    if (it == values.end()) return "";
-    const auto kv = it->second.find(key);
-    return kv == it->second.end() ? "" : kv->second;
-  }
-};
-
-template <class F>
-bool SpinUntil(framework::Node& node, std::chrono::seconds timeout, F&& done) {
-  const auto end = std::chrono::steady_clock::now() + timeout;
-  while (!done()) {
-    if (std::chrono::steady_clock::now() > end) return false;
-    node.SpinOnce(20ms);
-  }
-  return true;
-}
-
-void SpinFor(framework::Node& node, std::chrono::milliseconds d) {
-  const auto end = std::chrono::steady_clock::now() + d;
-  while (std::chrono::steady_clock::now() < end) node.SpinOnce(10ms);
-}
 
 // What the observer saw, by stamp (ns): skeletons by their stamp, beliefs
 // and predictions by the stamp of the skeleton they come from.
@@ -244,47 +210,43 @@ void ExpectRecordedSpacing(const std::map<int64_t, msg::HumanSkeleton>& skeleton
 // The service's own counters: nothing rejected, at least `matched` frames
 // accepted. Diagnostics come once a second: wait for the one that counts
 // every output seen (on a loaded machine the newest may still be older).
-void ExpectCountersCoverTheOutputs(framework::Node& node, Diagnostics& diag, int matched) {
-  const auto accepted = [&] {
-    const std::string v = diag.Get("intent", "frames_accepted");
-    return v.empty() ? 0 : std::stoi(v);
-  };
-  SpinUntil(node, 5s, [&] { return accepted() >= matched; });
-  EXPECT_EQ(diag.Get("intent", "frames_rejected"), "0");
+void ExpectCountersCoverTheOutputs(CellHarness& cell, int matched) {
+  const auto accepted = [&] { return cell.DiagNumber("intent", "frames_accepted"); };
+  cell.SpinUntil([&] { return accepted() >= matched; }, 5s);
+  EXPECT_EQ(cell.Diag("intent", "frames_rejected"), "0");
   EXPECT_GE(accepted(), matched);
-  EXPECT_EQ(diag.Get("intent", "rejected/" + kSkeletonTopic), "0");
-  EXPECT_FALSE(diag.Get("intent", "cycle_time_p99_s").empty());
+  EXPECT_EQ(cell.Diag("intent", "rejected/" + kSkeletonTopic), "0");
+  EXPECT_FALSE(cell.Diag("intent", "cycle_time_p99_s").empty());
 }
 
 TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) {
-  const int domain = UniqueDomain(11);
-  TestNode observer("observer", dds::Vendor::kCyclone, domain);
-  framework::Node& node = *observer.node;
-  Diagnostics diag;
-  diag.Subscribe(node);
+  CellHarness cell("intent-replay", dds::Vendor::kCyclone, 11, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
+  framework::Node& node = cell.node();
   Observed seen;
   seen.Subscribe(node);
   const auto& skeletons = seen.skeletons;
   const auto& beliefs = seen.beliefs;
   const auto& predictions = seen.predictions;
   const std::vector<std::string>& joints = model_->config.joints.joints;
-  Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",
-                  "cyclonedds", "--domain", std::to_string(domain)});
-  ASSERT_TRUE(SpinUntil(node, 30s, [&] { return diag.state["intent"] == "active"; })) << intent.Stderr();
+  cell.Configure("intent", cell.WriteFile("intent.yaml", IntentConfigText(joints, 15.0)));
+  cell.Start("intent");
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.State("intent") == "active"; }, 30s)) << cell.Logs("intent");
 
-  const std::string perception_yaml = ReplayConfig();
-  Process perception({BinPath("iplan-perception"), "--config", perception_yaml, "--dds", "fastdds", "--domain",
-                      std::to_string(domain)});
-  ASSERT_TRUE(SpinUntil(node, 60s, [&] { return diag.Get("perception", "replay_finished") == "true"; }))
-      << perception.Stderr();
-  SpinFor(node, 1500ms);  // last outputs and diagnostics
+  // The recording comes from the other vendor.
+  cell.Configure("perception", cell.WriteFile("perception.yaml", ReplayConfigText()));
+  cell.SetVendor("perception", dds::Vendor::kFastDds);
+  cell.Start("perception");
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.Diag("perception", "replay_finished") == "true"; }, 60s))
+      << cell.Logs("perception");
+  cell.SpinFor(1500ms);  // last outputs and diagnostics
 
   // Every played frame was published (all Florence joints are detected).
   int frames = 0;
   for (const auto& s : played_->sequences) {
     if (std::find(kPlayed.begin(), kPlayed.end(), s.id) != kPlayed.end()) frames += static_cast<int>(s.time.size());
   }
-  EXPECT_EQ(diag.Get("perception", "published"), std::to_string(frames));
+  EXPECT_EQ(cell.Diag("perception", "published"), std::to_string(frames));
   ASSERT_GE(static_cast<int>(skeletons.size()), frames - 2) << "observer missed skeletons";
   EXPECT_EQ(seen.duplicate_outputs, 0);
 
@@ -324,12 +286,8 @@ TEST_F(IntentServiceTest, ReplayedSequencesGetABeliefAndAPredictionPerSkeleton) 
   EXPECT_LE(unknown_stamps, frames - static_cast<int>(skeletons.size()));
 
   ExpectRecordedSpacing(skeletons, seq0);
-  ExpectCountersCoverTheOutputs(node, diag, matched);
-
-  perception.Signal(SIGTERM);
-  intent.Signal(SIGTERM);
-  EXPECT_EQ(perception.Wait(10s), 0) << perception.Stderr();
-  EXPECT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+  ExpectCountersCoverTheOutputs(cell, matched);
+  cell.Stop();
 }
 
 msg::HumanSkeleton Skeleton(uint32_t body, const std::vector<std::string>& names, const msg::Time& stamp) {
@@ -351,9 +309,9 @@ msg::HumanSkeleton Skeleton(uint32_t body, const std::vector<std::string>& names
 }
 
 // Writes a skeleton and gives the service time to answer.
-void Send(framework::Node& node, dds::Writer<msg::HumanSkeleton>& w, const msg::HumanSkeleton& s) {
+void Send(CellHarness& cell, dds::Writer<msg::HumanSkeleton>& w, const msg::HumanSkeleton& s) {
   ASSERT_TRUE(w.Write(s));
-  SpinFor(node, 60ms);
+  cell.SpinFor(60ms);
 }
 
 // Three good skeletons of body 500; garbage the boundary refuses (NaN, no
@@ -361,43 +319,41 @@ void Send(framework::Node& node, dds::Writer<msg::HumanSkeleton>& w, const msg::
 // missing, one at (0, 0, 0)); a fourth good one; then a backwards stamp on
 // the same writer (boundary) and an older stamp for body 500 from writer b
 // (core).
-void SendGoodAndGarbage(framework::Node& node, dds::Writer<msg::HumanSkeleton>& a, dds::Writer<msg::HumanSkeleton>& b,
+void SendGoodAndGarbage(CellHarness& cell, dds::Writer<msg::HumanSkeleton>& a, dds::Writer<msg::HumanSkeleton>& b,
                         const std::vector<std::string>& joints) {
   const double nan = std::numeric_limits<double>::quiet_NaN();
-  for (int i = 0; i < 3; ++i) Send(node, a, Skeleton(500, joints, msg::Now()));  // good: 3 outputs
+  for (int i = 0; i < 3; ++i) Send(cell, a, Skeleton(500, joints, msg::Now()));  // good: 3 outputs
 
   msg::HumanSkeleton bad = Skeleton(501, joints, msg::Now());
   bad.joints[2].position.y = nan;  // boundary check: non-finite
-  Send(node, a, bad);
+  Send(cell, a, bad);
   bad = Skeleton(502, {}, msg::Now());  // boundary check: no joints
-  Send(node, a, bad);
+  Send(cell, a, bad);
   bad = Skeleton(503, joints, msg::Now());
   bad.joints.push_back(bad.joints[0]);  // boundary check: duplicate joint name
-  Send(node, a, bad);
+  Send(cell, a, bad);
   std::vector<std::string> wrong = joints;
   for (auto& n : wrong) n = "openpose_" + n;
-  Send(node, a, Skeleton(504, wrong, msg::Now()));  // core: no model joint
+  Send(cell, a, Skeleton(504, wrong, msg::Now()));  // core: no model joint
   bad = Skeleton(505, joints, msg::Now());
   bad.joints.pop_back();  // core: one model joint missing
-  Send(node, a, bad);
+  Send(cell, a, bad);
   bad = Skeleton(506, joints, msg::Now());
   bad.joints[1].position = {};  // core: (0, 0, 0) is "not detected"
-  Send(node, a, bad);
+  Send(cell, a, bad);
   const msg::Time last_good_stamp = msg::Now();
-  Send(node, a, Skeleton(500, joints, last_good_stamp));  // good: output 4
+  Send(cell, a, Skeleton(500, joints, last_good_stamp));  // good: output 4
   // Backwards stamp on the same writer: boundary check.
-  Send(node, a, Skeleton(507, joints, msg::TimeFromSeconds(msg::ToSeconds(msg::Now()) - 1.0)));
+  Send(cell, a, Skeleton(507, joints, msg::TimeFromSeconds(msg::ToSeconds(msg::Now()) - 1.0)));
   // Another writer (first stamp of its own is accepted by the boundary check)
   // repeats body 500 at an older stamp: the core rejects it.
-  Send(node, b, Skeleton(500, joints, msg::TimeFromSeconds(msg::ToSeconds(last_good_stamp) - 0.5)));
+  Send(cell, b, Skeleton(500, joints, msg::TimeFromSeconds(msg::ToSeconds(last_good_stamp) - 0.5)));
 }
 
 TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
-  const int domain = UniqueDomain(12);
-  TestNode garbage("garbage", dds::Vendor::kFastDds, domain);
-  framework::Node& node = *garbage.node;
-  Diagnostics diag;
-  diag.Subscribe(node);
+  CellHarness cell("intent-garbage", dds::Vendor::kFastDds, 12, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
+  framework::Node& node = cell.node();
   std::multiset<uint32_t> belief_bodies, prediction_bodies;
   node.Subscribe(framework::topics::ActionBelief(),
                  std::function<void(const msg::ActionBelief&, const dds::SampleInfo&)>(
@@ -408,40 +364,40 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
                        prediction_bodies.insert(p.body_id);
                      }));
   const auto topic = framework::topics::HumanSkeleton();
-  dds::Writer<msg::HumanSkeleton> a(*garbage.participant, topic.name, topic.qos);
-  dds::Writer<msg::HumanSkeleton> b(*garbage.participant, topic.name, topic.qos);
+  dds::Writer<msg::HumanSkeleton> a(cell.participant(), topic.name, topic.qos);
+  dds::Writer<msg::HumanSkeleton> b(cell.participant(), topic.name, topic.qos);
 
   const std::vector<std::string>& joints = model_->config.joints.joints;
-  Process intent({BinPath("iplan-intent"), "--config", IntentConfig("intent.yaml", joints, 15.0), "--dds",
-                  "cyclonedds", "--domain", std::to_string(domain)});
-  ASSERT_TRUE(SpinUntil(node, 30s, [&] {
-    return diag.state["intent"] == "active" && a.MatchedReaders() > 0 && b.MatchedReaders() > 0;
-  })) << intent.Stderr();
-  SpinFor(node, 500ms);
+  cell.Configure("intent", cell.WriteFile("intent.yaml", IntentConfigText(joints, 15.0)));
+  cell.SetVendor("intent", dds::Vendor::kCyclone);
+  cell.Start("intent");
+  ASSERT_TRUE(cell.SpinUntil([&] {
+    return cell.State("intent") == "active" && a.MatchedReaders() > 0 && b.MatchedReaders() > 0;
+  }, 30s)) << cell.Logs("intent");
+  cell.SpinFor(500ms);
 
-  ASSERT_NO_FATAL_FAILURE(SendGoodAndGarbage(node, a, b, joints));
-  SpinFor(node, 1000ms);
+  ASSERT_NO_FATAL_FAILURE(SendGoodAndGarbage(cell, a, b, joints));
+  cell.SpinFor(1000ms);
 
-  EXPECT_TRUE(intent.Running()) << intent.Stderr();
+  EXPECT_TRUE(cell["intent"].Running()) << cell.Logs("intent");
   EXPECT_EQ(belief_bodies, std::multiset<uint32_t>({500, 500, 500, 500}));
   EXPECT_EQ(prediction_bodies, std::multiset<uint32_t>({500, 500, 500, 500}));
-  EXPECT_EQ(diag.Get("intent", "rejected/" + kSkeletonTopic), "4");  // nan, empty, duplicate, backwards
-  EXPECT_EQ(diag.Get("intent", "frames_rejected/missing_joint"), "3");
-  EXPECT_EQ(diag.Get("intent", "frames_rejected/stamp_not_increasing"), "1");
-  EXPECT_EQ(diag.Get("intent", "frames_rejected"), "4");
-  EXPECT_EQ(diag.Get("intent", "frames_accepted"), "4");
-  EXPECT_NE(diag.Get("intent", "last_rejected_frame").find("not after body 500"), std::string::npos)
-      << diag.Get("intent", "last_rejected_frame");
+  EXPECT_EQ(cell.Diag("intent", "rejected/" + kSkeletonTopic), "4");  // nan, empty, duplicate, backwards
+  EXPECT_EQ(cell.Diag("intent", "frames_rejected/missing_joint"), "3");
+  EXPECT_EQ(cell.Diag("intent", "frames_rejected/stamp_not_increasing"), "1");
+  EXPECT_EQ(cell.Diag("intent", "frames_rejected"), "4");
+  EXPECT_EQ(cell.Diag("intent", "frames_accepted"), "4");
+  EXPECT_NE(cell.Diag("intent", "last_rejected_frame").find("not after body 500"), std::string::npos)
+      << cell.Diag("intent", "last_rejected_frame");
 
   // Still serving after the garbage.
-  ASSERT_NO_FATAL_FAILURE(Send(node, a, Skeleton(500, joints, msg::Now())));
-  SpinFor(node, 500ms);
+  ASSERT_NO_FATAL_FAILURE(Send(cell, a, Skeleton(500, joints, msg::Now())));
+  cell.SpinFor(500ms);
   EXPECT_EQ(belief_bodies.count(500), 5u);
 
-  intent.Signal(SIGTERM);
-  ASSERT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+  cell.Stop();
   // Each kind of core rejection is logged once, then only counted.
-  const std::string err = intent.Stderr();
+  const std::string err = cell.Logs("intent");
   auto count = [&](const std::string& text) {
     int n = 0;
     for (std::size_t at = err.find(text); at != std::string::npos; at = err.find(text, at + 1)) ++n;
@@ -455,9 +411,9 @@ TEST_F(IntentServiceTest, GarbageSkeletonsAreRejectedCountedAndProduceNothing) {
 // component, the model's horizon and rate, a straight line continued), the
 // belief stays the model's.
 TEST_F(IntentServiceTest, ABaselinePredictorReplacesThePredictionNotTheBelief) {
-  const int domain = UniqueDomain(14);
-  TestNode cell("baseline_test", dds::Vendor::kCyclone, domain);
-  framework::Node& node = *cell.node;
+  CellHarness cell("intent-baseline", dds::Vendor::kCyclone, 14, "", /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
+  framework::Node& node = cell.node();
   std::optional<msg::ActionBelief> belief;
   std::optional<msg::HumanPrediction> prediction;
   node.Subscribe(framework::topics::ActionBelief(),
@@ -467,11 +423,11 @@ TEST_F(IntentServiceTest, ABaselinePredictorReplacesThePredictionNotTheBelief) {
                  std::function<void(const msg::HumanPrediction&, const dds::SampleInfo&)>(
                      [&](const msg::HumanPrediction& p, const dds::SampleInfo&) { prediction = p; }));
   const std::vector<std::string>& joints = model_->config.joints.joints;
-  const std::string cfg = IntentConfig("intent-cv.yaml", joints, 15.0);
-  std::ofstream(cfg, std::ios::app) << "  predictor: constant-velocity\n";
-  Process intent({BinPath("iplan-intent"), "--config", cfg, "--dds", "fastdds", "--domain", std::to_string(domain)});
+  cell.Configure("intent", cell.WriteFile("intent.yaml", IntentConfigText(joints, 15.0) + "  predictor: constant-velocity\n"));
+  cell.SetVendor("intent", dds::Vendor::kFastDds);
+  cell.Start("intent");
   auto& w = node.Advertise(framework::topics::HumanSkeleton());
-  ASSERT_TRUE(SpinUntil(node, 30s, [&] { return w.MatchedReaders() > 0; })) << intent.Stderr();
+  ASSERT_TRUE(cell.SpinUntil([&] { return w.MatchedReaders() > 0; }, 30s)) << cell.Logs("intent");
   // Every joint moves at 0.3 m/s along x, at 30 Hz for 0.5 s.
   const double t0 = msg::ToSeconds(msg::Now());
   msg::HumanSkeleton last;
@@ -480,10 +436,10 @@ TEST_F(IntentServiceTest, ABaselinePredictorReplacesThePredictionNotTheBelief) {
     last = Skeleton(700, joints, msg::TimeFromSeconds(t));
     for (auto& j : last.joints) j.position.x += 0.3 * (t - t0);
     ASSERT_TRUE(w.Write(last));
-    SpinFor(node, 33ms);
+    cell.SpinFor(33ms);
   }
-  SpinFor(node, 300ms);
-  ASSERT_TRUE(prediction.has_value()) << intent.Stderr();
+  cell.SpinFor(300ms);
+  ASSERT_TRUE(prediction.has_value()) << cell.Logs("intent");
   ASSERT_TRUE(belief.has_value());
   EXPECT_EQ(belief->actions, model_->actions);
   ASSERT_EQ(prediction->actions.size(), 1u);
@@ -496,8 +452,7 @@ TEST_F(IntentServiceTest, ABaselinePredictorReplacesThePredictionNotTheBelief) {
   const double tau = (k + 1) * prediction->time_step;
   EXPECT_NEAR(prediction->actions[0].joints[static_cast<std::size_t>(k) * J].mean.x, last.joints[0].position.x + 0.3 * tau,
               1e-6);
-  intent.Signal(SIGTERM);
-  EXPECT_EQ(intent.Wait(10s), 0) << intent.Stderr();
+  cell.Stop();
 }
 
 TEST_F(IntentServiceTest, AModelThatDoesNotMatchTheConfigurationIsRefused) {

@@ -18,6 +18,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <fstream>
 #include <functional>
 #include <iostream>
 #include <map>
@@ -105,6 +106,7 @@ class CellHarness {
     node.Subscribe(framework::topics::Diagnostics(),
                    std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
                      for (const auto& st : a.status) {
+                       state_[st.name] = st.message;
                        for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
                      }
                    }),
@@ -135,6 +137,8 @@ class CellHarness {
   /// The keystore the cell runs with ("" when unsecured).
   const std::string& security() const { return security_; }
   framework::Node& node() { return *observer_->node; }
+  /// The observer's participant (for the test's own writers and readers).
+  dds::Participant& participant() { return *observer_->participant; }
   int domain() const { return domain_; }
   /// The cell's folder: the services' logs (kept when the test failed) and
   /// whatever files the test writes for them.
@@ -153,28 +157,32 @@ class CellHarness {
   /// Runs `svc` on `vendor` instead of the cell's (from its next Start).
   void SetVendor(const std::string& svc, dds::Vendor vendor) { vendors_[svc] = vendor; }
 
-  /// Starts (or restarts) `svc` with the shipped configuration.
+  /// Starts `svc` with the configuration file `path` (e.g. one the test
+  /// wrote into dir()) instead of config/<svc>.yaml, and without the cell's
+  /// own settings for it (intent's model, perception's synthetic person, the
+  /// supervisor's Q-table): the file says everything (from its next Start).
+  void Configure(const std::string& svc, const std::string& path) { configs_[svc] = path; }
+
+  /// Writes `content` to dir()/`name` and returns its path.
+  std::string WriteFile(const std::string& name, const std::string& content) const {
+    const std::string path = (dir_ / name).string();
+    std::ofstream(path) << content;
+    return path;
+  }
+
+  /// Starts (or restarts) `svc` with the shipped configuration (or the file
+  /// Configure gave) and `extra` arguments after it.
   void Start(const std::string& svc, const std::vector<std::string>& extra = {}) {
     const std::string exe = svc == "robot_sim" ? "robot-sim" : svc == "collision_risk" ? "collision-risk" : svc;
     const dds::Vendor vendor = vendors_.count(svc) ? vendors_.at(svc) : vendor_;
     std::vector<std::string> argv = launchers_[svc];
-    argv.insert(argv.end(), {BinPath("iplan-" + exe), "--config", config_dir_ + "/" + svc + ".yaml", "--dds",
+    const bool own_config = configs_.count(svc) > 0;
+    argv.insert(argv.end(), {BinPath("iplan-" + exe), "--config",
+                             own_config ? configs_.at(svc) : config_dir_ + "/" + svc + ".yaml", "--dds",
                              dds::ToString(vendor), "--domain", std::to_string(domain_)});
     if (security_.empty()) argv.push_back("--insecure");
     if (!security_.empty()) argv.insert(argv.end(), {"--security", security_});
-    if (svc == "intent") {
-      if (model_.empty()) {
-        ADD_FAILURE() << "intent started in a cell made without it";
-        return;
-      }
-      argv.insert(argv.end(), {"--set", "intent.model=" + model_});
-    }
-    if (svc == "perception") {
-      argv.insert(argv.end(), {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true"});
-    }
-    if (svc == "supervisor") {
-      argv.insert(argv.end(), {"--set", "supervisor.q_table=" + q_table(), "--set", "supervisor.pause_between_tasks=0.2"});
-    }
+    if (!own_config && !AddCellSettings(svc, &argv)) return;
     argv.insert(argv.end(), extra.begin(), extra.end());
     procs_[svc] = std::make_unique<Process>(argv, std::map<std::string, std::string>{{"IPLAN_SECURITY", security_}},
                                             false, (dir_ / (svc + "-" + std::to_string(++starts_))).string());
@@ -275,12 +283,38 @@ class CellHarness {
     auto k = s->second.find(key);
     return k == s->second.end() ? "" : k->second;
   }
+  /// The newest diagnostics message of a service (its lifecycle state,
+  /// e.g. "active"; "" when not seen).
+  std::string State(const std::string& service) const {
+    auto s = state_.find(service);
+    return s == state_.end() ? "" : s->second;
+  }
   double DiagNumber(const std::string& service, const std::string& key, double otherwise = 0) const {
     const std::string v = Diag(service, key);
     return v.empty() ? otherwise : std::stod(v);
   }
 
  private:
+  /// The cell's own settings for `svc` (shipped configuration): intent's
+  /// model, perception's synthetic person, the supervisor's Q-table. False
+  /// (and a test failure) for intent in a cell made without it.
+  bool AddCellSettings(const std::string& svc, std::vector<std::string>* argv) const {
+    if (svc == "intent") {
+      if (model_.empty()) {
+        ADD_FAILURE() << "intent started in a cell made without it";
+        return false;
+      }
+      argv->insert(argv->end(), {"--set", "intent.model=" + model_});
+    }
+    if (svc == "perception") {
+      argv->insert(argv->end(), {"--set", "perception.provider=synthetic", "--set", "perception.publish_truth=true"});
+    }
+    if (svc == "supervisor") {
+      argv->insert(argv->end(), {"--set", "supervisor.q_table=" + q_table(), "--set", "supervisor.pause_between_tasks=0.2"});
+    }
+    return true;
+  }
+
   dds::Vendor vendor_;
   int domain_;
   std::string security_;  ///< DDS Security keystore, or ""
@@ -296,6 +330,8 @@ class CellHarness {
   std::vector<PermitSample> permits_;
   std::vector<msg::TaskOutcome> outcomes_;
   std::map<std::string, std::map<std::string, std::string>> diag_;
+  std::map<std::string, std::string> state_;    ///< service -> newest diagnostics message
+  std::map<std::string, std::string> configs_;  ///< services started with the test's own file (Configure)
 };
 
 }  // namespace iplan::testing
