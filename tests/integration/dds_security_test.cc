@@ -222,52 +222,6 @@ struct Variant {
   std::string clients;   ///< vendor of every other participant
 };
 
-// The cell's observer in this process: a credentialed participant (enclave
-// iplan-observer) recording robot-sim's diagnostics and the skeletons.
-class Observer {
- public:
-  Observer(const std::string& vendor, int domain) {
-    dds::ParticipantOptions o;
-    o.vendor = dds::ParseVendor(vendor);
-    o.domain_id = domain;
-    o.name = "iplan-observer";
-    o.security_dir = Keystores::Cell();
-    participant_ = dds::Participant::Create(o);
-    framework::NodeOptions no;
-    no.diagnostics_period = 0;
-    node_ = std::make_unique<framework::Node>("observer", *participant_, no);
-    using SI = const dds::SampleInfo&;
-    node_->Subscribe(framework::topics::HumanSkeleton(),
-                     std::function<void(const msg::HumanSkeleton&, SI)>([this](const msg::HumanSkeleton&, SI) { ++skeletons; }));
-    node_->Subscribe(framework::topics::Diagnostics(),
-                     std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
-                       for (const auto& s : a.status) {
-                         if (s.name != "robot_sim") continue;
-                         ++robot_diagnostics;
-                         for (const auto& kv : s.values) robot[kv.key] = kv.value;
-                       }
-                     }),
-                     framework::SubscribeOptions{false});
-  }
-  bool SpinUntil(const std::function<bool()>& done, std::chrono::milliseconds timeout) {
-    const auto end = Clock::now() + timeout;
-    while (!done() && Clock::now() < end) node_->SpinOnce(5ms);
-    return done();
-  }
-  // robot-sim's diagnostic counter `key` (-1: not reported yet).
-  long Robot(const std::string& key) const {
-    const auto it = robot.find(key);
-    return it == robot.end() ? -1 : std::stol(it->second);
-  }
-  int skeletons = 0;
-  int robot_diagnostics = 0;
-  std::map<std::string, std::string> robot;
-
- private:
-  std::unique_ptr<dds::Participant> participant_;
-  std::unique_ptr<framework::Node> node_;
-};
-
 std::string TrajectoryJson() {
   msg::JointTrajectory t;
   t.header.frame_id = "world";
@@ -292,27 +246,32 @@ std::string PermitJson() {
 
 class SecuredCell : public ::testing::TestWithParam<Variant> {
  protected:
+  // Perception and robot-sim on the services' vendor; the observer (enclave
+  // iplan-observer) on the clients', counting skeletons.
   void SetUp() override {
-    domain_ = UniqueDomain(140 + static_cast<int>(GetParam().name.size()));
-    for (const char* svc : {"iplan-perception", "iplan-robot-sim"}) {
-      services_.push_back(std::make_unique<Process>(std::vector<std::string>{
-          BinPath(svc), "--dds", GetParam().services, "--domain", std::to_string(domain_), "--security",
-          Keystores::Cell()}));
+    cell_ = std::make_unique<CellHarness>("sec-cell-" + GetParam().name, dds::ParseVendor(GetParam().clients),
+                                          140 + static_cast<int>(GetParam().name.size()), Keystores::Cell(),
+                                          /*with_intent=*/false);
+    ASSERT_TRUE(cell_->ready());
+    cell_->node().Subscribe(framework::topics::HumanSkeleton(),
+                            std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                                [this](const msg::HumanSkeleton&, const dds::SampleInfo&) { ++skeletons_; }));
+    for (const char* svc : {"perception", "robot_sim"}) {
+      cell_->SetVendor(svc, dds::ParseVendor(GetParam().services));
+      cell_->Start(svc);
     }
-    observer_ = std::make_unique<Observer>(GetParam().clients, domain_);
   }
   void TearDown() override {
-    for (auto& s : services_) {
-      s->Signal(SIGTERM);
-      EXPECT_EQ(s->Wait(15s), 0) << s->Stderr();
-    }
+    if (cell_) cell_->Stop();
   }
+  // robot-sim's diagnostic counter `key` (-1: not reported yet).
+  long Robot(const std::string& key) const { return std::lround(cell_->DiagNumber("robot_sim", key, -1)); }
   // `iplan ARGS` on the clients' vendor and the cell's domain; `security`:
   // keystore and enclave, or empty for a participant without credentials.
   std::unique_ptr<Process> Tool(std::vector<std::string> args, const std::string& keystore = "",
                                 const std::string& enclave = "") {
     args.insert(args.begin(), BinPath("iplan"));
-    args.insert(args.end(), {"--dds", GetParam().clients, "--domain", std::to_string(domain_)});
+    args.insert(args.end(), {"--dds", GetParam().clients, "--domain", std::to_string(cell_->domain())});
     if (!keystore.empty()) args.insert(args.end(), {"--security", keystore, "--enclave", enclave});
     return std::make_unique<Process>(args);
   }
@@ -322,21 +281,20 @@ class SecuredCell : public ::testing::TestWithParam<Variant> {
     return Tool({"topic", "pub", topic, json, "--stamp-now", "-r", "20", "-n", "40", "--wait-readers", "3"}, keystore,
                 enclave);
   }
-  int domain_ = 0;
-  std::vector<std::unique_ptr<Process>> services_;
-  std::unique_ptr<Observer> observer_;
+  std::unique_ptr<CellHarness> cell_;
+  int skeletons_ = 0;
 };
 
 TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
-  Observer& obs = *observer_;
+  CellHarness& cell = *cell_;
   // The entitled observer reads skeletons and robot-sim's diagnostics.
-  ASSERT_TRUE(obs.SpinUntil([&] { return obs.skeletons >= 5 && obs.robot_diagnostics >= 1; }, 40s))
-      << "skeletons " << obs.skeletons << ", robot-sim diagnostics " << obs.robot_diagnostics << "\n"
-      << services_[0]->Stderr() << services_[1]->Stderr();
+  ASSERT_TRUE(cell.SpinUntil([&] { return skeletons_ >= 5 && cell.DiagCount("robot_sim") >= 1; }, 40s))
+      << "skeletons " << skeletons_ << ", robot-sim diagnostics " << cell.DiagCount("robot_sim") << "\n"
+      << cell.Logs("perception") << cell.Logs("robot_sim");
   const std::string traj_topic = framework::topics::RobotTrajectory().name;
   const std::string permit_topic = framework::topics::SupervisorPermit().name;
-  EXPECT_EQ(obs.Robot("received/" + traj_topic), 0);
-  EXPECT_EQ(obs.Robot("received/" + permit_topic), 0);
+  EXPECT_EQ(Robot("received/" + traj_topic), 0);
+  EXPECT_EQ(Robot("received/" + permit_topic), 0);
 
   // Strangers reading: no skeleton within 8 s (exit 1: nothing arrived).
   auto bare_echo = Tool({"topic", "echo", "/iplan/human/skeleton", "-n", "1", "--timeout", "8", "--type",
@@ -367,23 +325,23 @@ TEST_P(SecuredCell, StrangersNeitherReadNorCommandEntitledParticipantsDo) {
   EXPECT_NE(other_monitor->Stderr().find(risk_permit), std::string::npos) << other_monitor->Stderr();
   // Two more diagnostics periods: robot-sim received nothing and ignored
   // nobody (no stranger's writer ever matched its readers).
-  const int seen = obs.robot_diagnostics;
-  ASSERT_TRUE(obs.SpinUntil([&] { return obs.robot_diagnostics >= seen + 2; }, 10s));
-  EXPECT_EQ(obs.Robot("received/" + traj_topic), 0);
-  EXPECT_EQ(obs.Robot("received/" + permit_topic), 0);
-  EXPECT_EQ(obs.Robot("ignored_writers"), 0);
+  const int seen = cell.DiagCount("robot_sim");
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.DiagCount("robot_sim") >= seen + 2; }, 10s));
+  EXPECT_EQ(Robot("received/" + traj_topic), 0);
+  EXPECT_EQ(Robot("received/" + permit_topic), 0);
+  EXPECT_EQ(Robot("ignored_writers"), 0);
 
   // Entitled, credentialed writers: robot-sim accepts their trajectory and permits.
   auto traj = Publish(traj_topic, TrajectoryJson(), Keystores::Cell(), "iplan-trajopt");
   auto permit = Publish(permit_topic, PermitJson(), Keystores::Cell(), "iplan-supervisor");
   EXPECT_EQ(traj->Wait(30s), 0) << traj->Stderr();
   EXPECT_EQ(permit->Wait(30s), 0) << permit->Stderr();
-  EXPECT_TRUE(obs.SpinUntil([&] {
-    return obs.Robot("received/" + traj_topic) >= 1 && obs.Robot("received/" + permit_topic) >= 10;
-  }, 10s)) << "trajectories " << obs.Robot("received/" + traj_topic) << ", permits "
-           << obs.Robot("received/" + permit_topic);
-  EXPECT_EQ(obs.Robot("ignored_writers"), 0);
-  EXPECT_EQ(obs.Robot("rejected/" + permit_topic), 0);
+  EXPECT_TRUE(cell.SpinUntil([&] {
+    return Robot("received/" + traj_topic) >= 1 && Robot("received/" + permit_topic) >= 10;
+  }, 10s)) << "trajectories " << Robot("received/" + traj_topic) << ", permits "
+           << Robot("received/" + permit_topic);
+  EXPECT_EQ(Robot("ignored_writers"), 0);
+  EXPECT_EQ(Robot("rejected/" + permit_topic), 0);
 }
 
 INSTANTIATE_TEST_SUITE_P(Vendors, SecuredCell,

@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "test_paths.h"
+#include "cell_harness.h"
 
 namespace iplan::testing {
 namespace {
@@ -56,12 +56,13 @@ class Ros2Client : public ::testing::TestWithParam<Pairing> {};
 
 TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
   const Pairing p = GetParam();
-  const int domain = UniqueDomain(static_cast<int>(p.cell.size() * 5 + p.client.size()));
-  const std::string d = std::to_string(domain);
-  Process trajopt({BinPath("iplan-trajopt"), "--dds", p.cell, "--domain", d, "--remap",
-                   "/iplan/robot/trajectory:=/arm_controller/joint_trajectory", "--set",
-                   "trajopt.output.zero_stamp=true"});
-  Process robot({BinPath("iplan-robot-sim"), "--dds", p.cell, "--domain", d, "-r", "joint_states:=/sim/joint_states"});
+  CellHarness cell("ros2-client", dds::ParseVendor(p.cell), static_cast<int>(p.cell.size() * 5 + p.client.size()), "",
+                   /*with_intent=*/false);
+  ASSERT_TRUE(cell.ready());
+  const std::string d = std::to_string(cell.domain());
+  cell.Start("trajopt", {"--remap", "/iplan/robot/trajectory:=/arm_controller/joint_trajectory", "--set",
+                         "trajopt.output.zero_stamp=true"});
+  cell.Start("robot_sim", {"-r", "joint_states:=/sim/joint_states"});
   // The stack reads the shipped loopback profile the way any DDS
   // application does: the vendor's own environment variable.
   const std::string dds_dir = std::string(IPLAN_SOURCE_DIR) + "/config/dds/";
@@ -79,7 +80,7 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
   const auto rc = client.Wait(90s);
   const std::string out = client.Stdout();
   ASSERT_TRUE(rc.has_value()) << "the ROS 2-style client did not finish\n" << out << client.Stderr();
-  EXPECT_EQ(*rc, 0) << out << client.Stderr() << "\ntrajopt:\n" << trajopt.Stderr();
+  EXPECT_EQ(*rc, 0) << out << client.Stderr() << "\ntrajopt:\n" << cell.Logs("trajopt");
 
   int trajectories = 0, transforms = 0, states = 0;
   std::istringstream lines(out);
@@ -119,6 +120,7 @@ TEST_P(Ros2Client, ExchangesJointStatesTrajectoriesAndStaticTf) {
   EXPECT_GE(transforms, 1) << out;
   std::cout << "client (" << p.client << ") <-> cell (" << p.cell << "): " << trajectories << " trajectories, "
             << transforms << " static transforms, " << states << " joint states read\n";
+  cell.Stop();
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPairings, Ros2Client,

@@ -107,6 +107,7 @@ class CellHarness {
                    std::function<void(const msg::DiagnosticArray&, SI)>([this](const msg::DiagnosticArray& a, SI) {
                      for (const auto& st : a.status) {
                        state_[st.name] = st.message;
+                       ++diag_count_[st.name];
                        for (const auto& kv : st.values) diag_[st.name][kv.key] = kv.value;
                      }
                    }),
@@ -289,6 +290,11 @@ class CellHarness {
     auto s = state_.find(service);
     return s == state_.end() ? "" : s->second;
   }
+  /// How many diagnostics reports of a service came (one a period).
+  int DiagCount(const std::string& service) const {
+    auto s = diag_count_.find(service);
+    return s == diag_count_.end() ? 0 : s->second;
+  }
   double DiagNumber(const std::string& service, const std::string& key, double otherwise = 0) const {
     const std::string v = Diag(service, key);
     return v.empty() ? otherwise : std::stod(v);
@@ -331,6 +337,7 @@ class CellHarness {
   std::vector<msg::TaskOutcome> outcomes_;
   std::map<std::string, std::map<std::string, std::string>> diag_;
   std::map<std::string, std::string> state_;    ///< service -> newest diagnostics message
+  std::map<std::string, int> diag_count_;       ///< service -> diagnostics reports seen
   std::map<std::string, std::string> configs_;  ///< services started with the test's own file (Configure)
 };
 
