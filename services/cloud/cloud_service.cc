@@ -156,6 +156,10 @@ class CloudService : public framework::Service {
       o.centre.x = s.centre.x();
       o.centre.y = s.centre.y();
       o.centre.z = s.centre.z();
+      o.orientation.x = s.orientation.x();
+      o.orientation.y = s.orientation.y();
+      o.orientation.z = s.orientation.z();
+      o.orientation.w = s.orientation.w();
       o.half_extents = {s.half_extents.x(), s.half_extents.y(), s.half_extents.z()};
       o.points = static_cast<uint32_t>(s.points);
       o.first_seen = msg::TimeFromNanoseconds(s.first_seen_ns);

@@ -121,6 +121,7 @@ class TrajoptService : public framework::Service {
       ObstacleBox b;
       b.id = o.id;
       b.centre = {o.centre.x, o.centre.y, o.centre.z};
+      b.orientation = Eigen::Quaterniond(o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z);
       b.half_extents = {o.half_extents[0], o.half_extents[1], o.half_extents[2]};
       boxes.push_back(b);
     }

@@ -147,6 +147,7 @@ TEST(ObstacleAvoidance, ABoxAppearingOnTheTableIsAvoidedWithNoContact) {
   msg::Obstacle o;
   o.id = 1;
   o.centre = {d.p_WS(0, low), d.p_WS(1, low), 0.5 * top};
+  o.orientation.w = 1.0;  // axis-aligned
   o.half_extents = {0.06, 0.06, 0.5 * top};
   o.points = 500;
   collision::SceneObject box;

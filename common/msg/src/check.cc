@@ -409,6 +409,11 @@ std::optional<std::string> CheckSemantics(const ObstacleArray& m) {
   for (std::size_t i = 0; i < m.obstacles.size(); ++i) {
     const Obstacle& o = m.obstacles[i];
     if (o.id == 0) return "obstacles[" + std::to_string(i) + "].id is 0";
+    const auto& q = o.orientation;
+    const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    if (std::abs(norm - 1.0) > 1e-3) {
+      return "obstacles[" + std::to_string(i) + "].orientation is not a unit quaternion (norm " + Num(norm) + ")";
+    }
     for (double h : o.half_extents) {
       if (h < 0) return "obstacles[" + std::to_string(i) + "].half_extents has " + Num(h);
     }

@@ -170,6 +170,23 @@ TEST(MsgCheck, RejectsBeliefThatDoesNotSumToOne) {
   EXPECT_EQ(Check(b), std::string("probabilities sum to 1.1"));
 }
 
+TEST(MsgCheck, ObstacleOrientationMustBeAUnitQuaternion) {
+  ObstacleArray a;
+  a.header.frame_id = "world";
+  Obstacle o;
+  o.id = 1;
+  o.half_extents = {0.1, 0.05, 0.1};
+  o.orientation.z = std::sin(0.15);  // yaw 0.3 rad
+  o.orientation.w = std::cos(0.15);
+  a.obstacles.push_back(o);
+  EXPECT_EQ(Check(a), std::nullopt);
+  a.obstacles[0].orientation = {};  // all zero: no rotation at all
+  EXPECT_EQ(Check(a), std::string("obstacles[0].orientation is not a unit quaternion (norm 0)"));
+  a.obstacles[0].orientation.w = 1.01;
+  ASSERT_TRUE(Check(a).has_value());
+  EXPECT_NE(Check(a)->find("norm 1.01"), std::string::npos) << *Check(a);
+}
+
 // Size limits: each at the limit passes, one above is rejected naming the
 // field and the limit (Limits in check.h).
 

@@ -2,9 +2,11 @@
 
 #include <cmath>
 #include <limits>
+#include <numeric>
 #include <stdexcept>
 
 #include "iplan/cloud/camera.h"
+#include "iplan/cloud/oriented_box.h"
 
 namespace iplan::cloud_service {
 
@@ -118,18 +120,30 @@ StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::
   const Eigen::Isometry3d& X_WS = params_.X_WS;
   std::vector<ClusterObservation> obs;
   obs.reserve(r.obstacles.size());
+  std::vector<Eigen::Vector3f> points_W;
+  std::vector<int> all;
+  const Eigen::Vector3f up_W = Eigen::Vector3f::UnitZ();
   for (const cloud::Obstacle& o : r.obstacles) {
     ClusterObservation c;
     c.box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
     c.box_max = -c.box_min;
+    points_W.clear();
     for (int i : o.indices) {
       const Eigen::Vector3d p = X_WS * cloud->points[static_cast<std::size_t>(i)].cast<double>();
+      points_W.push_back(p.cast<float>());
       c.centroid += p;
       c.box_min = c.box_min.cwiseMin(p);
       c.box_max = c.box_max.cwiseMax(p);
     }
     c.points = static_cast<int>(o.indices.size());
     c.centroid /= std::max(1, c.points);
+    all.resize(points_W.size());
+    std::iota(all.begin(), all.end(), 0);
+    const cloud::OrientedBox b = cloud::FitOrientedBox(points_W, all, &up_W);
+    const Eigen::Matrix3f R_WB = b.orientation.toRotationMatrix();
+    c.box.centre = b.centre.cast<double>();
+    c.box.yaw = std::atan2(static_cast<double>(R_WB(1, 0)), static_cast<double>(R_WB(0, 0)));
+    c.box.half_extents = b.half_extents.cast<double>();
     obs.push_back(c);
   }
   // Without the robot's pose the robot's own points are among the clusters
@@ -149,8 +163,9 @@ StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::
     if (t.cls != TrackClass::kStatic) continue;
     StaticObstacle s;
     s.id = t.id;
-    s.centre = 0.5 * (t.mean_min + t.mean_max);
-    s.half_extents = (0.5 * (t.mean_max - t.mean_min)).cwiseMax(0.0);
+    s.centre = t.mean_box.centre;
+    s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(t.mean_box.yaw, Eigen::Vector3d::UnitZ()));
+    s.half_extents = t.mean_box.half_extents.cwiseMax(0.0);
     s.points = t.last.points;
     s.first_seen_ns = t.first_seen_ns;
     out.obstacles.push_back(s);

@@ -41,11 +41,12 @@ struct CloudStageParams {
   std::string Validate() const;
 };
 
-/// A static obstacle, axis-aligned in W.
+/// A static obstacle: a box B upright in W (its z along W's z).
 struct StaticObstacle {
   uint32_t id = 0;                                         ///< the track's, >= 1, stable
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();        ///< m
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< m, >= 0
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();        ///< m, p_WB
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< R_WB, a turn about W's z
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< m along B's axes, >= 0
   int points = 0;                                          ///< cloud points at its last sighting
   int64_t first_seen_ns = 0;
 };

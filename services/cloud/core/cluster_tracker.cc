@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <tuple>
+#include <utility>
 
 namespace iplan::cloud_service {
 
@@ -14,6 +15,23 @@ std::string TrackerParams::Validate() const {
   if (lost_frames < 0) return "lost_frames must be >= 0, got " + std::to_string(lost_frames);
   if (!(person_extent > 0 && std::isfinite(person_extent))) return "person_extent must be > 0 m";
   return "";
+}
+
+void AddToMean(const UprightBox& next, int count, UprightBox* mean) {
+  if (count <= 0) {
+    *mean = next;
+    return;
+  }
+  constexpr double kQuarter = M_PI / 2;
+  double turn = std::remainder(next.yaw - mean->yaw, 2 * M_PI);  // in [-pi, pi]
+  const long quarters = std::lround(turn / kQuarter);
+  turn -= static_cast<double>(quarters) * kQuarter;  // in [-pi/4, pi/4]
+  Eigen::Vector3d half = next.half_extents;
+  if (quarters % 2 != 0) std::swap(half.x(), half.y());
+  const double w = 1.0 / (count + 1);
+  mean->centre += w * (next.centre - mean->centre);
+  mean->yaw = std::remainder(mean->yaw + w * turn, 2 * M_PI);
+  mean->half_extents += w * (half - mean->half_extents);
 }
 
 ClusterTracker::ClusterTracker(const TrackerParams& params) : params_(params) {
@@ -42,12 +60,14 @@ void ClusterTracker::Observe(Track* t, const ClusterObservation& o) const {
     t->still = 1;
     t->mean_min = o.box_min;
     t->mean_max = o.box_max;
+    t->mean_box = o.box;
     return;
   }
   ++t->still;
   const double w = 1.0 / t->still;  // running mean of the box since it settled
   t->mean_min += w * (o.box_min - t->mean_min);
   t->mean_max += w * (o.box_max - t->mean_max);
+  AddToMean(o.box, t->still - 1, &t->mean_box);
   if (t->cls == TrackClass::kPending && t->still >= params_.static_frames) t->cls = TrackClass::kStatic;
 }
 

@@ -4,7 +4,10 @@
 // `static_frames` frames is static; one that moves, or one as large as a
 // person, is human. A static one seen only in part (its visible box within
 // its settled box grown by `static_motion`: the arm in front of it) stays
-// static with its settled box. Pure algorithm, no DDS types.
+// static with its settled box. A static obstacle's box is the running mean
+// of its upright oriented boxes (z along W's z, the yaw that gives the
+// smallest footprint), so a rotated bin is as large as it is. Pure
+// algorithm, no DDS types.
 //
 // Frame: the cell frame W (`world`), metres; stamps in ns (wall clock).
 #pragma once
@@ -40,13 +43,27 @@ struct TrackerParams {
   std::string Validate() const;
 };
 
-/// One cluster of one frame, axis-aligned in W.
+/// A box B upright in W: its z axis along W's z, turned by `yaw` about it.
+struct UprightBox {
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();        ///< m, p_WB
+  double yaw = 0;                                          ///< rad, about W's z
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< m along B's x, y, z, >= 0
+};
+
+/// One cluster of one frame in W.
 struct ClusterObservation {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< m, mean of the points
-  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   ///< m
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();   ///< m, axis-aligned box around the points
   Eigen::Vector3d box_max = Eigen::Vector3d::Zero();   ///< m
+  UprightBox box;                                      ///< the upright box of least footprint around the points
   int points = 0;
 };
+
+/// The running mean of upright boxes: `count` boxes so far in `mean`, then
+/// `next`. A box is the same box turned by a multiple of 90 degrees with
+/// its x and y extents swapped, so `next` is first turned to within 45
+/// degrees of the mean's yaw.
+void AddToMean(const UprightBox& next, int count, UprightBox* mean);
 
 enum class TrackClass { kPending, kStatic, kHuman };
 
@@ -55,8 +72,9 @@ struct Track {
   TrackClass cls = TrackClass::kPending;
   ClusterObservation last;             ///< the latest sighting
   Eigen::Vector3d anchor = Eigen::Vector3d::Zero();  ///< m, where the centroid settled
-  Eigen::Vector3d mean_min = Eigen::Vector3d::Zero();  ///< m, box averaged since it settled
+  Eigen::Vector3d mean_min = Eigen::Vector3d::Zero();  ///< m, axis-aligned box averaged since it settled
   Eigen::Vector3d mean_max = Eigen::Vector3d::Zero();
+  UprightBox mean_box;       ///< the upright box averaged since it settled
   int still = 0;             ///< frames since it settled at `anchor`
   int unseen = 0;            ///< frames since the last sighting
   int64_t first_seen_ns = 0;

@@ -1,6 +1,7 @@
 #include "obstacle_set.h"
 
 #include <algorithm>
+#include <cmath>
 #include <set>
 #include <stdexcept>
 
@@ -22,6 +23,8 @@ std::optional<std::string> ObstacleSet::Update(int64_t stamp_ns, const std::vect
     if (!ids.insert(b.id).second) return which + " appears twice";
     if (!b.centre.allFinite() || !b.half_extents.allFinite() || b.half_extents.minCoeff() < 0)
       return which + " has a non-finite or negative size";
+    if (!b.orientation.coeffs().allFinite() || std::abs(b.orientation.norm() - 1.0) > 1e-3)
+      return which + " has an orientation that is not a unit quaternion";
   }
   bool any = false;
   for (const ObstacleBox& b : boxes) {
@@ -32,8 +35,10 @@ std::optional<std::string> ObstacleSet::Update(int64_t stamp_ns, const std::vect
       continue;
     }
     Seen& s = it->second;
+    // A turn moves a corner by about the angle times the box's radius.
+    const double turn = s.box.orientation.angularDistance(b.orientation) * b.half_extents.norm();
     if ((s.box.centre - b.centre).cwiseAbs().maxCoeff() > tolerance ||
-        (s.box.half_extents - b.half_extents).cwiseAbs().maxCoeff() > tolerance) {
+        (s.box.half_extents - b.half_extents).cwiseAbs().maxCoeff() > tolerance || turn > tolerance) {
       s.box = b;  // small jitter keeps the box the planner has, so it does not replan for noise
       any = true;
     }
@@ -65,6 +70,7 @@ std::vector<collision::SceneObject> ObstacleSet::SceneObjects() const {
     o.name = "obstacle " + std::to_string(id);
     o.shape = collision::SceneObject::Shape::kBox;
     o.X_WO.translation() = s.box.centre;
+    o.X_WO.linear() = s.box.orientation.normalized().toRotationMatrix();
     o.size = 2.0 * s.box.half_extents.cwiseMax(min_half_extent_);
     out.push_back(o);
   }

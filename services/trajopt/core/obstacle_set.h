@@ -18,16 +18,18 @@
 #include <vector>
 
 #include <Eigen/Core>
+#include <Eigen/Geometry>
 
 #include "iplan/collision/scene.h"
 
 namespace iplan::trajopt {
 
-/// One sensed box, axis-aligned in W.
+/// One sensed box B in W.
 struct ObstacleBox {
   uint32_t id = 0;                               ///< stable while tracked, >= 1
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();       ///< m, W
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero(); ///< m, >= 0
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();       ///< m, p_WB
+  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< R_WB, unit
+  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero(); ///< m along B's axes, >= 0
 };
 
 class ObstacleSet {
@@ -38,9 +40,10 @@ class ObstacleSet {
   explicit ObstacleSet(double timeout = 2.0, double min_half_extent = 0.005);
 
   /// The array of one cloud (stamp_ns). Returns why it was refused (a
-  /// repeated id, a non-finite or negative size), else nullopt; *changed
-  /// (may be null) tells whether the set changed: a new id, or a box that
-  /// moved or changed size by more than `tolerance` (m).
+  /// repeated id, a non-finite or negative size, an orientation that is not
+  /// a unit quaternion), else nullopt; *changed (may be null) tells whether
+  /// the set changed: a new id, or a box that moved, changed size or turned
+  /// (its angle times its half diagonal) by more than `tolerance` (m).
   std::optional<std::string> Update(int64_t stamp_ns, const std::vector<ObstacleBox>& boxes, bool* changed,
                                     double tolerance = 0.01);
   /// Removes boxes not seen for `timeout` at now_ns. Returns true when any was removed.

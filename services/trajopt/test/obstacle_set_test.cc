@@ -62,5 +62,29 @@ TEST(ObstacleSet, FlatBoxesAreThickenedAndBadArraysRefused) {
   EXPECT_THROW(ObstacleSet(0.0), std::invalid_argument);
 }
 
+// An oriented box keeps its turn in the scene; turning it past the
+// tolerance changes the set, a small wobble does not; a box whose
+// orientation is not a rotation is refused.
+TEST(ObstacleSet, OrientedBoxesKeepTheirTurn) {
+  ObstacleSet set(2.0);
+  ObstacleBox b = Box(1, 0.5);
+  b.half_extents = {0.15, 0.1, 0.1};
+  b.orientation = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  bool changed = false;
+  ASSERT_EQ(set.Update(0, {b}, &changed), std::nullopt);
+  const auto objects = set.SceneObjects();
+  ASSERT_EQ(objects.size(), 1u);
+  EXPECT_TRUE(objects[0].X_WO.linear().isApprox(Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ()).toRotationMatrix(), 1e-12));
+  EXPECT_TRUE(objects[0].size.isApprox(Eigen::Vector3d(0.3, 0.2, 0.2), 1e-12));
+  b.orientation = Eigen::AngleAxisd(0.32, Eigen::Vector3d::UnitZ());  // a corner moves 0.02 x 0.21 m: noise
+  ASSERT_EQ(set.Update(1, {b}, &changed), std::nullopt);
+  EXPECT_FALSE(changed);
+  b.orientation = Eigen::AngleAxisd(0.5, Eigen::Vector3d::UnitZ());  // 0.2 x 0.21 m: turned
+  ASSERT_EQ(set.Update(2, {b}, &changed), std::nullopt);
+  EXPECT_TRUE(changed);
+  b.orientation.coeffs() << 0, 0, 0, 0;
+  EXPECT_NE(set.Update(3, {b}, nullptr), std::nullopt);
+}
+
 }  // namespace
 }  // namespace iplan::trajopt

@@ -373,9 +373,10 @@ const json* SceneBuilder::Boxes(const msg::ObstacleArray& a) {
   json& cubes = e["cubes"];
   cubes = json::array();
   for (const msg::Obstacle& o : a.obstacles) {
-    // The message's boxes are axis-aligned in "world" (idl/iplan_msgs.idl).
+    // Oriented boxes in "world" (idl/iplan_msgs.idl), half extents along their own axes.
     const Eigen::Vector3d size(2 * o.half_extents[0], 2 * o.half_extents[1], 2 * o.half_extents[2]);
-    cubes.push_back({{"pose", Pose({o.centre.x, o.centre.y, o.centre.z})}, {"size", Point(size)}, {"color", Color(color)}});
+    const Eigen::Quaterniond q(o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z);
+    cubes.push_back({{"pose", Pose({o.centre.x, o.centre.y, o.centre.z}, q)}, {"size", Point(size)}, {"color", Color(color)}});
   }
   e["metadata"] = json::array({{{"key", "boxes"}, {"value", std::to_string(a.obstacles.size())}}});
   return &updates_[entity::kBoxes];

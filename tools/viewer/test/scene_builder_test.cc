@@ -235,6 +235,8 @@ TEST(SceneBuilder, CloudBoxesAndHumanPointsAreDrawn) {
   o.centre.x = 0.5;
   o.centre.y = -0.2;
   o.centre.z = 0.1;
+  o.orientation.z = std::sin(0.15);  // turned 0.3 rad about z
+  o.orientation.w = std::cos(0.15);
   o.half_extents = {0.05, 0.1, 0.15};
   a.obstacles.push_back(o);
   const auto* u = b.Boxes(a);
@@ -243,7 +245,9 @@ TEST(SceneBuilder, CloudBoxesAndHumanPointsAreDrawn) {
   EXPECT_EQ((*u)["entities"][0]["id"], entity::kBoxes);
   EXPECT_NEAR(At(box).y(), -0.2, 1e-12);
   EXPECT_DOUBLE_EQ(box["size"]["z"].get<double>(), 0.3);
-  EXPECT_DOUBLE_EQ(box["pose"]["orientation"]["w"].get<double>(), 1.0);
+  EXPECT_DOUBLE_EQ(box["size"]["y"].get<double>(), 0.2);  // along the box's own y
+  EXPECT_DOUBLE_EQ(box["pose"]["orientation"]["z"].get<double>(), std::sin(0.15));
+  EXPECT_DOUBLE_EQ(box["pose"]["orientation"]["w"].get<double>(), std::cos(0.15));
   // Three points: two of a part moving at 1 m/s along -x, one not tracked.
   msg::HumanPoints p;
   p.header.frame_id = "world";
