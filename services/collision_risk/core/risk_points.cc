@@ -111,7 +111,7 @@ void RiskMonitor::EvaluateBoundFromPoints(int64_t now_ns, RiskReport* out) {
   }
   for (int w = 0; w < W; ++w) {
     const double t = (w + 1) * pp.time_step;
-    collision::CalcForwardKinematics(robot_, RobotConfigurationAt(now_ns + static_cast<int64_t>(t * 1e9)), &data_);
+    collision::CalcForwardKinematics(robot_, RobotConfigurationAt(times[static_cast<std::size_t>(w)]), &data_);
     traj.centres = data_.p_WS;
     r.waypoint_times.push_back(t);
     const collision::GaussianPoints* at = &points_;
