@@ -146,25 +146,7 @@ class CloudService : public framework::Service {
   }
 
   void Publish(Node& node, const msg::Time& stamp, const StageOutput& out) {
-    obstacles_.header.stamp = stamp;
-    obstacles_.header.frame_id = frame_id_;
-    obstacles_.obstacles.clear();
-    for (const StaticObstacle& s : out.obstacles) {
-      if (obstacles_.obstacles.size() >= msg::Limits::kObstacles) break;
-      msg::Obstacle o;
-      o.id = s.id;
-      o.centre.x = s.centre.x();
-      o.centre.y = s.centre.y();
-      o.centre.z = s.centre.z();
-      o.orientation.x = s.orientation.x();
-      o.orientation.y = s.orientation.y();
-      o.orientation.z = s.orientation.z();
-      o.orientation.w = s.orientation.w();
-      o.half_extents = {s.half_extents.x(), s.half_extents.y(), s.half_extents.z()};
-      o.points = static_cast<uint32_t>(s.points);
-      o.first_seen = msg::TimeFromNanoseconds(s.first_seen_ns);
-      obstacles_.obstacles.push_back(o);
-    }
+    services::ToObstacles(out.obstacles, stamp, frame_id_, &obstacles_);
     human_.header = obstacles_.header;
     human_.voxel_size = human_voxel_;
     human_.points.clear();

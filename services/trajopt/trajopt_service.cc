@@ -116,15 +116,7 @@ class TrajoptService : public framework::Service {
   // A changed obstacle set replans at once: a box put in the robot's path
   // must not wait for the next tick.
   void OnObstacles(Node& node, const msg::ObstacleArray& m) {
-    std::vector<ObstacleBox> boxes;
-    for (const auto& o : m.obstacles) {
-      ObstacleBox b;
-      b.id = o.id;
-      b.centre = {o.centre.x, o.centre.y, o.centre.z};
-      b.orientation = Eigen::Quaterniond(o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z);
-      b.half_extents = {o.half_extents[0], o.half_extents[1], o.half_extents[2]};
-      boxes.push_back(b);
-    }
+    const std::vector<ObstacleBox> boxes = services::FromObstacles(m);
     bool changed = false;
     const auto why = obstacles_.Update(msg::ToNanoseconds(m.header.stamp), boxes, &changed);
     node.CountRejection("obstacles", why);

@@ -1,8 +1,10 @@
 #include "iplan/adapters/adapters.h"
 
 #include <algorithm>
+#include <limits>
 
 #include "iplan/cell/joint_trajectory.h"
+#include "iplan/msg/check.h"
 #include "iplan/msg/time.h"
 
 namespace iplan::services {
@@ -77,6 +79,40 @@ cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
                          FromWireCovariance(pm.velocity_covariance)});
   }
   return p;
+}
+
+std::vector<cell::ObstacleBox> FromObstacles(const msg::ObstacleArray& m) {
+  std::vector<cell::ObstacleBox> out;
+  out.reserve(m.obstacles.size());
+  for (const msg::Obstacle& o : m.obstacles) {
+    cell::ObstacleBox b;
+    b.id = o.id;
+    b.centre = {o.centre.x, o.centre.y, o.centre.z};
+    b.orientation = Eigen::Quaterniond(o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z);
+    b.half_extents = {o.half_extents[0], o.half_extents[1], o.half_extents[2]};
+    b.points = static_cast<int>(std::min<uint32_t>(o.points, std::numeric_limits<int>::max()));
+    b.first_seen_ns = msg::ToNanoseconds(o.first_seen);
+    out.push_back(b);
+  }
+  return out;
+}
+
+void ToObstacles(const std::vector<cell::ObstacleBox>& boxes, const msg::Time& stamp, const std::string& frame_id,
+                 msg::ObstacleArray* m) {
+  m->header.stamp = stamp;
+  m->header.frame_id = frame_id;
+  m->obstacles.clear();
+  for (const cell::ObstacleBox& b : boxes) {
+    if (m->obstacles.size() >= msg::Limits::kObstacles) break;
+    msg::Obstacle o;
+    o.id = b.id;
+    o.centre = {b.centre.x(), b.centre.y(), b.centre.z()};
+    o.orientation = {b.orientation.x(), b.orientation.y(), b.orientation.z(), b.orientation.w()};
+    o.half_extents = {b.half_extents.x(), b.half_extents.y(), b.half_extents.z()};
+    o.points = static_cast<uint32_t>(std::max(0, b.points));
+    o.first_seen = msg::TimeFromNanoseconds(b.first_seen_ns);
+    m->obstacles.push_back(o);
+  }
 }
 
 void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/adapters/adapters.h"
+#include "iplan/msg/check.h"
 #include "iplan/msg/time.h"
 
 namespace iplan::services {
@@ -73,6 +74,33 @@ TEST(TrajectoryStartNs, ZeroStampMeansReceipt) {
   EXPECT_EQ(TrajectoryStartNs(t, 42), 42);
   t.header.stamp = msg::TimeFromNanoseconds(1'700'000'000'000'000'007);
   EXPECT_EQ(TrajectoryStartNs(t, 42), 1'700'000'000'000'000'007);
+}
+
+// The static obstacles go out and come back as they were (the turn, the
+// stamps, the point count), and the message keeps its size limit.
+TEST(Obstacles, RoundTripKeepsEveryBoxAndTheLimit) {
+  cell::ObstacleBox b;
+  b.id = 7;
+  b.centre = {0.55, 0.45, 0.1};
+  b.orientation = Eigen::AngleAxisd(0.3, Eigen::Vector3d::UnitZ());
+  b.half_extents = {0.15, 0.1, 0.1};
+  b.points = 1234;
+  b.first_seen_ns = 1'700'000'000'123'456'789;
+  msg::ObstacleArray m;
+  ToObstacles({b}, msg::TimeFromNanoseconds(1'700'000'001'000'000'000), "world", &m);
+  EXPECT_EQ(m.header.frame_id, "world");
+  EXPECT_EQ(msg::ToNanoseconds(m.header.stamp), 1'700'000'001'000'000'000);
+  const std::vector<cell::ObstacleBox> back = FromObstacles(m);
+  ASSERT_EQ(back.size(), 1u);
+  EXPECT_EQ(back[0].id, 7u);
+  EXPECT_EQ(back[0].centre, b.centre);
+  EXPECT_TRUE(back[0].orientation.isApprox(b.orientation, 1e-15));
+  EXPECT_EQ(back[0].half_extents, b.half_extents);
+  EXPECT_EQ(back[0].points, 1234);
+  EXPECT_EQ(back[0].first_seen_ns, b.first_seen_ns);
+  const std::vector<cell::ObstacleBox> many(msg::Limits::kObstacles + 5, b);
+  ToObstacles(many, {}, "world", &m);
+  EXPECT_EQ(m.obstacles.size(), msg::Limits::kObstacles);
 }
 
 }  // namespace

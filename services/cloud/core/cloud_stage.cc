@@ -161,7 +161,7 @@ StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::
   HumanPoints(*cloud, human, track, stamp_ns, &out);
   for (const Track& t : tracker_.tracks()) {
     if (t.cls != TrackClass::kStatic) continue;
-    StaticObstacle s;
+    cell::ObstacleBox s;
     s.id = t.id;
     s.centre = t.mean_box.centre;
     s.orientation = Eigen::Quaterniond(Eigen::AngleAxisd(t.mean_box.yaw, Eigen::Vector3d::UnitZ()));

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include "services/cloud/core/cluster_tracker.h"
+#include "iplan/cell/obstacle_box.h"
 #include "services/cloud/core/point_motion.h"
 #include "iplan/cloud/cloud.h"
 #include "iplan/cloud/noise.h"
@@ -41,15 +42,6 @@ struct CloudStageParams {
   std::string Validate() const;
 };
 
-/// A static obstacle: a box B upright in W (its z along W's z).
-struct StaticObstacle {
-  uint32_t id = 0;                                         ///< the track's, >= 1, stable
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();        ///< m, p_WB
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< R_WB, a turn about W's z
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero();  ///< m along B's axes, >= 0
-  int points = 0;                                          ///< cloud points at its last sighting
-  int64_t first_seen_ns = 0;
-};
 
 /// One human point as a Gaussian in W.
 struct HumanPoint {
@@ -66,7 +58,7 @@ struct PointMotionEstimate {
 };
 
 struct StageOutput {
-  std::vector<StaticObstacle> obstacles;
+  std::vector<cell::ObstacleBox> obstacles;  ///< the static tracks: boxes upright in W (z along W's z), id = track id
   std::vector<HumanPoint> human;
   std::vector<PointMotionEstimate> motions;  ///< the tracked parts the human points name
   bool table_found = false;

@@ -72,7 +72,7 @@ TEST(CloudStageTest, BoxOnTheTableIsOneStaticObstacleWithStableId) {
     }
     ASSERT_EQ(out.obstacles.size(), 1u) << "frame " << f;
     EXPECT_TRUE(out.human.empty()) << "frame " << f;
-    const StaticObstacle& o = out.obstacles[0];
+    const cell::ObstacleBox& o = out.obstacles[0];
     if (id == 0) id = o.id;
     EXPECT_EQ(o.id, id);
     EXPECT_EQ(o.first_seen_ns, 1000);
@@ -101,7 +101,7 @@ TEST(CloudStageTest, ATurnedBoxIsReportedWithItsSizeAndTurn) {
     out = stage.Process(&c, std::nullopt, f * kFrameNs);
   }
   ASSERT_EQ(out.obstacles.size(), 1u);
-  const StaticObstacle& o = out.obstacles[0];
+  const cell::ObstacleBox& o = out.obstacles[0];
   EXPECT_LT((o.centre - centre).norm(), 0.02) << o.centre.transpose();
   EXPECT_LT(((2 * o.half_extents) - size).cwiseAbs().maxCoeff(), 0.03) << o.half_extents.transpose();
   // Turned about W's z only, by the box's yaw (a box is the same turned by pi).

@@ -20,17 +20,13 @@
 #include <Eigen/Core>
 #include <Eigen/Geometry>
 
+#include "iplan/cell/obstacle_box.h"
 #include "iplan/collision/scene.h"
 
 namespace iplan::trajopt {
 
-/// One sensed box B in W.
-struct ObstacleBox {
-  uint32_t id = 0;                               ///< stable while tracked, >= 1
-  Eigen::Vector3d centre = Eigen::Vector3d::Zero();       ///< m, p_WB
-  Eigen::Quaterniond orientation = Eigen::Quaterniond::Identity();  ///< R_WB, unit
-  Eigen::Vector3d half_extents = Eigen::Vector3d::Zero(); ///< m along B's axes, >= 0
-};
+/// One sensed box B in W (the cloud service's; id, pose and size are used).
+using cell::ObstacleBox;
 
 class ObstacleSet {
  public:

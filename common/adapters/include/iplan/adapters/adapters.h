@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 
 #include "iplan/cell/human_points.h"
+#include "iplan/cell/obstacle_box.h"
 #include "iplan/safety/ssm.h"
 #include "iplan/core/name_value.h"
 #include "iplan/cell/status.h"
@@ -37,6 +38,13 @@ void FillPrediction(const collision::JointMixture& in, msg::HumanPrediction* m);
 /// `motion` k >= 1 is motions[k - 1], 0 not tracked). The boundary has
 /// checked the message (finite, covariances PSD, motion indices in range).
 cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m);
+
+/// The static obstacles of one cloud, both ways. The boundary has checked
+/// a received message (ids >= 1, unit orientations, half extents >= 0);
+/// ToObstacles writes at most msg::Limits::kObstacles of them.
+std::vector<cell::ObstacleBox> FromObstacles(const msg::ObstacleArray& m);
+void ToObstacles(const std::vector<cell::ObstacleBox>& boxes, const msg::Time& stamp, const std::string& frame_id,
+                 msg::ObstacleArray* m);
 
 /// Trajectory points as (times in s from header.stamp, positions per point).
 void FromTrajectory(const msg::JointTrajectory& m, std::vector<double>* times,
