@@ -42,7 +42,6 @@ struct CloudStageParams {
   std::string Validate() const;
 };
 
-
 /// One human point as a Gaussian in W.
 struct HumanPoint {
   Eigen::Vector3d mean = Eigen::Vector3d::Zero();          ///< m
