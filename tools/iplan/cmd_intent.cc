@@ -91,6 +91,8 @@ struct EvalOptions {
   int synthetic_people = 12;
   bool json = false;
   int stride = 1;
+  // The per-person ellipsoid calibration, as the intent service's settings.
+  iplan::intent::CoverageAdapterParams coverage;
 };
 
 // The model configuration from the options and the joints of `data`.
@@ -297,6 +299,7 @@ void RunEval(const EvalOptions& o) {
   }
   EvalParams params;
   params.forecast_stride = o.stride;
+  params.coverage = o.coverage;
   const EvalReport report = EvaluateIntentModel(model, data, params);
   if (o.json) {
     std::cout << EvalReportToJson(report) << "\n";
@@ -314,6 +317,33 @@ void Guarded(const F& f) {
     std::cerr << "iplan intent: error: " << e.what() << "\n";
     SetExitCode(1);
   }
+}
+
+// `iplan intent eval`.
+void AddEvalCommand(CLI::App* intent) {
+  auto eval_opts = std::make_shared<EvalOptions>();
+  CLI::App* eval = intent->add_subcommand("eval", "Evaluate an intent model on a skeleton CSV");
+  EvalOptions& e = *eval_opts;
+  eval->add_option("--model", e.model, "Model file")->required();
+  eval->add_option("--data", e.data, "Skeleton CSV (shared layout)");
+  eval->add_option("--subjects", e.subjects, "Test subjects, comma separated");
+  eval->add_option("--synthetic", e.synthetic,
+                   "Instead of --data: the synthetic person of this perception.yaml (the cell's) doing its script, "
+                   "fresh people; reaching phases are scored separately");
+  eval->add_option("--seed", e.synthetic_seed, "With --synthetic: generator seed (default: the person's seed + 1000)");
+  eval->add_option("--people", e.synthetic_people, "With --synthetic: simulated people")->capture_default_str();
+  eval->add_option("--stride", e.stride, "Frames between evaluated forecast windows")->capture_default_str();
+  eval->add_option("--coverage-halving-time", e.coverage.halving_time,
+                   "s; each person's ellipsoids follow their matured forecasts (95 % inside), as the intent "
+                   "service's coverage_halving_time; 0: the model's own covariances")
+      ->capture_default_str();
+  eval->add_option("--coverage-carry-over", e.coverage.carry_over,
+                   "true: each person starts from the ellipsoid scales the one before ended with (the recording's "
+                   "sequences are people one after another in one cell), as the intent service's "
+                   "coverage_carry_over; false: from the model's")
+      ->capture_default_str();
+  eval->add_flag("--json", e.json, "Print the report as JSON");
+  eval->callback([eval_opts] { Guarded([&] { RunEval(*eval_opts); }); });
 }
 
 const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
@@ -381,20 +411,7 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
   train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
 
-  auto eval_opts = std::make_shared<EvalOptions>();
-  CLI::App* eval = intent->add_subcommand("eval", "Evaluate an intent model on a skeleton CSV");
-  EvalOptions& e = *eval_opts;
-  eval->add_option("--model", e.model, "Model file")->required();
-  eval->add_option("--data", e.data, "Skeleton CSV (shared layout)");
-  eval->add_option("--subjects", e.subjects, "Test subjects, comma separated");
-  eval->add_option("--synthetic", e.synthetic,
-                   "Instead of --data: the synthetic person of this perception.yaml (the cell's) doing its script, "
-                   "fresh people; reaching phases are scored separately");
-  eval->add_option("--seed", e.synthetic_seed, "With --synthetic: generator seed (default: the person's seed + 1000)");
-  eval->add_option("--people", e.synthetic_people, "With --synthetic: simulated people")->capture_default_str();
-  eval->add_option("--stride", e.stride, "Frames between evaluated forecast windows")->capture_default_str();
-  eval->add_flag("--json", e.json, "Print the report as JSON");
-  eval->callback([eval_opts] { Guarded([&] { RunEval(*eval_opts); }); });
+  AddEvalCommand(intent);
 });
 
 }  // namespace

@@ -47,6 +47,20 @@ void CoverageAdapter::Reset() {
   matured_ = Eigen::VectorXd::Zero(num_joints_);
 }
 
+void CoverageAdapter::Reset(const Eigen::Ref<const Eigen::VectorXd>& scales) {
+  if (scales.size() != num_joints_) {
+    throw std::invalid_argument("CoverageAdapter::Reset: " + std::to_string(scales.size()) + " scales, expected " +
+                                std::to_string(num_joints_));
+  }
+  Reset();
+  for (int j = 0; j < num_joints_; ++j) {
+    // A non-finite scale (never produced here) falls back to the model's.
+    if (!std::isfinite(scales(j))) continue;
+    scale_(j) = std::clamp(scales(j), params_.min_scale, params_.max_scale);
+    log_scale_(j) = std::log(scale_(j));
+  }
+}
+
 void CoverageAdapter::Observe(double stamp, const Eigen::Ref<const Eigen::VectorXd>& positions) {
   if (positions.size() != 3 * num_joints_) {
     throw std::invalid_argument("CoverageAdapter::Observe: " + std::to_string(positions.size()) +

@@ -317,12 +317,17 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
   const std::vector<int> hands = HandIndices(model);
   std::vector<bool> reached(J, false);
   WindowForecast w;
+  // The tracks are people one after another in one cell: with carry_over
+  // each starts from the scales the one before ended with, as the intent
+  // service starts a new body.
+  Eigen::VectorXd cell_scales = Eigen::VectorXd::Ones(J);
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
     // As online: every frame is predicted, updates the belief and the
     // coverage adapter; the forecast windows are scored on what is published.
     BeliefFilter filter(static_cast<int>(model.actions.size()), model.classifier.belief);
     CoverageAdapter coverage(J, H, rate, params.coverage);
+    if (params.coverage.carry_over) coverage.Reset(cell_scales);
     Eigen::VectorXd window_p(static_cast<Eigen::Index>(model.actions.size()));
     JointMixture& pred = timed_predict.pred;
     for (int e = 0; e + H <= n - 1; ++e) {
@@ -347,6 +352,7 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
         reached[j] = true;
       }
     }
+    cell_scales = coverage.variance_scales();
   }
   FinishSteps(s, params, H, std::max(1.0, static_cast<double>(r.num_forecast_windows) * J), &r);
   std::vector<std::string> hand_names;

@@ -101,5 +101,28 @@ TEST(CoverageAdapterTest, ResetForgetsAndBadInputIsRefused) {
   EXPECT_THROW(CoverageAdapter(1, 4, 10.0, bad), std::invalid_argument);
 }
 
+TEST(CoverageAdapterTest, ResetToScalesStartsANewPersonFromThem) {
+  CoverageAdapterParams params;
+  params.max_scale = 5.0;
+  CoverageAdapter a(2, 4, 10.0, params);
+  JointMixture p;
+  p.time_step = 0.1;
+  p.Resize(1, 4, 2);
+  p.probabilities[0] = 1.0;
+  for (auto& c : p.covariances[0]) c = Eigen::Matrix3d::Identity();
+  a.Record(0.0, p);
+  a.Reset(Eigen::Vector2d(3.0, 7.0));  // 7 is past max_scale
+  EXPECT_DOUBLE_EQ(a.variance_scales()(0), 3.0);
+  EXPECT_DOUBLE_EQ(a.variance_scales()(1), 5.0);
+  // The forecast recorded before the reset is not scored: a far-off
+  // observation when it matures leaves the scales as they were.
+  a.Observe(0.1, Eigen::VectorXd::Constant(6, 100.0));
+  EXPECT_DOUBLE_EQ(a.variance_scales()(0), 3.0);
+  a.Apply(&p);
+  EXPECT_DOUBLE_EQ(p.covariances[0][0](0, 0), 3.0);  // step 0, joint 0
+  EXPECT_DOUBLE_EQ(p.covariances[0][1](0, 0), 5.0);  // step 0, joint 1
+  EXPECT_THROW(a.Reset(Eigen::Vector3d::Ones()), std::invalid_argument);
+}
+
 }  // namespace
 }  // namespace iplan::intent

@@ -3,6 +3,7 @@
 // per-frame actions; and training on recordings whose action changes.
 #include "iplan/intent/evaluation.h"
 
+#include <algorithm>
 #include <cmath>
 #include <random>
 
@@ -117,6 +118,27 @@ TEST(EvaluationTest, HandErrorsAtReportedHorizonsInterpolateBetweenSteps) {
   const EvalReport p = EvaluateIntentModel(model, plain, params);
   EXPECT_EQ(p.reaching.num_samples, 0);
   EXPECT_NE(EvalReportToJson(p).find("\"reaching\": null"), std::string::npos);
+}
+
+// The sequences are people one after another in one cell: with carry_over
+// each starts from the ellipsoid scales the one before ended with, so their
+// order matters; without, each starts from the model's and it does not.
+TEST(EvaluationTest, CoverageScalesCarryOverFromOneSequenceToTheNext) {
+  const IntentModel model = TrainIntentModel(Sweeps(1, false), SweepConfig(), SweepParams());
+  const SkeletonDataset test = Sweeps(2, false);
+  SkeletonDataset reversed = test;
+  std::reverse(reversed.sequences.begin(), reversed.sequences.end());
+  EvalParams own;
+  own.coverage.carry_over = false;
+  const double own_forward = EvaluateIntentModel(model, test, own).coverage95;
+  EXPECT_DOUBLE_EQ(EvaluateIntentModel(model, reversed, own).coverage95, own_forward);
+  EvalParams carried;
+  ASSERT_TRUE(carried.coverage.carry_over);  // the default, as the service's
+  const double carried_forward = EvaluateIntentModel(model, test, carried).coverage95;
+  EXPECT_NE(carried_forward, own_forward);
+  EXPECT_NE(EvaluateIntentModel(model, reversed, carried).coverage95, carried_forward);
+  // Carried over, every person but the first starts calibrated: nearer 95 %.
+  EXPECT_LT(std::abs(carried_forward - 0.95), std::abs(own_forward - 0.95));
 }
 
 TEST(EvaluationTest, RecordingsWhoseActionChangesTrainAndAreScoredPerFrame) {

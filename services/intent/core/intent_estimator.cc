@@ -21,6 +21,7 @@ std::string IntentEstimatorParams::Validate() const {
 intent::CoverageAdapterParams IntentEstimatorParams::CoverageParams() const {
   intent::CoverageAdapterParams p;
   p.halving_time = coverage_halving_time;
+  p.carry_over = coverage_carry_over;
   return p;
 }
 
@@ -48,6 +49,7 @@ IntentEstimator::IntentEstimator(std::shared_ptr<const intent::IntentModel> mode
   scratch_.resize(3 * static_cast<Eigen::Index>(names.size()));
   seen_.resize(names.size());
   window_.resize(model_->config.window, scratch_.size());
+  cell_scales_ = Eigen::VectorXd::Ones(static_cast<Eigen::Index>(names.size()));
 }
 
 int IntentEstimator::buffered_frames(std::uint32_t body_id) const {
@@ -84,6 +86,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
                                                " ignored"};
     }
     it = bodies_.emplace(frame.body_id, Body(*model_, params_.CoverageParams())).first;
+    if (params_.coverage_carry_over) it->second.coverage.Reset(cell_scales_);
   }
   Body& body = it->second;
   if (!body.stamps.empty()) {
@@ -97,7 +100,11 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
       body.stamps.clear();
       body.positions.clear();
       body.belief.Reset();
-      body.coverage.Reset();
+      if (params_.coverage_carry_over) {
+        body.coverage.Reset(cell_scales_);
+      } else {
+        body.coverage.Reset();
+      }
     }
   }
   body.stamps.push_back(frame.stamp);
@@ -114,6 +121,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
   for (int c = 0; c < out->num_actions(); ++c) out->probabilities[static_cast<std::size_t>(c)] = body.belief.probabilities()(c);
   // Score the body's earlier forecasts that mature now, then calibrate this one.
   body.coverage.Observe(frame.stamp, scratch_);
+  cell_scales_ = body.coverage.variance_scales();
   body.coverage.Apply(out);
   body.coverage.Record(frame.stamp, *out);
   DropStale(frame.stamp);

@@ -63,6 +63,9 @@ struct IntentEstimatorParams {
   /// s: online calibration of each body's forecast ellipsoids
   /// (intent::CoverageAdapterParams::halving_time); 0: the model's own.
   double coverage_halving_time = intent::CoverageAdapterParams{}.halving_time;
+  /// A new body (or one back from a tracking gap) starts from the ellipsoid
+  /// scales last learned in this cell (true) or from the model's (false).
+  bool coverage_carry_over = intent::CoverageAdapterParams{}.carry_over;
 
   template <class Archive>
   void Serialize(Archive* a) {
@@ -72,6 +75,9 @@ struct IntentEstimatorParams {
     a->Visit(IPLAN_NVP(coverage_halving_time,
                        "s; each body's forecast ellipsoids follow its own matured forecasts (95 % inside): "
                        "with all inside their variance halves in this time; 0: the model's covariances, >= 0"));
+    a->Visit(IPLAN_NVP(coverage_carry_over,
+                       "true: a new body's ellipsoids start from the scales last learned in this cell; "
+                       "false: from the model's"));
   }
   /// Empty when valid, else the offending field and value.
   std::string Validate() const;
@@ -141,6 +147,7 @@ class IntentEstimator {
   std::vector<int> seen_;       // per model joint: times seen in the frame
   Eigen::MatrixXd window_;      // (<= T, 3 J)
   Eigen::VectorXd window_probabilities_;  // (C) of the newest window
+  Eigen::VectorXd cell_scales_;  // (J) the ellipsoid scales last learned (coverage_carry_over)
 };
 
 }  // namespace iplan::intent_service

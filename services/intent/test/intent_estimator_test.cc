@@ -276,6 +276,29 @@ TEST_F(IntentEstimatorTest, BodiesAreIndependentAndForgottenAfterTheTimeout) {
   EXPECT_EQ(est.buffered_frames(3), 1);
 }
 
+// A person who stands still for 10 s narrows their ellipsoids (every matured
+// step inside). The next person starts from those scales with
+// coverage_carry_over, from the model's without.
+TEST_F(IntentEstimatorTest, ANewBodyStartsFromTheScalesLearnedInTheCell) {
+  JointMixture first[2];
+  for (const bool carry : {false, true}) {
+    IntentEstimatorParams p;
+    p.coverage_carry_over = carry;
+    IntentEstimator est(model_, p);
+    JointMixture out;
+    for (int i = 0; i < 150; ++i) ASSERT_TRUE(est.Update(Frame(1, i / 15.0, Rest()), &out).accepted());
+    ASSERT_TRUE(est.Update(Frame(2, 10.0, Rest()), &first[carry]).accepted());
+  }
+  JointMixture model_only;
+  intent::PredictIntent(*model_, ModelRow(*model_, Rest()), &model_only);
+  for (std::size_t c = 0; c < model_only.covariances.size(); ++c) {
+    for (std::size_t i = 0; i < model_only.covariances[c].size(); ++i) {
+      EXPECT_NEAR(first[0].covariances[c][i].trace(), model_only.covariances[c][i].trace(), 1e-12);
+      EXPECT_LT(first[1].covariances[c][i].trace(), 0.5 * model_only.covariances[c][i].trace());
+    }
+  }
+}
+
 TEST_F(IntentEstimatorTest, HistoryIsBoundedByTheWindowSpan) {
   IntentEstimator est(model_, {});
   JointMixture out;

@@ -20,6 +20,13 @@
 // of adaptive conformal inference), from the first second on only past
 // observations are used. s_j is bounded to [min_scale, max_scale].
 //
+// A new person starts from the scales the cell has learned so far (the
+// previous person's, `carry_over`), not from the model's: the cell's camera
+// and its people differ from the training people in the same way for
+// everyone, and a person tracked for a few seconds would otherwise spend them
+// with the model's ellipsoids (on the cell's synthetic person, the hands'
+// scales settle at 3-9 within a 17 s episode).
+//
 // Used with the same parameters by the intent service (per body) and by
 // EvaluateIntentModel (per track). Not thread-safe; one instance per person.
 #pragma once
@@ -41,6 +48,10 @@ struct CoverageAdapterParams {
   double target = 0.95;    ///< share of matured steps inside, in (0, 1)
   double min_scale = 0.1;  ///< bounds of s_j (0 < min <= 1 <= max)
   double max_scale = 10.0;
+  /// true: a new person (or a tracking gap) starts from the scales learned
+  /// so far in the cell (Reset(scales) with the last person's); false: from
+  /// the model's (1). The owner of the adapters applies it.
+  bool carry_over = true;
 
   /// Empty string when valid, else the offending field and value.
   std::string Validate() const;
@@ -52,8 +63,11 @@ class CoverageAdapter {
   /// Hz (a model's config). Throws std::invalid_argument on bad sizes or params.
   CoverageAdapter(int num_joints, int horizon, double rate, CoverageAdapterParams params = {});
 
-  /// Forgets the stored forecasts and sets every scale to 1 (a new person).
+  /// Forgets the stored forecasts and sets every scale to 1 (the model's).
   void Reset();
+  /// Forgets the stored forecasts and starts from `scales` (J), e.g. the
+  /// previous person's variance_scales(), clamped to [min_scale, max_scale].
+  void Reset(const Eigen::Ref<const Eigen::VectorXd>& scales);
 
   /// Scores the stored forecasts whose steps mature at time `stamp` (s, not
   /// decreasing between calls) against the observed `positions` (3 J, m,
