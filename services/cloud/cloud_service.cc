@@ -38,7 +38,6 @@ class CloudService : public framework::Service {
     CloudStageParams p = settings.StageParams();
     joint_state_timeout_ = settings.joint_state_timeout;
     frame_id_ = settings.frame_id;
-    human_voxel_ = p.human_voxel;
     const std::string& robot_file = settings.robot;
     try {
       if (!overrides.empty()) throw std::runtime_error("--set into " + pipeline_file + " is not supported; edit the file");
@@ -134,9 +133,9 @@ class CloudService : public framework::Service {
     node.SetDiagnosticValue("obstacles", std::to_string(out.obstacles.size()));
     node.SetDiagnosticValue("human_points", std::to_string(out.human.size()));
     std::size_t tracked = 0;
-    for (const HumanPoint& h : out.human) tracked += h.motion >= 0;
+    for (int k : out.human.motion_of) tracked += k >= 0;
     node.SetDiagnosticValue("tracked_human_points", std::to_string(tracked));
-    node.SetDiagnosticValue("motions", std::to_string(out.motions.size()));
+    node.SetDiagnosticValue("motions", std::to_string(out.human.motions.size()));
     node.SetDiagnosticValue("clusters", std::to_string(out.clusters));
     node.SetDiagnosticValue("table", out.table_found ? std::to_string(out.table_points) + " points" : "not found");
     node.SetDiagnosticValue("clouds_without_self_filter", std::to_string(unfiltered_));
@@ -147,32 +146,7 @@ class CloudService : public framework::Service {
 
   void Publish(Node& node, const msg::Time& stamp, const StageOutput& out) {
     services::ToObstacles(out.obstacles, stamp, frame_id_, &obstacles_);
-    human_.header = obstacles_.header;
-    human_.voxel_size = human_voxel_;
-    human_.points.clear();
-    for (const HumanPoint& h : out.human) {
-      if (human_.points.size() >= msg::Limits::kHumanPoints) break;
-      msg::PointGaussian g;
-      g.mean.x = h.mean.x();
-      g.mean.y = h.mean.y();
-      g.mean.z = h.mean.z();
-      g.covariance = services::ToWireCovariance(h.covariance);
-      g.motion = h.motion >= 0 && static_cast<std::size_t>(h.motion) < msg::Limits::kPointMotions
-                     ? static_cast<uint32_t>(h.motion + 1)
-                     : 0;
-      human_.points.push_back(g);
-    }
-    human_.motions.clear();
-    for (const PointMotionEstimate& e : out.motions) {
-      if (human_.motions.size() >= msg::Limits::kPointMotions) break;
-      msg::PointMotion m;
-      m.id = e.id;
-      m.velocity.x = e.velocity.x();
-      m.velocity.y = e.velocity.y();
-      m.velocity.z = e.velocity.z();
-      m.velocity_covariance = services::ToWireCovariance(e.velocity_covariance);
-      human_.motions.push_back(m);
-    }
+    services::ToHumanPoints(out.human, stamp, frame_id_, &human_);
     std::string err;
     if (!obstacles_writer_->Write(obstacles_, &err)) node.log().warn("obstacles not published: {}", err);
     if (!human_writer_->Write(human_, &err)) node.log().warn("human points not published: {}", err);
@@ -184,7 +158,6 @@ class CloudService : public framework::Service {
   static constexpr int64_t kBracketNs = 600000000;            // 0.6 s: the widest gap interpolated across
   std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
   double joint_state_timeout_ = 0.2;
-  double human_voxel_ = 0.03;
   std::string frame_id_ = "world";
   cloud::Cloud cloud_;
   msg::ObstacleArray obstacles_;

@@ -76,9 +76,36 @@ cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m) {
   }
   for (const msg::PointMotion& pm : m.motions) {
     p.motions.push_back({Eigen::Vector3d(pm.velocity.x, pm.velocity.y, pm.velocity.z),
-                         FromWireCovariance(pm.velocity_covariance)});
+                         FromWireCovariance(pm.velocity_covariance), pm.id});
   }
   return p;
+}
+
+void ToHumanPoints(const cell::HumanPoints& p, const msg::Time& stamp, const std::string& frame_id,
+                   msg::HumanPoints* m) {
+  m->header.stamp = stamp;
+  m->header.frame_id = frame_id;
+  m->voxel_size = p.voxel_size;
+  m->points.clear();
+  for (int i = 0; i < p.size(); ++i) {
+    if (m->points.size() >= msg::Limits::kHumanPoints) break;
+    msg::PointGaussian g;
+    const auto mean = p.means.col(i);
+    g.mean = {mean.x(), mean.y(), mean.z()};
+    g.covariance = ToWireCovariance(p.covariances[static_cast<std::size_t>(i)]);
+    const int k = i < static_cast<int>(p.motion_of.size()) ? p.motion_of[static_cast<std::size_t>(i)] : -1;
+    g.motion = k >= 0 && static_cast<std::size_t>(k) < msg::Limits::kPointMotions ? static_cast<uint32_t>(k + 1) : 0;
+    m->points.push_back(g);
+  }
+  m->motions.clear();
+  for (const cell::PointMotion& pm : p.motions) {
+    if (m->motions.size() >= msg::Limits::kPointMotions) break;
+    msg::PointMotion w;
+    w.id = pm.id;
+    w.velocity = {pm.velocity.x(), pm.velocity.y(), pm.velocity.z()};
+    w.velocity_covariance = ToWireCovariance(pm.covariance);
+    m->motions.push_back(w);
+  }
 }
 
 std::vector<cell::ObstacleBox> FromObstacles(const msg::ObstacleArray& m) {

@@ -103,5 +103,54 @@ TEST(Obstacles, RoundTripKeepsEveryBoxAndTheLimit) {
   EXPECT_EQ(m.obstacles.size(), msg::Limits::kObstacles);
 }
 
+TEST(HumanPointsAdapter, RoundTripKeepsPointsMotionsAndTheLimits) {
+  cell::HumanPoints p;
+  p.voxel_size = 0.03;
+  p.means.resize(3, 3);
+  p.means << 1.0, 1.1, 1.2,  //
+      0.0, 0.1, 0.2,         //
+      0.3, 0.4, 0.5;
+  for (int i = 0; i < 3; ++i) {
+    Eigen::Matrix3d c = (1e-4 * (i + 1)) * Eigen::Matrix3d::Identity();
+    c(0, 1) = c(1, 0) = 1e-5;
+    p.covariances.push_back(c);
+  }
+  p.motion_of = {1, -1, 0};
+  p.motions.push_back({Eigen::Vector3d(0.1, 0, 0), 0.01 * Eigen::Matrix3d::Identity(), 4});
+  p.motions.push_back({Eigen::Vector3d(-0.4, 0.2, 0), 0.04 * Eigen::Matrix3d::Identity(), 9});
+  msg::HumanPoints m;
+  ToHumanPoints(p, msg::TimeFromNanoseconds(1'700'000'001'000'000'000), "world", &m);
+  EXPECT_EQ(m.header.frame_id, "world");
+  EXPECT_EQ(msg::ToNanoseconds(m.header.stamp), 1'700'000'001'000'000'000);
+  ASSERT_EQ(m.points.size(), 3u);
+  EXPECT_EQ(m.points[0].motion, 2u);  // motions[1] on the wire as k + 1
+  EXPECT_EQ(m.points[1].motion, 0u);
+  const cell::HumanPoints back = FromHumanPoints(m);
+  EXPECT_EQ(back.voxel_size, 0.03);
+  EXPECT_EQ(back.means, p.means);
+  for (int i = 0; i < 3; ++i) EXPECT_EQ(back.covariances[static_cast<std::size_t>(i)], p.covariances[static_cast<std::size_t>(i)]);
+  EXPECT_EQ(back.motion_of, p.motion_of);
+  ASSERT_EQ(back.motions.size(), 2u);
+  for (std::size_t k = 0; k < 2; ++k) {
+    EXPECT_EQ(back.motions[k].id, p.motions[k].id);
+    EXPECT_EQ(back.motions[k].velocity, p.motions[k].velocity);
+    EXPECT_EQ(back.motions[k].covariance, p.motions[k].covariance);
+  }
+  // More than the wire holds: points and motions cut at the limits, and a
+  // point whose motion was cut goes out untracked.
+  cell::HumanPoints many;
+  const int n = static_cast<int>(msg::Limits::kHumanPoints) + 5;
+  many.means = Eigen::Matrix3Xd::Ones(3, n);
+  many.covariances.assign(static_cast<std::size_t>(n), 1e-4 * Eigen::Matrix3d::Identity());
+  many.motions.assign(msg::Limits::kPointMotions + 2, cell::PointMotion{});
+  many.motion_of.assign(static_cast<std::size_t>(n), static_cast<int>(msg::Limits::kPointMotions) + 1);
+  many.motion_of[0] = 0;
+  ToHumanPoints(many, {}, "world", &m);
+  EXPECT_EQ(m.points.size(), msg::Limits::kHumanPoints);
+  EXPECT_EQ(m.motions.size(), msg::Limits::kPointMotions);
+  EXPECT_EQ(m.points[0].motion, 1u);
+  EXPECT_EQ(m.points[1].motion, 0u);
+}
+
 }  // namespace
 }  // namespace iplan::services

@@ -121,7 +121,7 @@ void BM_CloudStage(benchmark::State& state) {
   std::size_t human = 0, n = 0;
   Run(state, [&](int f) {
     work = frames[static_cast<std::size_t>(f)];  // the copy the service decodes into (not timed apart)
-    human += stage.Process(&work, cell.q, f * 33'333'333LL).human.size();
+    human += static_cast<std::size_t>(stage.Process(&work, cell.q, f * 33'333'333LL).human.size());
     ++n;
   });
   state.counters["human_points"] = static_cast<double>(human) / static_cast<double>(std::max<std::size_t>(1, n));

@@ -113,22 +113,24 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
     camera.Render(scene, &cloud);
     Frame fr;
     fr.stamp_ns = static_cast<int64_t>(std::llround(t * 1e9)) + 1'000'000'000'000LL;
-    for (const auto& h : stage.Process(&cloud, q, fr.stamp_ns).human) {
+    const cell::HumanPoints human = stage.Process(&cloud, q, fr.stamp_ns).human;
+    for (int i = 0; i < human.size(); ++i) {
+      const Eigen::Vector3d mean = human.means.col(i);
       std::size_t best = 0;
       double d = 1e9;
       for (std::size_t k = 0; k < c.size(); ++k) {
-        const double e = (h.mean - c[k]).norm() - radii[k];
+        const double e = (mean - c[k]).norm() - radii[k];
         if (e < d) d = e, best = k;
       }
       Eigen::Index near = 0;
       double dr = 1e9;
       for (Eigen::Index k = 0; k < data.p_WS.cols(); ++k) {
-        const double e = (data.p_WS.col(k) - h.mean).norm() - robot.spheres[static_cast<std::size_t>(k)].radius;
+        const double e = (data.p_WS.col(k) - mean).norm() - robot.spheres[static_cast<std::size_t>(k)].radius;
         if (e < dr) dr = e, near = k;
       }
-      fr.points.push_back(h.mean);
+      fr.points.push_back(mean);
       fr.v_true.push_back((after[best] - before[best]) / 0.01);
-      fr.u.push_back((data.p_WS.col(near) - h.mean).normalized());
+      fr.u.push_back((data.p_WS.col(near) - mean).normalized());
     }
     frames.push_back(std::move(fr));
   }

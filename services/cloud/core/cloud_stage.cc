@@ -77,33 +77,38 @@ void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& 
   for (int i : indices) p_W.push_back(X_WS * cloud.points[static_cast<std::size_t>(i)]);
   if (params_.human_voxel > 0) p_W = cloud::VoxelCentroids(p_W, static_cast<float>(params_.human_voxel));
   const Eigen::Matrix3d R_WS = params_.X_WS.linear();
-  for (const Eigen::Vector3f& p : p_W) {
+  cell::HumanPoints& human = out->human;
+  human.stamp_ns = stamp_ns;
+  human.voxel_size = params_.human_voxel;
+  human.means.resize(3, static_cast<Eigen::Index>(p_W.size()));
+  human.covariances.resize(p_W.size());
+  for (std::size_t i = 0; i < p_W.size(); ++i) {
     // The noise of a point measured where the voxel's centroid is: the
     // centroid of several points is no worse measured than one of them.
-    const Eigen::Vector3f p_S = (X_SW_ * p.cast<double>()).cast<float>();
-    HumanPoint h;
-    h.mean = p.cast<double>();
-    h.covariance = R_WS * cloud::PointCovariance(params_.noise, p_S) * R_WS.transpose();
-    out->human.push_back(h);
+    const Eigen::Vector3f p_S = (X_SW_ * p_W[i].cast<double>()).cast<float>();
+    human.means.col(static_cast<Eigen::Index>(i)) = p_W[i].cast<double>();
+    human.covariances[i] = R_WS * cloud::PointCovariance(params_.noise, p_S) * R_WS.transpose();
   }
   // Their motion: without a self-filter the robot's points are among them
   // (and would make parts of their own): the parts are left alone (the next
   // frame predicts them over the longer gap), this frame's points are not
   // tracked.
   if (!track) return;
-  std::vector<Eigen::Vector3d> means(out->human.size());
-  for (std::size_t i = 0; i < means.size(); ++i) means[i] = out->human[i].mean;
+  std::vector<Eigen::Vector3d> means(static_cast<std::size_t>(human.size()));
+  for (std::size_t i = 0; i < means.size(); ++i) means[i] = human.means.col(static_cast<Eigen::Index>(i));
   const std::vector<int> part_of = motion_.Update(means, stamp_ns);
   std::vector<int> motion_of(motion_.parts().size(), -1);
   for (std::size_t k = 0; k < motion_.parts().size(); ++k) {
     const MotionPart& part = motion_.parts()[k];
     if (!motion_.Tracked(part)) continue;
-    motion_of[k] = static_cast<int>(out->motions.size());
-    out->motions.push_back({part.id, part.velocity(), part.velocity_covariance()});
+    motion_of[k] = static_cast<int>(human.motions.size());
+    human.motions.push_back({part.velocity(), part.velocity_covariance(), part.id});
   }
+  human.motion_of.assign(means.size(), -1);
   for (std::size_t i = 0; i < part_of.size(); ++i) {
-    if (part_of[i] >= 0) out->human[i].motion = motion_of[static_cast<std::size_t>(part_of[i])];
+    if (part_of[i] >= 0) human.motion_of[i] = motion_of[static_cast<std::size_t>(part_of[i])];
   }
+  if (human.motions.empty()) human.motion_of.clear();  // as FromHumanPoints: empty when none is tracked
 }
 
 StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns) {

@@ -19,6 +19,7 @@
 #include <Eigen/Geometry>
 
 #include "services/cloud/core/cluster_tracker.h"
+#include "iplan/cell/human_points.h"
 #include "iplan/cell/obstacle_box.h"
 #include "services/cloud/core/point_motion.h"
 #include "iplan/cloud/cloud.h"
@@ -42,24 +43,12 @@ struct CloudStageParams {
   std::string Validate() const;
 };
 
-/// One human point as a Gaussian in W.
-struct HumanPoint {
-  Eigen::Vector3d mean = Eigen::Vector3d::Zero();          ///< m
-  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();    ///< m^2
-  int motion = -1;  ///< index into StageOutput::motions of its tracked part; -1: not tracked (speed unknown)
-};
-
-/// The velocity of a tracked part of a person (point_motion.h), in W.
-struct PointMotionEstimate {
-  uint32_t id = 0;                                                  ///< the part's, >= 1, stable
-  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();               ///< m/s
-  Eigen::Matrix3d velocity_covariance = Eigen::Matrix3d::Zero();    ///< (m/s)^2
-};
-
 struct StageOutput {
   std::vector<cell::ObstacleBox> obstacles;  ///< the static tracks: boxes upright in W (z along W's z), id = track id
-  std::vector<HumanPoint> human;
-  std::vector<PointMotionEstimate> motions;  ///< the tracked parts the human points name
+  /// The human points as Gaussians in W (the camera's noise at each), with
+  /// the velocities of the tracked parts they belong to (point_motion.h);
+  /// stamped with the cloud, voxel_size = human_voxel.
+  cell::HumanPoints human;
   bool table_found = false;
   int table_points = 0;
   int clusters = 0;           ///< segments of this frame

@@ -67,11 +67,11 @@ TEST(CloudStageTest, BoxOnTheTableIsOneStaticObstacleWithStableId) {
     EXPECT_GT(out.table_points, 50000);
     if (f < 9) {  // static_frames = 10: pending, counted as human points meanwhile
       EXPECT_TRUE(out.obstacles.empty()) << "frame " << f;
-      EXPECT_FALSE(out.human.empty());
+      EXPECT_FALSE((out.human.size() == 0));
       continue;
     }
     ASSERT_EQ(out.obstacles.size(), 1u) << "frame " << f;
-    EXPECT_TRUE(out.human.empty()) << "frame " << f;
+    EXPECT_TRUE((out.human.size() == 0)) << "frame " << f;
     const cell::ObstacleBox& o = out.obstacles[0];
     if (id == 0) id = o.id;
     EXPECT_EQ(o.id, id);
@@ -147,12 +147,16 @@ TEST(CloudStageTest, MovingPersonIsHumanPointsNearTheTruth) {
     cam.Render(scene, &c);
     const StageOutput out = stage.Process(&c, std::nullopt, f * kFrameNs);
     EXPECT_TRUE(out.obstacles.empty()) << "frame " << f;
-    ASSERT_GT(out.human.size(), 50u) << "frame " << f;
-    for (const HumanPoint& h : out.human) {
+    ASSERT_GT(out.human.size(), 50) << "frame " << f;
+    EXPECT_EQ(out.human.stamp_ns, f * kFrameNs);
+    EXPECT_EQ(out.human.voxel_size, Params().human_voxel);
+    EXPECT_EQ(out.human.Check(), std::nullopt);
+    for (int i = 0; i < out.human.size(); ++i) {
+      const Eigen::Vector3d mean = out.human.means.col(i);
       double surface = 1e9;
-      for (const auto& s : scene.spheres) surface = std::min(surface, (h.mean - s.centre).norm() - s.radius);
+      for (const auto& s : scene.spheres) surface = std::min(surface, (mean - s.centre).norm() - s.radius);
       EXPECT_LT(std::abs(surface), 0.03);  // a 3 cm voxel's centroid near the surface
-      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(h.covariance);
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(out.human.covariances[static_cast<std::size_t>(i)]);
       EXPECT_GT(eig.eigenvalues().minCoeff(), 0);
       EXPECT_LT(std::sqrt(eig.eigenvalues().maxCoeff()), 0.01);  // a few mm at 1.5 m
     }
@@ -181,11 +185,11 @@ TEST(CloudStageTest, RobotSpheresAreFilteredGivenTheJointState) {
   const StageOutput with_q = filtered.Process(&c, Eigen::VectorXd(0), 0);
   EXPECT_TRUE(with_q.self_filtered);
   EXPECT_EQ(with_q.clusters, 0);
-  EXPECT_TRUE(with_q.human.empty());
+  EXPECT_TRUE((with_q.human.size() == 0));
   const StageOutput without_q = unfiltered.Process(&copy, std::nullopt, 0);
   EXPECT_FALSE(without_q.self_filtered);
   EXPECT_EQ(without_q.clusters, 1);
-  EXPECT_FALSE(without_q.human.empty());  // the robot counts as human: cautious
+  EXPECT_FALSE((without_q.human.size() == 0));  // the robot counts as human: cautious
 }
 
 TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
@@ -212,7 +216,7 @@ TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
     cam.Render(scene, &c);
     const StageOutput out = stage.Process(&c, std::nullopt, f * kFrameNs);
     EXPECT_TRUE(out.obstacles.empty());
-    EXPECT_FALSE(out.human.empty());
+    EXPECT_FALSE((out.human.size() == 0));
   }
   StageOutput out;
   for (int f = 12; f < 22; ++f) {
@@ -222,7 +226,7 @@ TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
   ASSERT_EQ(out.obstacles.size(), 1u);
   EXPECT_EQ(out.obstacles[0].first_seen_ns, 12 * kFrameNs);
   EXPECT_LT((out.obstacles[0].centre - centre).norm(), 0.02);
-  EXPECT_TRUE(out.human.empty());
+  EXPECT_TRUE((out.human.size() == 0));
 }
 
 TEST(CloudStageTest, WorkspaceCropRemovesWhatIsOutside) {

@@ -38,6 +38,12 @@ void FillPrediction(const collision::JointMixture& in, msg::HumanPrediction* m);
 /// `motion` k >= 1 is motions[k - 1], 0 not tracked). The boundary has
 /// checked the message (finite, covariances PSD, motion indices in range).
 cell::HumanPoints FromHumanPoints(const msg::HumanPoints& m);
+/// The other way, as the cloud service publishes them: at most
+/// msg::Limits::kHumanPoints points and kPointMotions motions (a point whose
+/// motion is not written goes out untracked); the stamp and frame are the
+/// cloud's, as ToObstacles'.
+void ToHumanPoints(const cell::HumanPoints& p, const msg::Time& stamp, const std::string& frame_id,
+                   msg::HumanPoints* m);
 
 /// The static obstacles of one cloud, both ways. The boundary has checked
 /// a received message (ids >= 1, unit orientations, half extents >= 0);

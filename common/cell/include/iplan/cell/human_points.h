@@ -22,6 +22,7 @@ namespace iplan::cell {
 struct PointMotion {
   Eigen::Vector3d velocity = Eigen::Vector3d::Zero();    ///< m/s
   Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();  ///< (m/s)^2, symmetric positive semi-definite
+  uint32_t id = 0;  ///< the tracked part's, >= 1 and stable while it is tracked; 0: not known
 };
 
 struct HumanPoints {
