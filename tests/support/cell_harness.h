@@ -23,6 +23,7 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -115,14 +116,7 @@ class CellHarness {
   }
 
   ~CellHarness() {
-    for (auto& [name, p] : procs_) {
-      if (!p) continue;
-      p->Signal(SIGCONT);
-      p->Signal(SIGTERM);
-    }
-    for (auto& [name, p] : procs_) {
-      if (p) p->Wait(std::chrono::seconds(10));
-    }
+    TerminateAll(false);
     procs_.clear();
     observer_.reset();
     // Service logs stay for a failed test (each start: <svc>-<n>.out/.err).
@@ -193,18 +187,7 @@ class CellHarness {
   }
   /// Stops every service started; each must exit 0 on SIGTERM. Their logs
   /// stay readable (Logs) until a service is started again.
-  void Stop() {
-    for (auto& [name, p] : procs_) {
-      if (!p) continue;
-      p->Signal(SIGCONT);
-      p->Signal(SIGTERM);
-    }
-    for (auto& [name, p] : procs_) {
-      if (p) {
-        EXPECT_EQ(p->Wait(std::chrono::seconds(10)), 0) << name << ":\n" << p->Stderr();
-      }
-    }
-  }
+  void Stop() { TerminateAll(true); }
   Process& operator[](const std::string& svc) { return *procs_.at(svc); }
   std::string Logs(const std::string& svc) const {
     auto it = procs_.find(svc);
@@ -301,6 +284,22 @@ class CellHarness {
   }
 
  private:
+  // SIGTERM to every service started (SIGCONT first: a test may have
+  // stopped one), then waits up to 10 s for each; with `expect_clean`, each
+  // must have exited 0.
+  void TerminateAll(bool expect_clean) {
+    for (auto& [name, p] : procs_) {
+      if (!p) continue;
+      p->Signal(SIGCONT);
+      p->Signal(SIGTERM);
+    }
+    for (auto& [name, p] : procs_) {
+      if (!p) continue;
+      const std::optional<int> code = p->Wait(std::chrono::seconds(10));
+      if (expect_clean) EXPECT_EQ(code, 0) << name << ":\n" << p->Stderr();
+    }
+  }
+
   /// The cell's own settings for `svc` (shipped configuration): intent's
   /// model, perception's synthetic person, the supervisor's Q-table. False
   /// (and a test failure) for intent in a cell made without it.

@@ -7,6 +7,7 @@
 #include <numeric>
 #include <stdexcept>
 
+#include "iplan/adapters/adapters.h"
 #include "iplan/msg/time.h"
 
 namespace iplan::viewer {
@@ -372,25 +373,24 @@ const json* SceneBuilder::Boxes(const msg::ObstacleArray& a) {
   const Rgba color{0.95, 0.45, 0.1, 0.45};
   json& cubes = e["cubes"];
   cubes = json::array();
-  for (const msg::Obstacle& o : a.obstacles) {
-    // Oriented boxes in "world" (idl/iplan_msgs.idl), half extents along their own axes.
-    const Eigen::Vector3d size(2 * o.half_extents[0], 2 * o.half_extents[1], 2 * o.half_extents[2]);
-    const Eigen::Quaterniond q(o.orientation.w, o.orientation.x, o.orientation.y, o.orientation.z);
-    cubes.push_back({{"pose", Pose({o.centre.x, o.centre.y, o.centre.z}, q)}, {"size", Point(size)}, {"color", Color(color)}});
+  for (const cell::ObstacleBox& b : services::FromObstacles(a)) {
+    // Oriented boxes in "world", half extents along their own axes.
+    cubes.push_back({{"pose", Pose(b.centre, b.orientation)}, {"size", Point(2 * b.half_extents)}, {"color", Color(color)}});
   }
   e["metadata"] = json::array({{{"key", "boxes"}, {"value", std::to_string(a.obstacles.size())}}});
   return &updates_[entity::kBoxes];
 }
 
-const json* SceneBuilder::HumanPoints(const msg::HumanPoints& p) {
-  if (p.header.frame_id != "world") {
-    Reject("human points in frame '" + p.header.frame_id + "', not the cell frame 'world'");
+const json* SceneBuilder::HumanPoints(const msg::HumanPoints& m) {
+  if (m.header.frame_id != "world") {
+    Reject("human points in frame '" + m.header.frame_id + "', not the cell frame 'world'");
     return nullptr;
   }
+  const cell::HumanPoints p = services::FromHumanPoints(m);
   constexpr double kVelocityLead = 0.5;  // s drawn ahead along each part's velocity
   const Rgba tracked{0.55, 0.2, 0.85, 0.9}, untracked{0.9, 0.15, 0.15, 0.9}, arrow{0.35, 0.05, 0.6, 1.0};
-  json& e = Persistent(entity::kHumanPoints, p.header.stamp);
-  const std::size_t n = p.points.size();
+  json& e = Persistent(entity::kHumanPoints, m.header.stamp);
+  const std::size_t n = static_cast<std::size_t>(p.size());
   const std::size_t stride = std::max<std::size_t>(1, (n + options_.max_cloud_points - 1) / options_.max_cloud_points);
   const double d = p.voxel_size > 0 ? p.voxel_size : options_.cloud_point_size;
   json& cubes = e["cubes"];
@@ -399,12 +399,12 @@ const json* SceneBuilder::HumanPoints(const msg::HumanPoints& p) {
   std::vector<int> count(p.motions.size(), 0);
   std::size_t n_tracked = 0;
   for (std::size_t i = 0; i < n; ++i) {
-    const msg::PointGaussian& g = p.points[i];
-    const Eigen::Vector3d v(g.mean.x, g.mean.y, g.mean.z);
-    const bool moving = g.motion > 0 && g.motion <= p.motions.size();
+    const Eigen::Vector3d v = p.means.col(static_cast<Eigen::Index>(i));
+    const int k = i < p.motion_of.size() ? p.motion_of[i] : -1;  // in range: the boundary checked it
+    const bool moving = k >= 0;
     if (moving) {
-      sum[g.motion - 1] += v;
-      ++count[g.motion - 1];
+      sum[static_cast<std::size_t>(k)] += v;
+      ++count[static_cast<std::size_t>(k)];
       ++n_tracked;
     }
     if (i % stride != 0) continue;
@@ -414,9 +414,8 @@ const json* SceneBuilder::HumanPoints(const msg::HumanPoints& p) {
   for (std::size_t k = 0; k < p.motions.size(); ++k) {
     if (count[k] == 0) continue;
     const Eigen::Vector3d c = sum[k] / count[k];
-    const auto& v = p.motions[k].velocity;
     segments.push_back(Point(c));
-    segments.push_back(Point(c + kVelocityLead * Eigen::Vector3d(v.x, v.y, v.z)));
+    segments.push_back(Point(c + kVelocityLead * p.motions[k].velocity));
   }
   e["lines"] = json::array();
   if (!segments.empty()) e["lines"].push_back(Line(2, std::move(segments), 0.01, arrow));
