@@ -81,6 +81,7 @@ struct TrainOptions {
   int history_samples = iplan::intent::IntentModelConfig{}.history_samples;
   int gp_iterations = 150, max_forecast_windows = 600, forecast_stride = 2;
   std::uint64_t seed = 1;
+  int threads = 0;
 };
 
 struct EvalOptions {
@@ -158,6 +159,7 @@ iplan::intent::TrainParams MakeTrainParams(const TrainOptions& o) {
   params.max_forecast_windows = o.max_forecast_windows;
   params.forecast_stride = o.forecast_stride;
   params.seed = o.seed;
+  params.threads = o.threads;
   return params;
 }
 
@@ -409,6 +411,11 @@ const bool kRegistered = RegisterCommand("intent", [](CLI::App& app) {
   train->add_flag("--normalise-size", t.normalise_size,
                   "Classifier features divided by shoulder width (needs joints shoulder_l, shoulder_r)");
   train->add_option("--seed", t.seed, "Random seed")->capture_default_str();
+  train->add_option("--threads", t.threads,
+                    "Threads for the classifier's cross-validation folds (0: one per hardware thread); the model "
+                    "does not depend on it")
+      ->check(CLI::Range(0, 256))
+      ->capture_default_str();
   train->callback([train_opts] { Guarded([&] { RunTrain(*train_opts); }); });
 
   AddEvalCommand(intent);

@@ -5,9 +5,11 @@
 // same way (docs/intent.md, pipeline steps 3, 4 and 7).
 #include <algorithm>
 #include <cmath>
+#include <exception>
 #include <limits>
 #include <map>
 #include <set>
+#include <thread>
 #include <vector>
 
 #include "intent_training.h"
@@ -146,26 +148,56 @@ Eigen::MatrixXd PredictRows(const IvmModel& ivm, const Eigen::MatrixXd& K,
 
 // Leave-one-subject-out at (K, lambda, mirror): the held-out log-loss summed
 // over the recorded samples and the number classified correctly.
+// The folds run on up to TrainParams::threads threads; each writes only its
+// own sums, added in fold order afterwards, so the result does not depend on
+// the thread count.
 void LeaveOneSubjectOut(const Eigen::MatrixXd& K, const ClassifierSamples& cs, int num_subjects,
                         int C, const TrainParams& params, double lambda, bool mirror, double* loss,
                         int* correct) {
-  for (int fold = 0; fold < num_subjects; ++fold) {
+  std::vector<double> fold_loss(static_cast<size_t>(num_subjects), 0.0);
+  std::vector<int> fold_correct(static_cast<size_t>(num_subjects), 0);
+  auto run_fold = [&](int fold) {
     const std::vector<int> tr = TrainingRows(cs, fold, mirror);
     std::vector<int> te;
     for (int i = 0; i < cs.num_recorded; ++i) {
       if (cs.subject[i] == fold) te.push_back(i);
     }
-    if (te.empty() || tr.empty()) continue;
+    if (te.empty() || tr.empty()) return;
     const IvmModel ivm = FitIvmOnRows(K, cs, tr, C, params, lambda);
     const Eigen::MatrixXd P = PredictRows(ivm, K, tr, te);
     std::vector<int> yte;
     for (int i : te) yte.push_back(cs.labels[i]);
-    *loss += MeanLogLoss(P, yte) * te.size();
+    fold_loss[static_cast<size_t>(fold)] = MeanLogLoss(P, yte) * te.size();
     for (size_t r = 0; r < te.size(); ++r) {
       Eigen::Index arg;
       P.row(static_cast<Eigen::Index>(r)).maxCoeff(&arg);
-      if (arg == yte[r]) ++*correct;
+      if (arg == yte[r]) ++fold_correct[static_cast<size_t>(fold)];
     }
+  };
+  const int hardware = static_cast<int>(std::max(1u, std::thread::hardware_concurrency()));
+  const int threads = std::min(num_subjects, params.threads > 0 ? params.threads : hardware);
+  if (threads <= 1) {
+    for (int fold = 0; fold < num_subjects; ++fold) run_fold(fold);
+  } else {
+    std::vector<std::exception_ptr> failed(static_cast<size_t>(threads));
+    std::vector<std::thread> pool;
+    for (int w = 0; w < threads; ++w) {
+      pool.emplace_back([&, w] {
+        try {
+          for (int fold = w; fold < num_subjects; fold += threads) run_fold(fold);
+        } catch (...) {
+          failed[static_cast<size_t>(w)] = std::current_exception();
+        }
+      });
+    }
+    for (std::thread& t : pool) t.join();
+    for (const std::exception_ptr& e : failed) {
+      if (e) std::rethrow_exception(e);
+    }
+  }
+  for (int fold = 0; fold < num_subjects; ++fold) {
+    *loss += fold_loss[static_cast<size_t>(fold)];
+    *correct += fold_correct[static_cast<size_t>(fold)];
   }
 }
 

@@ -45,6 +45,7 @@ std::string TrainParams::Validate() const {
   const std::string ivm_error = ivm.Validate();
   if (!ivm_error.empty() && ivm_error.find("lambda") == std::string::npos) return "ivm: " + ivm_error;
   if (pseudo_inputs < 1) return "pseudo_inputs " + std::to_string(pseudo_inputs) + " must be >= 1";
+  if (threads < 0 || threads > 256) return "threads " + std::to_string(threads) + " must be in [0, 256]";
   if (forecast_stride < 1) return "forecast_stride must be >= 1";
   if (max_forecast_windows < 2) return "max_forecast_windows must be >= 2";
   if (gp_iterations < 0) return "gp_iterations must be >= 0";

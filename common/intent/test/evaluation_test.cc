@@ -10,6 +10,7 @@
 #include <gtest/gtest.h>
 
 #include "iplan/intent/kinematic_baseline.h"
+#include "iplan/intent/model_io.h"
 
 namespace iplan::intent {
 namespace {
@@ -139,6 +140,24 @@ TEST(EvaluationTest, CoverageScalesCarryOverFromOneSequenceToTheNext) {
   EXPECT_NE(EvaluateIntentModel(model, reversed, carried).coverage95, carried_forward);
   // Carried over, every person but the first starts calibrated: nearer 95 %.
   EXPECT_LT(std::abs(carried_forward - 0.95), std::abs(own_forward - 0.95));
+}
+
+// The classifier's cross-validation folds on several threads give the very
+// model one thread gives (three subjects: up to three folds at once); a bad
+// count is refused.
+TEST(TrainingTest, TheModelDoesNotDependOnTheThreadCount) {
+  const SkeletonDataset train = Sweeps(1, false);
+  TrainParams one = SweepParams();
+  one.sigma_factors = {0.5, 1.0};  // a grid, so that the folds run
+  one.threads = 1;
+  const std::string want = SerializeIntentModel(TrainIntentModel(train, SweepConfig(), one));
+  for (const int threads : {2, 3, 0}) {
+    TrainParams p = one;
+    p.threads = threads;
+    EXPECT_EQ(SerializeIntentModel(TrainIntentModel(train, SweepConfig(), p)), want) << threads << " threads";
+  }
+  one.threads = -1;
+  EXPECT_EQ(one.Validate(), "threads -1 must be in [0, 256]");
 }
 
 TEST(EvaluationTest, RecordingsWhoseActionChangesTrainAndAreScoredPerFrame) {

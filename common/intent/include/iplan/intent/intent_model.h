@@ -113,6 +113,11 @@ struct TrainParams {
   int min_forecast_windows = 20;
   int gp_iterations = 150;         ///< L-BFGS iterations per action.
   std::uint64_t seed = 1;
+  /// Threads for the classifier's leave-one-subject-out folds (one fold per
+  /// thread at a time); 0: one per hardware thread. The model does not
+  /// depend on it (each fold is fitted alone, the folds' sums are added in
+  /// fold order).
+  int threads = 0;
 
   /// Empty string when valid, else the offending field and value.
   std::string Validate() const;
@@ -233,7 +238,7 @@ struct TrainReport {
 /// Throws std::invalid_argument for invalid config/params, a model joint
 /// missing from the data (the message names it), or fewer than two actions.
 /// Any valid JointConfig works, including one joint without a torso.
-/// Deterministic for a given seed. Single-threaded.
+/// Deterministic for a given seed, whatever TrainParams::threads.
 IntentModel TrainIntentModel(const SkeletonDataset& data,
                              const IntentModelConfig& config,
                              const TrainParams& params,
