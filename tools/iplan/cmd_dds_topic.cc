@@ -249,7 +249,14 @@ int RunPub(const PubOptions& o) {
     next += period;
     std::this_thread::sleep_until(next);
   }
-  writer.WaitForAcknowledgments(2s);
+  // Exit only once the matched readers have what was written: a reader whose
+  // side of the discovery is still running (seconds on a loaded host) gets a
+  // volatile sample by retransmission, which needs this writer alive.
+  const auto ack_timeout = std::max<std::chrono::nanoseconds>(2s, Seconds(o.wait_readers));
+  if (n > 0 && !writer.WaitForAcknowledgments(ack_timeout)) {
+    std::cerr << "iplan topic pub: not every matched reader of " << RosTopicName(topic) << " acknowledged within "
+              << std::chrono::duration<double>(ack_timeout).count() << " s; it may have missed the message\n";
+  }
   type->destroy(m);
   std::cout << "published " << n << " message" << (n == 1 ? "" : "s") << " on " << RosTopicName(topic) << "\n";
   return rc;
@@ -294,7 +301,10 @@ void Register(CLI::App& app) {
   p->add_option("-r,--rate", pub.rate, "messages per second (with --count other than 1)");
   p->add_option("-n,--count", pub.count, "messages to publish (0: until Ctrl-C)")->capture_default_str();
   p->add_flag("--stamp-now", pub.stamp_now, "set header.stamp to the current time on every message");
-  p->add_option("--wait-readers", pub.wait_readers, "seconds to wait for a reader before publishing")->capture_default_str();
+  p->add_option("--wait-readers", pub.wait_readers,
+                "seconds to wait for a reader before publishing, and at least 2 s afterwards for the readers to "
+                "acknowledge (reliable topics)")
+      ->capture_default_str();
   p->callback([] { SetExitCode(RunPub(pub)); });
 }
 
