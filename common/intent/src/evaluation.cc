@@ -319,7 +319,7 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
   WindowForecast w;
   // The tracks are people one after another in one cell: with carry_over
   // each starts from the scales the one before ended with, as the intent
-  // service starts a new body.
+  // service starts a new body; without, from 1 (the model's).
   Eigen::VectorXd cell_scales = Eigen::VectorXd::Ones(J);
   for (const Track& t : tracks) {
     const int n = static_cast<int>(t.positions.rows());
@@ -327,7 +327,7 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
     // coverage adapter; the forecast windows are scored on what is published.
     BeliefFilter filter(static_cast<int>(model.actions.size()), model.classifier.belief);
     CoverageAdapter coverage(J, H, rate, params.coverage);
-    if (params.coverage.carry_over) coverage.Reset(cell_scales);
+    coverage.Reset(cell_scales);
     Eigen::VectorXd window_p(static_cast<Eigen::Index>(model.actions.size()));
     JointMixture& pred = timed_predict.pred;
     for (int e = 0; e + H <= n - 1; ++e) {
@@ -352,7 +352,7 @@ void ScoreForecasts(const std::vector<Track>& tracks, const EvalParams& params,
         reached[j] = true;
       }
     }
-    cell_scales = coverage.variance_scales();
+    if (params.coverage.carry_over) cell_scales = coverage.variance_scales();
   }
   FinishSteps(s, params, H, std::max(1.0, static_cast<double>(r.num_forecast_windows) * J), &r);
   std::vector<std::string> hand_names;

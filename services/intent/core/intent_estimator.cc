@@ -86,7 +86,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
                                                " ignored"};
     }
     it = bodies_.emplace(frame.body_id, Body(*model_, params_.CoverageParams())).first;
-    if (params_.coverage_carry_over) it->second.coverage.Reset(cell_scales_);
+    it->second.coverage.Reset(cell_scales_);
   }
   Body& body = it->second;
   if (!body.stamps.empty()) {
@@ -100,11 +100,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
       body.stamps.clear();
       body.positions.clear();
       body.belief.Reset();
-      if (params_.coverage_carry_over) {
-        body.coverage.Reset(cell_scales_);
-      } else {
-        body.coverage.Reset();
-      }
+      body.coverage.Reset(cell_scales_);
     }
   }
   body.stamps.push_back(frame.stamp);
@@ -121,7 +117,7 @@ FrameResult IntentEstimator::Update(const SkeletonFrame& frame, collision::Joint
   for (int c = 0; c < out->num_actions(); ++c) out->probabilities[static_cast<std::size_t>(c)] = body.belief.probabilities()(c);
   // Score the body's earlier forecasts that mature now, then calibrate this one.
   body.coverage.Observe(frame.stamp, scratch_);
-  cell_scales_ = body.coverage.variance_scales();
+  if (params_.coverage_carry_over) cell_scales_ = body.coverage.variance_scales();
   body.coverage.Apply(out);
   body.coverage.Record(frame.stamp, *out);
   DropStale(frame.stamp);

@@ -147,7 +147,9 @@ class IntentEstimator {
   std::vector<int> seen_;       // per model joint: times seen in the frame
   Eigen::MatrixXd window_;      // (<= T, 3 J)
   Eigen::VectorXd window_probabilities_;  // (C) of the newest window
-  Eigen::VectorXd cell_scales_;  // (J) the ellipsoid scales last learned (coverage_carry_over)
+  // (J) where a new body's ellipsoid scales start: the scales last learned
+  // with coverage_carry_over, else always 1 (the model's).
+  Eigen::VectorXd cell_scales_;
 };
 
 }  // namespace iplan::intent_service
