@@ -93,7 +93,7 @@ void ToHumanPoints(const cell::HumanPoints& p, const msg::Time& stamp, const std
     const auto mean = p.means.col(i);
     g.mean = {mean.x(), mean.y(), mean.z()};
     g.covariance = ToWireCovariance(p.covariances[static_cast<std::size_t>(i)]);
-    const int k = i < static_cast<int>(p.motion_of.size()) ? p.motion_of[static_cast<std::size_t>(i)] : -1;
+    const int k = p.MotionIndexOf(i);
     g.motion = k >= 0 && static_cast<std::size_t>(k) < msg::Limits::kPointMotions ? static_cast<uint32_t>(k + 1) : 0;
     m->points.push_back(g);
   }

@@ -40,7 +40,7 @@ PointsSeparation EvaluatePointsSeparation(const collision::GaussianPoints& point
     motion_speed[k] = m.velocity.norm() + speed_sigmas * LargestStd(m.covariance);
   }
   auto speed_bound = [&](int input) {
-    const int k = input < static_cast<int>(seen.motion_of.size()) ? seen.motion_of[static_cast<std::size_t>(input)] : -1;
+    const int k = seen.MotionIndexOf(input);
     return k >= 0 ? motion_speed[static_cast<std::size_t>(k)] : s.default_human_speed;
   };
   std::vector<double> block_speed(points.blocks().size(), 0.0);

@@ -26,7 +26,7 @@ std::map<std::tuple<int, long, long, long>, Cell> Coarsen(const cell::HumanPoint
   std::map<std::tuple<int, long, long, long>, Cell> cells;
   for (int i = 0; i < seen.size(); ++i) {
     const Eigen::Vector3d p = seen.means.col(i);
-    const int motion = i < static_cast<int>(seen.motion_of.size()) ? seen.motion_of[static_cast<std::size_t>(i)] : -1;
+    const int motion = seen.MotionIndexOf(i);
     const auto key = std::make_tuple(motion, std::lround(std::floor(p.x() / size)), std::lround(std::floor(p.y() / size)),
                                      std::lround(std::floor(p.z() / size)));
     Cell& c = cells[key];

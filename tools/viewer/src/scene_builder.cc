@@ -400,7 +400,7 @@ const json* SceneBuilder::HumanPoints(const msg::HumanPoints& m) {
   std::size_t n_tracked = 0;
   for (std::size_t i = 0; i < n; ++i) {
     const Eigen::Vector3d v = p.means.col(static_cast<Eigen::Index>(i));
-    const int k = i < p.motion_of.size() ? p.motion_of[i] : -1;  // in range: the boundary checked it
+    const int k = p.MotionIndexOf(static_cast<int>(i));  // in range: the boundary checked it
     const bool moving = k >= 0;
     if (moving) {
       sum[static_cast<std::size_t>(k)] += v;

@@ -36,9 +36,14 @@ struct HumanPoints {
   std::vector<PointMotion> motions;
 
   int size() const { return static_cast<int>(means.cols()); }
+  /// The index into `motions` of point i's part, -1 when it is not tracked
+  /// (i in [0, size())).
+  int MotionIndexOf(int i) const {
+    return i < static_cast<int>(motion_of.size()) ? motion_of[static_cast<std::size_t>(i)] : -1;
+  }
   /// Point i's motion, null when it is not tracked (i in [0, size())).
   const PointMotion* MotionOf(int i) const {
-    const int k = i < static_cast<int>(motion_of.size()) ? motion_of[static_cast<std::size_t>(i)] : -1;
+    const int k = MotionIndexOf(i);
     return k >= 0 ? &motions[static_cast<std::size_t>(k)] : nullptr;
   }
   /// Why the points are inconsistent (sizes, a motion index out of range, a
