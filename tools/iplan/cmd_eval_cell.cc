@@ -41,6 +41,7 @@ struct CellOptions {
   double episode_limit = 120, time_limit = 20;
   double anticipation_weight = -1;  // < 0: supervisor.yaml's
   int anticipation_depth = 0;       // 0: supervisor.yaml's
+  double duration_weight = -1;      // < 0: supervisor.yaml's
   bool retrain = false, quiet = false;
 };
 
@@ -176,6 +177,7 @@ bool Prepare(const CellOptions& o, eval_common::CellInputs* in, cell_sim::CellBe
     setup->task_time_limit = o.time_limit;
     if (o.anticipation_weight >= 0) setup->learning.anticipation_weight = o.anticipation_weight;
     if (o.anticipation_depth > 0) setup->learning.anticipation_depth = o.anticipation_depth;
+    if (o.duration_weight >= 0) setup->learning.duration_weight = o.duration_weight;
     try {
       cell_sim::CalibrateBaselines(RecordCellDemonstrations(in->cell.person), &setup->base);
     } catch (const std::exception& e) {
@@ -222,6 +224,7 @@ int RunCell(const CellOptions& o) {
   for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
   std::cout << "\n  configuration " << in.dir << "\n  " << in.model.summary << "\n  task planner: anticipation_weight "
             << setup.learning.anticipation_weight << ", anticipation_depth " << setup.learning.anticipation_depth
+            << ", duration_weight " << setup.learning.duration_weight
             << ", one per predictor, learning over the episodes\n\n";
 
   std::vector<std::vector<cell_sim::CellEpisodeResult>> results;
@@ -259,6 +262,7 @@ int RunCell(const CellOptions& o) {
   doc["time_limit_s"] = o.time_limit;
   doc["anticipation_weight"] = setup.learning.anticipation_weight;
   doc["anticipation_depth"] = setup.learning.anticipation_depth;
+  doc["duration_weight"] = setup.learning.duration_weight;
   doc["predictors"] = std::move(per);
   doc["model_recovers_oracle_gain"] = GainJson(summary);
   doc["people"] = std::move(people);
@@ -310,6 +314,10 @@ void AddEvalCellCommand(CLI::App* eval) {
   c->add_option("--anticipation-depth", o->anticipation_depth,
                 "the task planners' anticipation_depth instead of supervisor.yaml's")
       ->check(CLI::Range(1, 8));
+  c->add_option("--duration-weight", o->duration_weight,
+                "the task planners' duration_weight (reward per second of a task's time less its delay) instead of "
+                "supervisor.yaml's (0: METHOD 6's reward)")
+      ->check(CLI::NonNegativeNumber);
   c->add_option("--threads", o->threads, "planner threads (0: as planner_replanning.yaml; results do not depend on it)")
       ->capture_default_str()
       ->check(CLI::Range(0, 64));

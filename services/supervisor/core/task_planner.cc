@@ -113,6 +113,7 @@ std::string QLearningParams::Validate() const {
   if (!(epsilon_decay > 0 && epsilon_decay <= 1)) return "epsilon_decay must be in (0, 1]";
   if (!(epsilon_min >= 0 && epsilon_min <= 1)) return "epsilon_min must be in [0, 1]";
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
+  if (!(duration_weight >= 0) || !std::isfinite(duration_weight)) return "duration_weight must be >= 0";
   if (!(anticipation_weight >= 0) || !std::isfinite(anticipation_weight)) return "anticipation_weight must be >= 0";
   if (!(task_duration_prior > 0) || !std::isfinite(task_duration_prior)) return "task_duration_prior must be > 0";
   if (anticipation_depth < 1 || anticipation_depth > 8) return "anticipation_depth must be in [1, 8]";
@@ -277,15 +278,16 @@ int TaskPlanner::Choose(const ActionOutlook& outlook) {
   return best;
 }
 
-double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief) {
+double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief,
+                             double motion) {
   const State s = state_;
   const State next = succeeded ? (s | (1ULL << task)) : s;
-  // A delay that is not a number says nothing about the task: learn
+  // A time that is not a number says nothing about the task: learn
   // nothing from it, but the task did end, so the state still moves on.
-  const bool refused = !std::isfinite(delay);
-  const double reward =
-      refused ? std::numeric_limits<double>::quiet_NaN()
-              : Harmony(task, belief) - params_.delay_weight * std::clamp(delay, 0.0, kMaxDelay);
+  const bool refused = !std::isfinite(delay) || !std::isfinite(motion);
+  const double reward = refused ? std::numeric_limits<double>::quiet_NaN()
+                                : Harmony(task, belief) - params_.delay_weight * std::clamp(delay, 0.0, kMaxDelay) -
+                                      params_.duration_weight * std::clamp(motion, 0.0, kMaxDelay);
   if (refused) ++refused_outcomes_;
   if (params_.learning && !refused) {
     double best_next = 0;

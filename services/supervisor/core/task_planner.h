@@ -4,6 +4,9 @@
 // Q-learning. The reward prefers tasks that do not conflict with what the
 // person is predicted to do and penalises the delay a task caused:
 //   r = h(s, a | p(c)) - w_d * delay,  h = 1 - sum_c p(c) conflict(a, c).
+// Our extension of the reward: - w_t * (the task's time less its delay),
+// so that the learned order also saves the robot's travel (w_t = 0:
+// METHOD 6's reward).
 // Our extension, the anticipating choice: the next task maximises
 //   Q(s, a) - w_c * E[conflict of a over its own duration, and of the best
 //                    continuation of up to anticipation_depth - 1 tasks],
@@ -114,6 +117,9 @@ struct QLearningParams {
   double epsilon_decay = 1.0;
   double epsilon_min = 0.0;   ///< floor of the decayed epsilon
   double delay_weight = 1.0;  ///< w_d, per second of delay
+  /// w_t, per second of a task's time less its delay (our extension: the
+  /// order's travel counts, not only its waits); 0: METHOD 6's reward.
+  double duration_weight = 0.0;
   /// w_c, per second of expected conflict of a task over its duration (our
   /// extension, the anticipating choice); 0: METHOD 6's choice (Q alone).
   double anticipation_weight = 0.0;
@@ -136,6 +142,7 @@ struct QLearningParams {
     a->Visit(IPLAN_NVP(epsilon_decay, "factor on epsilon per finished learning episode, in (0, 1]"));
     a->Visit(IPLAN_NVP(epsilon_min, "floor of the decayed epsilon, in [0, 1]"));
     a->Visit(IPLAN_NVP(delay_weight, "w_d, per second of delay, >= 0"));
+    a->Visit(IPLAN_NVP(duration_weight, "w_t, per second of a task's time less its delay, >= 0; 0: METHOD 6's reward"));
     a->Visit(IPLAN_NVP(anticipation_weight,
                        "w_c, per second a task is expected to conflict with the person over its duration, >= 0; 0: off"));
     a->Visit(IPLAN_NVP(anticipation_depth,
@@ -197,13 +204,15 @@ class TaskPlanner {
   /// The largest delay (s) one task is charged: a finite but absurd delay
   /// from the network (1.7e308) would otherwise overflow the Q-values.
   static constexpr double kMaxDelay = 3600.0;
-  /// Q-learning update after `task` ended with `delay` (s), clamped to
+  /// Q-learning update after `task` ended with `delay` (s) and took
+  /// `motion` s besides (its time less the delay), each clamped to
   /// [0, kMaxDelay]; advances the state when `succeeded` (counting the
   /// episode when that finishes it, in learning mode). Returns the reward.
-  /// A non-finite delay (NaN, inf) is refused: no update, NaN returned,
-  /// counted in refused_outcomes(); the state still advances. So is an
-  /// update that would make the Q-value non-finite (absurd delay_weight).
-  double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief);
+  /// A non-finite delay or motion (NaN, inf) is refused: no update, NaN
+  /// returned, counted in refused_outcomes(); the state still advances. So
+  /// is an update that would make the Q-value non-finite (absurd weights).
+  double Complete(int task, bool succeeded, double delay, const std::map<std::string, double>& belief,
+                  double motion = 0.0);
   /// Outcomes Complete() did not learn from (see there), since construction.
   uint64_t refused_outcomes() const { return refused_outcomes_; }
   /// Starts a new episode (state 0).
