@@ -42,6 +42,7 @@ struct CellOptions {
   double anticipation_weight = -1;  // < 0: supervisor.yaml's
   int anticipation_depth = 0;       // 0: supervisor.yaml's
   double duration_weight = -1;      // < 0: supervisor.yaml's
+  double travel_weight = -1;        // < 0: supervisor.yaml's
   bool retrain = false, quiet = false;
 };
 
@@ -178,6 +179,7 @@ bool Prepare(const CellOptions& o, eval_common::CellInputs* in, cell_sim::CellBe
     if (o.anticipation_weight >= 0) setup->learning.anticipation_weight = o.anticipation_weight;
     if (o.anticipation_depth > 0) setup->learning.anticipation_depth = o.anticipation_depth;
     if (o.duration_weight >= 0) setup->learning.duration_weight = o.duration_weight;
+    if (o.travel_weight >= 0) setup->learning.travel_weight = o.travel_weight;
     try {
       cell_sim::CalibrateBaselines(RecordCellDemonstrations(in->cell.person), &setup->base);
     } catch (const std::exception& e) {
@@ -224,7 +226,8 @@ int RunCell(const CellOptions& o) {
   for (Predictor p : predictors) std::cout << " " << cell_sim::ToString(p);
   std::cout << "\n  configuration " << in.dir << "\n  " << in.model.summary << "\n  task planner: anticipation_weight "
             << setup.learning.anticipation_weight << ", anticipation_depth " << setup.learning.anticipation_depth
-            << ", duration_weight " << setup.learning.duration_weight
+            << ", duration_weight " << setup.learning.duration_weight << ", travel_weight "
+            << setup.learning.travel_weight
             << ", one per predictor, learning over the episodes\n\n";
 
   std::vector<std::vector<cell_sim::CellEpisodeResult>> results;
@@ -263,6 +266,7 @@ int RunCell(const CellOptions& o) {
   doc["anticipation_weight"] = setup.learning.anticipation_weight;
   doc["anticipation_depth"] = setup.learning.anticipation_depth;
   doc["duration_weight"] = setup.learning.duration_weight;
+  doc["travel_weight"] = setup.learning.travel_weight;
   doc["predictors"] = std::move(per);
   doc["model_recovers_oracle_gain"] = GainJson(summary);
   doc["people"] = std::move(people);
@@ -317,6 +321,10 @@ void AddEvalCellCommand(CLI::App* eval) {
   c->add_option("--duration-weight", o->duration_weight,
                 "the task planners' duration_weight (reward per second of a task's time less its delay) instead of "
                 "supervisor.yaml's (0: METHOD 6's reward)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--travel-weight", o->travel_weight,
+                "the task planners' travel_weight (choice penalty per second of estimated travel to a task's goal) "
+                "instead of supervisor.yaml's (0: off)")
       ->check(CLI::NonNegativeNumber);
   c->add_option("--threads", o->threads, "planner threads (0: as planner_replanning.yaml; results do not depend on it)")
       ->capture_default_str()

@@ -114,6 +114,8 @@ std::string QLearningParams::Validate() const {
   if (!(epsilon_min >= 0 && epsilon_min <= 1)) return "epsilon_min must be in [0, 1]";
   if (!(delay_weight >= 0)) return "delay_weight must be >= 0";
   if (!(duration_weight >= 0) || !std::isfinite(duration_weight)) return "duration_weight must be >= 0";
+  if (!(travel_weight >= 0) || !std::isfinite(travel_weight)) return "travel_weight must be >= 0";
+  if (!(travel_speed > 0) || !std::isfinite(travel_speed)) return "travel_speed must be > 0";
   if (!(anticipation_weight >= 0) || !std::isfinite(anticipation_weight)) return "anticipation_weight must be >= 0";
   if (!(task_duration_prior > 0) || !std::isfinite(task_duration_prior)) return "task_duration_prior must be > 0";
   if (anticipation_depth < 1 || anticipation_depth > 8) return "anticipation_depth must be in [1, 8]";
@@ -132,6 +134,9 @@ TaskPlanner::TaskPlanner(TaskGraph graph, QLearningParams params)
       }
     }
     prerequisites_.push_back(mask);
+  }
+  for (std::size_t i = 0; i < graph_.tasks.size(); ++i) {
+    if (graph_.tasks[i].name == graph_.rest) rest_ = static_cast<int>(i);
   }
   durations_.assign(graph_.tasks.size(), {0, 0.0});
 }
@@ -162,6 +167,21 @@ std::vector<double>& TaskPlanner::Row(State s) {
   auto it = q_.find(s);
   if (it == q_.end()) it = q_.emplace(s, std::vector<double>(graph_.tasks.size(), 0.0)).first;
   return it->second;
+}
+
+double TaskPlanner::Travel(int task) const {
+  const std::vector<double>* from = nullptr;
+  if (last_ >= 0) {
+    const RobotTask& l = graph_.tasks[static_cast<std::size_t>(last_)];
+    from = l.retreat.empty() ? &l.goal : &l.retreat;
+  } else if (rest_ >= 0) {
+    from = &graph_.tasks[static_cast<std::size_t>(rest_)].goal;
+  }
+  const std::vector<double>& to = graph_.tasks[static_cast<std::size_t>(task)].goal;
+  if (!from || from->empty() || from->size() != to.size()) return 0.0;
+  double largest = 0.0;
+  for (std::size_t j = 0; j < to.size(); ++j) largest = std::max(largest, std::abs(to[j] - (*from)[j]));
+  return largest / params_.travel_speed;
 }
 
 double TaskPlanner::Q(State s, int task) const {
@@ -266,6 +286,9 @@ int TaskPlanner::Choose(const ActionOutlook& outlook) {
       cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * seconds;
     }
   }
+  if (params_.travel_weight > 0) {
+    for (int a : avail) cost[static_cast<std::size_t>(a)] += params_.travel_weight * Travel(a);
+  }
   auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };
   int best = avail.front();
   for (int a : avail) {
@@ -312,6 +335,7 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
     }
   }
   state_ = next;
+  if (succeeded) last_ = task;
   if (params_.learning && succeeded && episode_done()) ++episodes_learned_;
   return reward;
 }

@@ -13,7 +13,10 @@
 // the expected seconds during which the person, forecast from the belief
 // and the person's own task graph (core/human_graph.h), does an action the
 // tasks conflict with while they run; task durations are learned from
-// outcomes. w_c = 0 is METHOD 6's choice.
+// outcomes. w_c = 0 is METHOD 6's choice. And the travel: the choice also
+// subtracts w_v * the estimated seconds from where the robot stands to the
+// task's goal (the largest joint move at travel_speed), so that the order
+// does not send the arm back and forth (w_v = 0: off).
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
 // with a message and the previous good copy is used. The backup is only
 // ever replaced by a file that passes the loader's checks, so it stays good
@@ -120,6 +123,13 @@ struct QLearningParams {
   /// w_t, per second of a task's time less its delay (our extension: the
   /// order's travel counts, not only its waits); 0: METHOD 6's reward.
   double duration_weight = 0.0;
+  /// w_v, per second of estimated travel from where the robot stands (the
+  /// task finished last: its retreat, else its goal; at an episode's start
+  /// the rest task's goal) to a candidate's goal, subtracted in the choice
+  /// (our extension, the planned part of the time a task takes); 0: off.
+  double travel_weight = 0.0;
+  /// rad/s; the estimate is max_j |q_goal_j - q_j| / travel_speed.
+  double travel_speed = 1.0;
   /// w_c, per second of expected conflict of a task over its duration (our
   /// extension, the anticipating choice); 0: METHOD 6's choice (Q alone).
   double anticipation_weight = 0.0;
@@ -143,6 +153,9 @@ struct QLearningParams {
     a->Visit(IPLAN_NVP(epsilon_min, "floor of the decayed epsilon, in [0, 1]"));
     a->Visit(IPLAN_NVP(delay_weight, "w_d, per second of delay, >= 0"));
     a->Visit(IPLAN_NVP(duration_weight, "w_t, per second of a task's time less its delay, >= 0; 0: METHOD 6's reward"));
+    a->Visit(IPLAN_NVP(travel_weight,
+                       "w_v, per second of estimated travel to a task's goal, subtracted in the choice, >= 0; 0: off"));
+    a->Visit(IPLAN_NVP(travel_speed, "rad/s the travel estimate assumes for the largest joint move, > 0"));
     a->Visit(IPLAN_NVP(anticipation_weight,
                        "w_c, per second a task is expected to conflict with the person over its duration, >= 0; 0: off"));
     a->Visit(IPLAN_NVP(anticipation_depth,
@@ -216,7 +229,16 @@ class TaskPlanner {
   /// Outcomes Complete() did not learn from (see there), since construction.
   uint64_t refused_outcomes() const { return refused_outcomes_; }
   /// Starts a new episode (state 0).
-  void ResetEpisode() { state_ = 0; }
+  void ResetEpisode() {
+    state_ = 0;
+    last_ = -1;
+  }
+  /// The task finished last in this episode, -1 before the first.
+  int last_task() const { return last_; }
+  /// Estimated seconds from where the robot stands (see travel_weight) to
+  /// `task`'s goal: the largest joint move over travel_speed; 0 when either
+  /// place is not known as joint positions of one size.
+  double Travel(int task) const;
 
   double Q(State s, int task) const;
 
@@ -268,6 +290,8 @@ class TaskPlanner {
   QLearningParams params_;
   std::map<State, std::vector<double>> q_;
   State state_ = 0;
+  int last_ = -1;  // the task finished last this episode, -1: none yet
+  int rest_ = -1;  // the rest task, -1: none
   uint64_t episodes_learned_ = 0;
   uint64_t refused_outcomes_ = 0;
   uint64_t save_failures_ = 0;

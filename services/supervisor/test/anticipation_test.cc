@@ -6,7 +6,7 @@
 // *next*, where METHOD 6's choice (and one looking at the current action
 // only) picks the conflicting one; task durations are learned and saved;
 // the duration weight (our extension of the reward) learns the order that
-// travels less.
+// travels less; the travel weight chooses the nearer task.
 #include <unistd.h>
 
 #include <cmath>
@@ -305,6 +305,53 @@ TEST(TaskPlanner, TheDurationWeightLearnsTheOrderThatTravelsLess) {
   EXPECT_EQ(params.Validate(), "duration_weight must be >= 0");
   params.duration_weight = std::numeric_limits<double>::infinity();
   EXPECT_EQ(params.Validate(), "duration_weight must be >= 0");
+}
+
+TEST(TaskPlanner, TheTravelWeightChoosesTheNearerTaskFromWhereTheRobotStands) {
+  // One joint: rest at 0, pick_left's goal at 2, pick_right's at 0.5 and
+  // its retreat at 1.8, place (after both) at 1. No Q-values, no belief:
+  // the choice is the travel's alone.
+  TaskGraph g = testing::SmallGraph();
+  g.human_graph = {};
+  g.tasks[0].goal = {2.0};
+  g.tasks[1].goal = {0.5};
+  g.tasks[1].retreat = {1.8};
+  g.tasks[2].goal = {1.0};
+  g.tasks.push_back({"rest", {0.0}, {"place"}, {}});
+  g.rest = "rest";
+  QLearningParams params;
+  params.learning = false;
+  params.travel_weight = 1.0;
+  params.travel_speed = 0.5;  // rad/s
+  TaskPlanner p(g, params);
+  EXPECT_DOUBLE_EQ(p.Travel(0), 4.0);  // from the rest pose: 2 rad at 0.5 rad/s
+  EXPECT_DOUBLE_EQ(p.Travel(1), 1.0);
+  EXPECT_EQ(p.Choose({}), 1);  // pick_right is nearer
+  p.Complete(1, true, 0.0, {});
+  EXPECT_EQ(p.last_task(), 1);
+  EXPECT_DOUBLE_EQ(p.Travel(0), 0.4);  // from pick_right's retreat, 1.8
+  p.Complete(0, false, 0.0, {});       // failed: the robot is not at pick_left
+  EXPECT_EQ(p.last_task(), 1);
+  p.Complete(0, true, 0.0, {});
+  EXPECT_DOUBLE_EQ(p.Travel(2), 2.0);  // from pick_left's goal (no retreat), 2
+  p.ResetEpisode();
+  EXPECT_EQ(p.last_task(), -1);
+  EXPECT_DOUBLE_EQ(p.Travel(0), 4.0);
+
+  // Without the weight the choice is METHOD 6's: Q ties, the first task.
+  params.travel_weight = 0.0;
+  TaskPlanner q(g, params);
+  EXPECT_EQ(q.Choose({}), 0);
+  // A goal of another size (a pose not solved for this arm) travels 0.
+  g.tasks[0].goal = {2.0, 0.0};
+  TaskPlanner r(g, QLearningParams{});
+  EXPECT_DOUBLE_EQ(r.Travel(0), 0.0);
+
+  params.travel_weight = -1.0;
+  EXPECT_EQ(params.Validate(), "travel_weight must be >= 0");
+  params.travel_weight = 1.0;
+  params.travel_speed = 0.0;
+  EXPECT_EQ(params.Validate(), "travel_speed must be > 0");
 }
 
 }  // namespace
