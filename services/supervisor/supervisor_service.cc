@@ -234,7 +234,6 @@ class SupervisorService : public framework::Service {
     if (current_task_ < 0 || o.task_id != task_id_) return;  // not ours / stale
     const bool ok = services::TaskStatusFromWire(o.status) == cell::TaskStatus::kSucceeded;
     // Its time without the delay: how long it takes when nothing is in the way.
-    if (ok) planner_->ObserveDuration(current_task_, o.duration - o.delay);
     const double reward = planner_->Complete(current_task_, ok, o.delay, belief_, o.duration - o.delay);
     ++completed_;
     node.log().info("task {} '{}' {} in {:.2f} s, delay {:.2f} s, reward {:.3f}", o.task_id, o.task_name,

@@ -335,7 +335,10 @@ double TaskPlanner::Complete(int task, bool succeeded, double delay, const std::
     }
   }
   state_ = next;
-  if (succeeded) last_ = task;
+  if (succeeded) {
+    last_ = task;
+    ObserveDuration(task, motion);
+  }
   if (params_.learning && succeeded && episode_done()) ++episodes_learned_;
   return reward;
 }

@@ -220,7 +220,8 @@ class TaskPlanner {
   /// Q-learning update after `task` ended with `delay` (s) and took
   /// `motion` s besides (its time less the delay), each clamped to
   /// [0, kMaxDelay]; advances the state when `succeeded` (counting the
-  /// episode when that finishes it, in learning mode). Returns the reward.
+  /// episode when that finishes it, in learning mode) and learns `motion` as
+  /// the task's duration (ObserveDuration). Returns the reward.
   /// A non-finite delay or motion (NaN, inf) is refused: no update, NaN
   /// returned, counted in refused_outcomes(); the state still advances. So
   /// is an update that would make the Q-value non-finite (absurd weights).

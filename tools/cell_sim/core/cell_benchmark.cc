@@ -125,7 +125,6 @@ CellEpisodeResult RunOne(const CellBenchmarkSetup& setup, const EpisodeSpec& spe
   };
   feed.done = [&](double t, int frame, const trajopt::TaskOutcome& o) {
     const bool ok = o.status == trajopt::TaskStatus::kSucceeded;
-    if (ok) planner->ObserveDuration(current, o.duration - o.delay);
     planner->Complete(current, ok, o.delay, outlook.At(t, frame).belief, o.duration - o.delay);
     return !planner->episode_done();
   };
