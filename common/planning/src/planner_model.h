@@ -253,6 +253,10 @@ struct PlannerModel {
   // result; returns false to stop.
   using SsmPairVisitor = std::function<bool(const SsmVisit& at, const Eigen::Vector3d& delta, const safety::SsmPair& pair)>;
   // Waypoints [from, to] with the FK in data[from .. min(to + 1, n)].
+  // The factor on the plan's robot speed in the ssm pair rule: the
+  // monitor's min_speed_scale with ssm_predicts_slowing (and its speed
+  // reduction on), else 1.
+  double SsmRuleSpeedScale() const;
   void VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
                      const SsmPairVisitor& visit) const;
   void AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, Eigen::MatrixXd* G) const;

@@ -10,7 +10,9 @@
 //    action's mean mu at the waypoint's prediction step, moving at
 //    (mu(step + 1) - mu(step)) / prediction dt (the last step's speed at
 //    the end);
-//  - margin m = d - S_p(v_h, v_r) of the pair rule. The pair violates when
+//  - margin m = d - S_p(v_h, v_r) of the pair rule; with
+//    ssm_predicts_slowing, v_r at the monitor's min_speed_scale (the
+//    monitor slows a robot down to that before it stops it). The pair violates when
 //    m < ssm_margin and the robot sphere is not retreating (moving away at
 //    kRetreatFactor x retreat_speed or faster: the monitor's retreat rule
 //    with room for the interpolation between waypoints).
@@ -62,9 +64,14 @@ int PlannerModel::SsmLastWaypoint(const Problem& at) const {
   return std::min(at.n, static_cast<int>(std::floor(params.ssm_horizon / at.dt + 1e-9)));
 }
 
+double PlannerModel::SsmRuleSpeedScale() const {
+  return params.ssm_predicts_slowing && params.ssm.speed_reduction ? params.ssm.min_speed_scale : 1.0;
+}
+
 void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision::RobotData>& data, int from, int to,
                                  const SsmPairVisitor& visit) const {
   const safety::SsmParams& s = params.ssm;
+  const double rule_scale = SsmRuleSpeedScale();
   const double reach = at.ssm_activation;
   const int S = static_cast<int>(radii.size());
   Eigen::Matrix3Xd v_robot(3, S);
@@ -109,7 +116,8 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
                                 : Eigen::Vector3d::Zero();
             for (int sp : link_groups[g]) {
               const Eigen::Vector3d delta = d.p_WS.col(sp) - mu;
-              const safety::SsmPair pair = safety::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_h, v_robot.col(sp));
+              const safety::SsmPair pair =
+                  safety::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_h, rule_scale * v_robot.col(sp));
               if (pair.margin >= reach) continue;
               const double away = delta.norm() > 1e-9 ? v_robot.col(sp).dot(delta.normalized()) : 0.0;
               const bool retreat = s.retreat_speed > 0 && away >= kRetreatFactor * s.retreat_speed;
@@ -127,6 +135,7 @@ void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, E
   if (last < at.k) return;
   const double w = params.weights.ssm, act = at.ssm_activation;
   const safety::SsmParams& s = params.ssm;
+  const double rule_scale = SsmRuleSpeedScale();  // v_r of a pair is the plan's speed x this
   // The pairs within the activation band (not retreating), and per waypoint
   // and person the actions they belong to: only where those actions are
   // likely enough to stop the plan (ssm_stop_probability) do they cost, so
@@ -155,7 +164,7 @@ void PlannerModel::AddSsmCost(const Problem& at, Workspace* ws, CostTerms* ev, E
     if (len < 1e-9) continue;
     const Eigen::Vector3d u = np.delta / len;  // human -> robot
     // dm/dp_i = u (+ slope / dt u while approaching), dm/dp_{i+1} = -slope / dt u.
-    const double k_v = np.pair.v_r > 0 ? ProtectiveSeparationSlope(s, np.pair.v_r) / at.dt : 0.0;
+    const double k_v = np.pair.v_r > 0 ? rule_scale * ProtectiveSeparationSlope(s, np.pair.v_r) / at.dt : 0.0;
     const double scale = -2.0 * w * v.probability * e;
     const collision::RobotData& d = ws->data[static_cast<std::size_t>(i)];
     chains->AddPointGradient(d, links[sp], d.p_WS.col(sp), scale * (1.0 + k_v) * u, G->col(i));

@@ -31,8 +31,12 @@ collision::HumanPrediction Hand(int steps, F at, double probability = 1.0) {
 // The smallest monitor margin d - S_p over the waypoints 1 .. last of Q
 // against the hand (action 0) whose step k is at waypoint k; pairs whose
 // robot sphere moves away at `retreat` m/s or faster are left out.
+// With `stop_scale`, the smallest of the pairs' stop scales instead (the
+// fraction of its speed at which the monitor lets the robot go on; below
+// min_speed_scale it stops it).
 double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& Q, double dt,
-                     const collision::HumanPrediction& hand, const safety::SsmParams& ssm, int last, double retreat) {
+                     const collision::HumanPrediction& hand, const safety::SsmParams& ssm, int last, double retreat,
+                     bool stop_scale = false) {
   double worst = std::numeric_limits<double>::infinity();
   collision::RobotData d0(robot), d1(robot);
   for (int i = 1; i <= std::min<int>(last, static_cast<int>(Q.cols()) - 1); ++i) {
@@ -46,7 +50,7 @@ double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& 
       const Eigen::Vector3d v_r = (d1.p_WS.col(s) - d0.p_WS.col(s)) / dt;
       if (v_r.dot(delta.normalized()) >= retreat) continue;
       const safety::SsmPair pair = safety::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h, v_r);
-      worst = std::min(worst, pair.margin);
+      worst = std::min(worst, stop_scale ? pair.stop_scale : pair.margin);
     }
   }
   return worst;
@@ -89,6 +93,57 @@ TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
   EXPECT_GE(MonitorMargin(robot_, seen.positions, 0.1, hand, on_.ssm, last, retreat), on_.ssm_margin - 1e-9);
   EXPECT_GE(seen.ssm_margin, on_.ssm_margin - 1e-9);
   EXPECT_EQ(seen.positions.col(seen.positions.cols() - 1), g.q);  // it still gets there
+}
+
+TEST_F(PredictedMonitorTest, WithTheMonitorsSlowingPredictedAPlanItWouldOnlySlowDownGoesAhead) {
+  // A hand held still 0.28 m beside the middle of the straight path (further
+  // than in RefusesAPlanTheMonitorWouldStop): the monitor would slow the
+  // free plan down there (d - S_p < 0 at its speed), not stop it. Judged by
+  // the monitor's stop (ssm_predicts_slowing: the rule at min_speed_scale of
+  // the plan's speed), the plan may pass closer than the rule at its own
+  // speed allows, so it keeps nearer to the free path (a lower cost), and
+  // the monitor still never has to stop it.
+  PlannerParams slowing = on_;
+  slowing.ssm_predicts_slowing = true;
+  ASSERT_TRUE(slowing.ssm.speed_reduction);
+  const Planner blind_planner(robot_, scene_, off_), strict(robot_, scene_, on_), predicting(robot_, scene_, slowing);
+  const IkResult s = strict.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+  const IkResult g = strict.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+  ASSERT_TRUE(s.success && g.success);
+  const collision::HumanPrediction hand = Hand(31, [](int) { return Eigen::Vector3d(0.76, -0.10, 0.30); });
+  PlanningRequest req;
+  req.start_q = s.q;
+  req.goal = Goal::Joint(g.q);
+  req.people = {{&hand, 0.1, 0.0}};
+  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+  const double retreat = 2.0 * on_.ssm.retreat_speed;
+  auto margin = [&](const PlanningResult& r) { return MonitorMargin(robot_, r.positions, 0.1, hand, on_.ssm, last, retreat); };
+  auto stop_scale = [&](const PlanningResult& r) {
+    return MonitorMargin(robot_, r.positions, 0.1, hand, on_.ssm, last, retreat, true);
+  };
+
+  const PlanningResult blind = blind_planner.Plan(req);
+  const PlanningResult kept = strict.Plan(req);
+  const PlanningResult slowed = predicting.Plan(req);
+  ASSERT_TRUE(blind.success() && kept.success() && slowed.success()) << blind.reason << kept.reason << slowed.reason;
+  EXPECT_LT(margin(blind), 0.0);  // the free plan: inside S_p at its speed, the monitor would stop it
+  EXPECT_LT(stop_scale(blind), on_.ssm.min_speed_scale);
+  // The rule at the plan's speed keeps the margin; judged by the stop, the
+  // plan goes closer (below ssm_margin at its own speed) and costs less ...
+  EXPECT_GE(margin(kept), on_.ssm_margin - 1e-9);
+  EXPECT_LT(margin(slowed), on_.ssm_margin);
+  EXPECT_LT(slowed.cost, kept.cost);
+  // ... and the monitor would at most slow it down, never stop it.
+  EXPECT_GE(stop_scale(slowed), on_.ssm.min_speed_scale);
+  EXPECT_GE(slowed.ssm_margin, on_.ssm_margin - 1e-9);  // the planner's own account, at min_speed_scale
+  EXPECT_EQ(slowed.positions.col(slowed.positions.cols() - 1), g.q);
+  // Without the monitor's speed reduction there is no slowing to predict:
+  // the rule at the plan's own speed, as without the option.
+  PlannerParams no_reduction = slowing;
+  no_reduction.ssm.speed_reduction = false;
+  const PlanningResult r = Planner(robot_, scene_, no_reduction).Plan(req);
+  ASSERT_TRUE(r.success()) << r.reason;
+  EXPECT_GE(margin(r), on_.ssm_margin - 1e-9);
 }
 
 TEST_F(PredictedMonitorTest, ARobotInThePersonsWayGetsOutOfIt) {

@@ -115,6 +115,14 @@ struct PlannerParams {
   /// so that plans keep clear of that, slow down near the person and, when
   /// the person comes towards the robot, get out of their way.
   bool predict_ssm = false;
+  /// With predict_ssm and the monitor's speed reduction
+  /// (ssm.speed_reduction): the rule is the monitor's stop, not its slowing.
+  /// Each pair is judged with the robot sphere at ssm.min_speed_scale of the
+  /// plan's speed, the slowest the monitor slows the robot to before it
+  /// stops it, so a plan the monitor would only slow down stays feasible
+  /// and costs nothing. false: the plan's own speed (the monitor's slowing
+  /// counts as a stop).
+  bool ssm_predicts_slowing = false;
   safety::SsmParams ssm;
   double ssm_margin = 0.03;          ///< m, >= 0
   double ssm_activation = 0.05;      ///< m, >= ssm_margin
@@ -171,6 +179,7 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(max_waits, "waits inserted before giving up, >= 0"));
   a->Visit(IPLAN_NVP(human_separation, "m; soft keep-out from the predicted person, >= 0 (0 = off)"));
   a->Visit(IPLAN_NVP(predict_ssm, "judge plans by the separation monitor's rule against the predicted person"));
+  a->Visit(IPLAN_NVP(ssm_predicts_slowing, "with the monitor's speed_reduction: judge pairs at min_speed_scale x the plan's speed (the monitor's stop, not its slowing)"));
   a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "the monitor's ISO/TS 15066 parameters (trajopt: from the cell's safety file)"));
   a->Visit(IPLAN_NVP(ssm_margin, "m; a safe plan keeps d - S_p >= this at every free waypoint within ssm_horizon, >= 0"));
   a->Visit(IPLAN_NVP(ssm_activation, "m; the ssm cost starts below this margin, >= ssm_margin"));
