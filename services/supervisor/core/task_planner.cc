@@ -169,20 +169,24 @@ std::vector<double>& TaskPlanner::Row(State s) {
   return it->second;
 }
 
-double TaskPlanner::Travel(int task) const {
-  const std::vector<double>* from = nullptr;
-  if (last_ >= 0) {
-    const RobotTask& l = graph_.tasks[static_cast<std::size_t>(last_)];
-    from = l.retreat.empty() ? &l.goal : &l.retreat;
-  } else if (rest_ >= 0) {
-    from = &graph_.tasks[static_cast<std::size_t>(rest_)].goal;
+const std::vector<double>* TaskPlanner::PlaceAfter(int task) const {
+  if (task >= 0) {
+    const RobotTask& t = graph_.tasks[static_cast<std::size_t>(task)];
+    return t.retreat.empty() ? &t.goal : &t.retreat;
   }
+  return rest_ >= 0 ? &graph_.tasks[static_cast<std::size_t>(rest_)].goal : nullptr;
+}
+
+double TaskPlanner::TravelBetween(int from_task, int task) const {
+  const std::vector<double>* from = PlaceAfter(from_task);
   const std::vector<double>& to = graph_.tasks[static_cast<std::size_t>(task)].goal;
   if (!from || from->empty() || from->size() != to.size()) return 0.0;
   double largest = 0.0;
   for (std::size_t j = 0; j < to.size(); ++j) largest = std::max(largest, std::abs(to[j] - (*from)[j]));
   return largest / params_.travel_speed;
 }
+
+double TaskPlanner::Travel(int task) const { return TravelBetween(last_, task); }
 
 double TaskPlanner::Q(State s, int task) const {
   const auto it = q_.find(s);
@@ -232,13 +236,16 @@ double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast, d
   return seconds;
 }
 
-double TaskPlanner::BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const {
+double TaskPlanner::BestContinuation(State state, const ActionForecast* forecast, double from, int place, int depth,
+                                     double conflict_weight, double travel_weight) const {
   if (depth <= 0) return 0.0;
   double best = 0;
   bool any = false;
   for (int b : AvailableIn(state)) {
-    const double c = ExpectedConflict(b, forecast, from) +
-                     BestContinuation(state | (1ULL << b), forecast, from + TaskDuration(b), depth - 1);
+    double c = BestContinuation(state | (1ULL << b), forecast, from + TaskDuration(b), b, depth - 1, conflict_weight,
+                                travel_weight);
+    if (forecast && conflict_weight > 0) c += conflict_weight * ExpectedConflict(b, *forecast, from);
+    if (travel_weight > 0) c += travel_weight * TravelBetween(place, b);
     best = any ? std::min(best, c) : c;
     any = true;
   }
@@ -266,8 +273,8 @@ double TaskPlanner::ExpectedConflict(int task, const ActionOutlook& outlook) con
 double TaskPlanner::AnticipatedConflict(int task, const ActionOutlook& outlook) const {
   if (outlook.belief.empty()) return 0.0;
   const ActionForecast forecast = SequenceForecast(state_, outlook);
-  return ExpectedConflict(task, forecast, 0.0) + BestContinuation(state_ | (1ULL << task), forecast, TaskDuration(task),
-                                                                   params_.anticipation_depth - 1);
+  return ExpectedConflict(task, forecast, 0.0) + BestContinuation(state_ | (1ULL << task), &forecast, TaskDuration(task),
+                                                                   task, params_.anticipation_depth - 1, 1.0, 0.0);
 }
 
 int TaskPlanner::Choose(const ActionOutlook& outlook) {
@@ -276,18 +283,22 @@ int TaskPlanner::Choose(const ActionOutlook& outlook) {
   if (params_.learning && std::uniform_real_distribution<double>(0, 1)(rng_) < Epsilon()) {
     return avail[std::uniform_int_distribution<std::size_t>(0, avail.size() - 1)(rng_)];
   }
-  // The anticipation: one forecast, as long as the longest sequence.
+  // The anticipation (one forecast, as long as the longest sequence) and
+  // the travel, of the candidate and of the continuation after it that
+  // costs the least of both.
+  const double w_c = outlook.belief.empty() ? 0.0 : params_.anticipation_weight;
+  const double w_v = params_.travel_weight;
+  std::optional<ActionForecast> forecast;
+  if (w_c > 0) forecast = SequenceForecast(state_, outlook);
   std::vector<double> cost(graph_.tasks.size(), 0.0);
-  if (params_.anticipation_weight > 0 && !outlook.belief.empty()) {
-    const ActionForecast forecast = SequenceForecast(state_, outlook);
+  if (w_c > 0 || w_v > 0) {
     for (int a : avail) {
-      const double seconds = ExpectedConflict(a, forecast, 0.0) +
-                             BestContinuation(state_ | (1ULL << a), forecast, TaskDuration(a), params_.anticipation_depth - 1);
-      cost[static_cast<std::size_t>(a)] = params_.anticipation_weight * seconds;
+      double c = BestContinuation(state_ | (1ULL << a), forecast ? &*forecast : nullptr, TaskDuration(a), a,
+                                  params_.anticipation_depth - 1, w_c, w_v);
+      if (forecast) c += w_c * ExpectedConflict(a, *forecast, 0.0);
+      c += w_v * Travel(a);
+      cost[static_cast<std::size_t>(a)] = c;
     }
-  }
-  if (params_.travel_weight > 0) {
-    for (int a : avail) cost[static_cast<std::size_t>(a)] += params_.travel_weight * Travel(a);
   }
   auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };
   int best = avail.front();

@@ -7,16 +7,16 @@
 // Our extension of the reward: - w_t * (the task's time less its delay),
 // so that the learned order also saves the robot's travel (w_t = 0:
 // METHOD 6's reward).
-// Our extension, the anticipating choice: the next task maximises
-//   Q(s, a) - w_c * E[conflict of a over its own duration, and of the best
-//                    continuation of up to anticipation_depth - 1 tasks],
-// the expected seconds during which the person, forecast from the belief
-// and the person's own task graph (core/human_graph.h), does an action the
-// tasks conflict with while they run; task durations are learned from
-// outcomes. w_c = 0 is METHOD 6's choice. And the travel: the choice also
-// subtracts w_v * the estimated seconds from where the robot stands to the
-// task's goal (the largest joint move at travel_speed), so that the order
-// does not send the arm back and forth (w_v = 0: off).
+// Our extension, the anticipating choice: the next task a maximises
+//   Q(s, a) - min over continuations [w_c * E[conflict] + w_v * travel]
+// of the sequence of a and up to anticipation_depth - 1 tasks after it:
+// E[conflict] the expected seconds during which the person, forecast from
+// the belief and the person's own task graph (core/human_graph.h), does an
+// action a task conflicts with while it runs (durations learned from
+// outcomes); travel the estimated seconds from where the robot stands (or
+// the sequence's task before) to each task's goal (the largest joint move
+// at travel_speed), so that the order does not send the arm back and
+// forth. w_c = w_v = 0 is METHOD 6's choice.
 // The Q-table is saved atomically and reloaded; a corrupt file is refused
 // with a message and the previous good copy is used. The backup is only
 // ever replaced by a file that passes the loader's checks, so it stays good
@@ -133,9 +133,10 @@ struct QLearningParams {
   /// w_c, per second of expected conflict of a task over its duration (our
   /// extension, the anticipating choice); 0: METHOD 6's choice (Q alone).
   double anticipation_weight = 0.0;
-  /// Tasks in the sequence the anticipation looks at: the candidate and the
-  /// best continuation of up to depth - 1 tasks after it (1: the candidate
-  /// alone).
+  /// Tasks in the sequence the choice looks at: the candidate and the
+  /// continuation of up to depth - 1 tasks after it with the least cost,
+  /// w_c * expected conflict + w_v * travel, each task's travel from the one
+  /// before (1: the candidate alone).
   int anticipation_depth = 1;
   /// s a task is expected to take before it has been done once (then: the
   /// mean of its outcomes' durations less their delays).
@@ -159,7 +160,7 @@ struct QLearningParams {
     a->Visit(IPLAN_NVP(anticipation_weight,
                        "w_c, per second a task is expected to conflict with the person over its duration, >= 0; 0: off"));
     a->Visit(IPLAN_NVP(anticipation_depth,
-                       "tasks looked at by the anticipation: the candidate and the best continuation, in [1, 8]"));
+                       "tasks the choice looks at (conflict and travel): the candidate and the best continuation, in [1, 8]"));
     a->Visit(IPLAN_NVP(task_duration_prior, "s a task is expected to take before it was done once, > 0"));
     a->Visit(IPLAN_NVP(seed, "seed of the exploration generator"));
   }
@@ -188,10 +189,11 @@ class TaskPlanner {
   /// 0 in deployment.
   double Epsilon() const;
   /// Chooses the next task: epsilon-greedy in learning mode, greedy in
-  /// deployment, on Q(s, a) - anticipation_weight * AnticipatedConflict(a,
-  /// outlook) (Q alone when the weight is 0 or the belief empty); ties
-  /// broken by the harmony with the belief, then by index. -1 when the
-  /// episode is done. Allocates (the forecast).
+  /// deployment, on Q(s, a) - [w_c * expected conflict + w_v * travel] of a
+  /// and of the continuation of up to anticipation_depth - 1 tasks after it
+  /// that costs the least (the conflict term only with a belief; Q alone
+  /// when both weights are 0); ties broken by the harmony with the belief,
+  /// then by index. -1 when the episode is done. Allocates (the forecast).
   int Choose(const ActionOutlook& outlook);
   /// s of expected conflict of the sequence that starts with `task` (one
   /// available now) and continues with the continuation of up to
@@ -280,8 +282,18 @@ class TaskPlanner {
   std::optional<std::string> Parse(const std::string& data, const std::string& path, Table* table) const;
   // s of conflict of `task` over [from, from + TaskDuration(task)).
   double ExpectedConflict(int task, const ActionForecast& forecast, double from) const;
-  // The least conflict of up to `depth` tasks available in `state`, from `from` (s).
-  double BestContinuation(State state, const ActionForecast& forecast, double from, int depth) const;
+  // The least cost of up to `depth` tasks available in `state`, the first
+  // starting at `from` (s) with the robot where `place` left it (-1: the
+  // rest pose): conflict_weight * their expected conflict (none without a
+  // forecast) + travel_weight * their travel, each from the one before.
+  double BestContinuation(State state, const ActionForecast* forecast, double from, int place, int depth,
+                          double conflict_weight, double travel_weight) const;
+  // Where the robot stands after `task`: its retreat, else its goal; for -1
+  // the rest task's goal (nullptr without one).
+  const std::vector<double>* PlaceAfter(int task) const;
+  // s of travel from where `from_task` left the robot (-1: rest) to `task`'s
+  // goal, as Travel.
+  double TravelBetween(int from_task, int task) const;
   // The forecast long enough for the sequences from `state` (anticipation_depth tasks).
   ActionForecast SequenceForecast(State state, const ActionOutlook& outlook) const;
   std::vector<int> AvailableIn(State state) const;

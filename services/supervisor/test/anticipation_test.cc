@@ -354,5 +354,45 @@ TEST(TaskPlanner, TheTravelWeightChoosesTheNearerTaskFromWhereTheRobotStands) {
   EXPECT_EQ(params.Validate(), "travel_speed must be > 0");
 }
 
+TEST(TaskPlanner, TheChoiceLooksAtTheTravelOfTheWholeOrder) {
+  // One joint: rest at 0, pick_left at 1, pick_right at -0.6, place (after
+  // both) at -1. The nearest task first (pick_right, 0.6 rad) makes the
+  // order travel 0.6 + 1.6 + 2.0 = 4.2 rad; pick_left first, 1.0 + 1.6 +
+  // 0.4 = 3.0 rad. Looking one task ahead picks the nearer; looking at the
+  // whole order (anticipation_depth 3), the shorter order. No belief, no
+  // Q-values: the travel alone.
+  TaskGraph g = testing::SmallGraph();
+  g.human_graph = {};
+  g.tasks[0].goal = {1.0};
+  g.tasks[1].goal = {-0.6};
+  g.tasks[2].goal = {-1.0};
+  g.tasks.push_back({"rest", {0.0}, {"place"}, {}});
+  g.rest = "rest";
+  QLearningParams params;
+  params.learning = false;
+  params.travel_weight = 1.0;
+  params.anticipation_depth = 1;
+  EXPECT_EQ(TaskPlanner(g, params).Choose({}), 1);
+  for (int depth : {3, 4, 8}) {  // the rest task after place changes nothing; the depth is capped by the tasks left
+    params.anticipation_depth = depth;
+    TaskPlanner p(g, params);
+    EXPECT_EQ(p.Choose({}), 0) << "depth " << depth;
+    p.Complete(0, true, 0.0, {});
+    EXPECT_EQ(p.Choose({}), 1);
+    p.Complete(1, true, 0.0, {});
+    EXPECT_EQ(p.Choose({}), 2);
+  }
+  // A retreat is where the next leg starts: pick_right withdrawing to 1
+  // makes pick_right first 0.6 + 0 + 2.0 = 2.6 rad, pick_left first 1.0 +
+  // 1.6 + 2.0 = 4.6 rad.
+  params.anticipation_depth = 3;
+  g.tasks[1].retreat = {1.0};
+  EXPECT_EQ(TaskPlanner(g, params).Choose({}), 1);
+  // Without the travel weight nothing is looked at: METHOD 6's choice (Q
+  // ties, the first task).
+  params.travel_weight = 0.0;
+  EXPECT_EQ(TaskPlanner(g, params).Choose({}), 0);
+}
+
 }  // namespace
 }  // namespace iplan::supervisor
