@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include <gtest/gtest.h>
 
@@ -61,9 +62,27 @@ class PredictedMonitorTest : public ::testing::Test {
   PredictedMonitorTest() : robot_(testing::LoadPanda()), scene_(testing::LoadCell()) {
     on_.predict_ssm = true;
   }
+  // From the tool at (0.45, -0.35, 0.30) to (0.45, 0.15, 0.30) (m, W), past
+  // a hand held still at (hand_x, -0.10, 0.30) (hand_, which the request
+  // points into); the goal's joint positions in *goal.
+  PlanningRequest PassTheHand(double hand_x, Eigen::VectorXd* goal) {
+    const Planner plain(robot_, scene_, off_);
+    const IkResult s = plain.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
+    const IkResult g = plain.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
+    EXPECT_TRUE(s.success && g.success);
+    hand_.emplace(Hand(31, [hand_x](int) { return Eigen::Vector3d(hand_x, -0.10, 0.30); }));
+    PlanningRequest req;
+    req.start_q = s.q;
+    req.goal = Goal::Joint(g.q);
+    req.people = {{&*hand_, 0.1, 0.0}};
+    *goal = g.q;
+    return req;
+  }
   collision::RobotModel robot_;
   collision::SceneParams scene_;
   PlannerParams off_, on_;
+  std::optional<collision::HumanPrediction> hand_;
+  const int last_ = static_cast<int>(std::lround(PlannerParams{}.ssm_horizon / PlannerParams{}.dt));
 };
 
 TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
@@ -71,15 +90,10 @@ TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
   // collision bound is negligible there, but a robot passing at speed is
   // inside the protective separation (S_p = 0.17 m + 0.25 s x v_r).
   const Planner plain(robot_, scene_, off_);
-  const IkResult s = plain.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = plain.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
-  const collision::HumanPrediction hand = Hand(31, [](int) { return Eigen::Vector3d(0.70, -0.10, 0.30); });
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
-  req.people = {{&hand, 0.1, 0.0}};
-  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+  Eigen::VectorXd goal;
+  const PlanningRequest req = PassTheHand(0.70, &goal);
+  const collision::HumanPrediction& hand = *hand_;
+  const int last = last_;
   const double retreat = 2.0 * on_.ssm.retreat_speed;
 
   const PlanningResult blind = plain.Plan(req);
@@ -92,7 +106,7 @@ TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
   ASSERT_TRUE(seen.success()) << seen.reason;
   EXPECT_GE(MonitorMargin(robot_, seen.positions, 0.1, hand, on_.ssm, last, retreat), on_.ssm_margin - 1e-9);
   EXPECT_GE(seen.ssm_margin, on_.ssm_margin - 1e-9);
-  EXPECT_EQ(seen.positions.col(seen.positions.cols() - 1), g.q);  // it still gets there
+  EXPECT_EQ(seen.positions.col(seen.positions.cols() - 1), goal);  // it still gets there
 }
 
 TEST_F(PredictedMonitorTest, WithTheMonitorsSlowingPredictedAPlanItWouldOnlySlowDownGoesAhead) {
@@ -107,15 +121,10 @@ TEST_F(PredictedMonitorTest, WithTheMonitorsSlowingPredictedAPlanItWouldOnlySlow
   slowing.ssm_predicts_slowing = true;
   ASSERT_TRUE(slowing.ssm.speed_reduction);
   const Planner blind_planner(robot_, scene_, off_), strict(robot_, scene_, on_), predicting(robot_, scene_, slowing);
-  const IkResult s = strict.SolveIk({0.45, -0.35, 0.30}, DownOrientation(0.0), Ready(), 1);
-  const IkResult g = strict.SolveIk({0.45, 0.15, 0.30}, DownOrientation(0.0), Ready(), 1);
-  ASSERT_TRUE(s.success && g.success);
-  const collision::HumanPrediction hand = Hand(31, [](int) { return Eigen::Vector3d(0.76, -0.10, 0.30); });
-  PlanningRequest req;
-  req.start_q = s.q;
-  req.goal = Goal::Joint(g.q);
-  req.people = {{&hand, 0.1, 0.0}};
-  const int last = static_cast<int>(std::lround(on_.ssm_horizon / on_.dt));
+  Eigen::VectorXd goal;
+  const PlanningRequest req = PassTheHand(0.76, &goal);
+  const collision::HumanPrediction& hand = *hand_;
+  const int last = last_;
   const double retreat = 2.0 * on_.ssm.retreat_speed;
   auto margin = [&](const PlanningResult& r) { return MonitorMargin(robot_, r.positions, 0.1, hand, on_.ssm, last, retreat); };
   auto stop_scale = [&](const PlanningResult& r) {
@@ -136,7 +145,7 @@ TEST_F(PredictedMonitorTest, WithTheMonitorsSlowingPredictedAPlanItWouldOnlySlow
   // ... and the monitor would at most slow it down, never stop it.
   EXPECT_GE(stop_scale(slowed), on_.ssm.min_speed_scale);
   EXPECT_GE(slowed.ssm_margin, on_.ssm_margin - 1e-9);  // the planner's own account, at min_speed_scale
-  EXPECT_EQ(slowed.positions.col(slowed.positions.cols() - 1), g.q);
+  EXPECT_EQ(slowed.positions.col(slowed.positions.cols() - 1), goal);
   // Without the monitor's speed reduction there is no slowing to predict:
   // the rule at the plan's own speed, as without the option.
   PlannerParams no_reduction = slowing;
