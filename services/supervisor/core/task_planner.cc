@@ -236,16 +236,22 @@ double TaskPlanner::ExpectedConflict(int task, const ActionForecast& forecast, d
   return seconds;
 }
 
+double TaskPlanner::OrderCost(State state, const ActionForecast* forecast, double from, int place, int task, int depth,
+                              double conflict_weight, double travel_weight) const {
+  double c = BestContinuation(state | (1ULL << task), forecast, from + TaskDuration(task), task, depth - 1,
+                              conflict_weight, travel_weight);
+  if (forecast && conflict_weight > 0) c += conflict_weight * ExpectedConflict(task, *forecast, from);
+  if (travel_weight > 0) c += travel_weight * TravelBetween(place, task);
+  return c;
+}
+
 double TaskPlanner::BestContinuation(State state, const ActionForecast* forecast, double from, int place, int depth,
                                      double conflict_weight, double travel_weight) const {
   if (depth <= 0) return 0.0;
   double best = 0;
   bool any = false;
   for (int b : AvailableIn(state)) {
-    double c = BestContinuation(state | (1ULL << b), forecast, from + TaskDuration(b), b, depth - 1, conflict_weight,
-                                travel_weight);
-    if (forecast && conflict_weight > 0) c += conflict_weight * ExpectedConflict(b, *forecast, from);
-    if (travel_weight > 0) c += travel_weight * TravelBetween(place, b);
+    const double c = OrderCost(state, forecast, from, place, b, depth, conflict_weight, travel_weight);
     best = any ? std::min(best, c) : c;
     any = true;
   }
@@ -273,8 +279,7 @@ double TaskPlanner::ExpectedConflict(int task, const ActionOutlook& outlook) con
 double TaskPlanner::AnticipatedConflict(int task, const ActionOutlook& outlook) const {
   if (outlook.belief.empty()) return 0.0;
   const ActionForecast forecast = SequenceForecast(state_, outlook);
-  return ExpectedConflict(task, forecast, 0.0) + BestContinuation(state_ | (1ULL << task), &forecast, TaskDuration(task),
-                                                                   task, params_.anticipation_depth - 1, 1.0, 0.0);
+  return OrderCost(state_, &forecast, 0.0, last_, task, params_.anticipation_depth, 1.0, 0.0);
 }
 
 int TaskPlanner::Choose(const ActionOutlook& outlook) {
@@ -293,11 +298,8 @@ int TaskPlanner::Choose(const ActionOutlook& outlook) {
   std::vector<double> cost(graph_.tasks.size(), 0.0);
   if (w_c > 0 || w_v > 0) {
     for (int a : avail) {
-      double c = BestContinuation(state_ | (1ULL << a), forecast ? &*forecast : nullptr, TaskDuration(a), a,
-                                  params_.anticipation_depth - 1, w_c, w_v);
-      if (forecast) c += w_c * ExpectedConflict(a, *forecast, 0.0);
-      c += w_v * Travel(a);
-      cost[static_cast<std::size_t>(a)] = c;
+      cost[static_cast<std::size_t>(a)] =
+          OrderCost(state_, forecast ? &*forecast : nullptr, 0.0, last_, a, params_.anticipation_depth, w_c, w_v);
     }
   }
   auto score = [&](int a) { return Q(state_, a) - cost[static_cast<std::size_t>(a)]; };

@@ -288,6 +288,11 @@ class TaskPlanner {
   // forecast) + travel_weight * their travel, each from the one before.
   double BestContinuation(State state, const ActionForecast* forecast, double from, int place, int depth,
                           double conflict_weight, double travel_weight) const;
+  // The cost of doing `task` (available in `state`) next, starting at
+  // `from` (s) with the robot where `place` left it, and then the cheapest
+  // continuation of up to depth - 1 tasks (BestContinuation's terms).
+  double OrderCost(State state, const ActionForecast* forecast, double from, int place, int task, int depth,
+                   double conflict_weight, double travel_weight) const;
   // Where the robot stands after `task`: its retreat, else its goal; for -1
   // the rest task's goal (nullptr without one).
   const std::vector<double>* PlaceAfter(int task) const;
