@@ -39,6 +39,7 @@ HumanPrediction::HumanPrediction(int num_actions, int num_steps,
         << radii_.size() << " spheres";
     throw std::invalid_argument(msg.str());
   }
+  speed_allowances_.assign(radii_.size(), 0.0);
   probabilities_.assign(num_actions, 1.0 / num_actions);
   FactorizedGaussian unit;
   FactorizeGaussian(Eigen::Vector3d::Zero(), Eigen::Matrix3d::Identity(), &unit);
@@ -56,6 +57,13 @@ bool HumanPrediction::SetSphere(int action, int step, int sphere,
   if (!FactorizeGaussian(mean, cov, &g)) return false;
   gaussians_[Index(action, step, sphere)] = g;
   summaries_up_to_date_ = false;
+  return true;
+}
+
+bool HumanPrediction::set_speed_allowance(int sphere, double v) {
+  IPLAN_COLLISION_DEMAND(sphere >= 0 && sphere < num_spheres());
+  if (!(v >= 0.0) || !std::isfinite(v)) return false;
+  speed_allowances_[static_cast<size_t>(sphere)] = v;
   return true;
 }
 

@@ -10,6 +10,9 @@
 //    action's mean mu at the waypoint's prediction step, moving at
 //    (mu(step + 1) - mu(step)) / prediction dt (the last step's speed at
 //    the end);
+//    plus its speed allowance straight at the robot sphere
+//    (HumanPrediction::speed_allowance: what the monitor adds for a depth
+//    point not tracked, or for a tracked part's velocity uncertainty);
 //  - margin m = d - S_p(v_h, v_r) of the pair rule; with
 //    ssm_predicts_slowing, v_r at the monitor's min_speed_scale (the
 //    monitor slows a robot down to that before it stops it). The pair violates when
@@ -97,14 +100,15 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
           // Any pair of this group and sphere l: S_p is at most that of the
           // fastest robot sphere and the fastest action's mean speed.
           const double far = (c - sm.centre).norm() - sm.spread - cover - hp.radius(l);
-          if (far >= reach + safety::ProtectiveSeparationDistance(s, 0.0, v_r_max)) {
+          const double allowance = hp.speed_allowance(l);
+          if (far >= reach + safety::ProtectiveSeparationDistance(s, allowance, v_r_max)) {
             double v_h_max = 0.0;
             if (t_next > t_prev) {
               for (int a = 0; a < hp.num_actions(); ++a)
                 v_h_max = std::max(v_h_max, (hp.sphere(a, t_next, l).mean - hp.sphere(a, t_prev, l).mean).norm());
               v_h_max /= person.time_step * (t_next - t_prev);
             }
-            if (far >= reach + safety::ProtectiveSeparationDistance(s, v_h_max, v_r_max)) continue;
+            if (far >= reach + safety::ProtectiveSeparationDistance(s, v_h_max + allowance, v_r_max)) continue;
           }
           for (int a = 0; a < hp.num_actions(); ++a) {
             const double pa = hp.action_probability(a);
@@ -116,8 +120,12 @@ void PlannerModel::VisitSsmPairs(const Problem& at, const std::vector<collision:
                                 : Eigen::Vector3d::Zero();
             for (int sp : link_groups[g]) {
               const Eigen::Vector3d delta = d.p_WS.col(sp) - mu;
+              // The monitor's allowance, straight at the robot sphere.
+              const double len = delta.norm();
+              const Eigen::Vector3d v_pair =
+                  allowance > 0 && len > 1e-9 ? Eigen::Vector3d(v_h + allowance / len * delta) : v_h;
               const safety::SsmPair pair =
-                  safety::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_h, rule_scale * v_robot.col(sp));
+                  safety::SsmPairRule(s, delta, radii[sp] + hp.radius(l), v_pair, rule_scale * v_robot.col(sp));
               if (pair.margin >= reach) continue;
               const double away = delta.norm() > 1e-9 ? v_robot.col(sp).dot(delta.normalized()) : 0.0;
               const bool retreat = s.retreat_speed > 0 && away >= kRetreatFactor * s.retreat_speed;

@@ -35,9 +35,12 @@ collision::HumanPrediction Hand(int steps, F at, double probability = 1.0) {
 // With `stop_scale`, the smallest of the pairs' stop scales instead (the
 // fraction of its speed at which the monitor lets the robot go on; below
 // min_speed_scale it stops it).
+// `allowance` (m/s) is added to the hand's speed straight at each robot
+// sphere, as collision risk adds a depth point's velocity uncertainty (or
+// the ISO speed for a point not tracked).
 double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& Q, double dt,
                      const collision::HumanPrediction& hand, const safety::SsmParams& ssm, int last, double retreat,
-                     bool stop_scale = false) {
+                     bool stop_scale = false, double allowance = 0.0) {
   double worst = std::numeric_limits<double>::infinity();
   collision::RobotData d0(robot), d1(robot);
   for (int i = 1; i <= std::min<int>(last, static_cast<int>(Q.cols()) - 1); ++i) {
@@ -50,7 +53,8 @@ double MonitorMargin(const collision::RobotModel& robot, const Eigen::MatrixXd& 
       const Eigen::Vector3d delta = d0.p_WS.col(s) - mu;
       const Eigen::Vector3d v_r = (d1.p_WS.col(s) - d0.p_WS.col(s)) / dt;
       if (v_r.dot(delta.normalized()) >= retreat) continue;
-      const safety::SsmPair pair = safety::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h, v_r);
+      const safety::SsmPair pair =
+          safety::SsmPairRule(ssm, delta, robot.spheres[s].radius + 0.05, v_h + allowance * delta.normalized(), v_r);
       worst = std::min(worst, stop_scale ? pair.stop_scale : pair.margin);
     }
   }
@@ -107,6 +111,35 @@ TEST_F(PredictedMonitorTest, RefusesAPlanTheMonitorWouldStop) {
   EXPECT_GE(MonitorMargin(robot_, seen.positions, 0.1, hand, on_.ssm, last, retreat), on_.ssm_margin - 1e-9);
   EXPECT_GE(seen.ssm_margin, on_.ssm_margin - 1e-9);
   EXPECT_EQ(seen.positions.col(seen.positions.cols() - 1), goal);  // it still gets there
+}
+
+// A depth point's speed allowance (HumanPrediction::speed_allowance): the
+// monitor adds it to the point's speed towards the robot, so the planner
+// plans for the larger protective separation it asks for (passing slower or
+// further away), while the sphere keeps its own radius for the bound.
+TEST_F(PredictedMonitorTest, APointsSpeedAllowanceIsPredictedAsTheMonitorAddsIt) {
+  Eigen::VectorXd goal;
+  const PlanningRequest req = PassTheHand(0.85, &goal);
+  const int last = last_;
+  const double retreat = 2.0 * on_.ssm.retreat_speed, allowance = 0.6;
+  const Planner predicting(robot_, scene_, on_);
+  const PlanningResult plain = predicting.Plan(req);
+  ASSERT_TRUE(plain.success()) << plain.reason;
+  EXPECT_GE(MonitorMargin(robot_, plain.positions, 0.1, *hand_, on_.ssm, last, retreat), on_.ssm_margin - 1e-9);
+  // The same plan, judged with the allowance: the monitor would stop it.
+  EXPECT_LT(MonitorMargin(robot_, plain.positions, 0.1, *hand_, on_.ssm, last, retreat, false, allowance), 0.0);
+
+  ASSERT_TRUE(hand_->set_speed_allowance(0, allowance));
+  EXPECT_FALSE(hand_->set_speed_allowance(0, -1.0));
+  EXPECT_FALSE(hand_->set_speed_allowance(0, std::numeric_limits<double>::quiet_NaN()));
+  EXPECT_DOUBLE_EQ(hand_->speed_allowance(0), allowance);
+  const PlanningResult wide = predicting.Plan(req);
+  ASSERT_TRUE(wide.success()) << wide.reason;
+  EXPECT_GE(MonitorMargin(robot_, wide.positions, 0.1, *hand_, on_.ssm, last, retreat, false, allowance),
+            on_.ssm_margin - 1e-9);
+  EXPECT_GE(wide.ssm_margin, on_.ssm_margin - 1e-9);
+  EXPECT_EQ(wide.positions.col(wide.positions.cols() - 1), goal);
+  EXPECT_GT((wide.positions - plain.positions).cwiseAbs().maxCoeff(), 0.05);  // another plan, not the same one
 }
 
 TEST_F(PredictedMonitorTest, WithTheMonitorsSlowingPredictedAPlanItWouldOnlySlowDownGoesAhead) {

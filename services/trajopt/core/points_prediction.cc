@@ -61,7 +61,7 @@ std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPred
     cells = Coarsen(seen, size);
   }
   const double point_radius = std::max(kMinPointRadius, 0.5 * seen.voxel_size);
-  std::vector<double> radii;
+  std::vector<double> radii, allowances;
   std::vector<Eigen::Vector3d> centres;
   std::vector<Eigen::Matrix3d> noise;
   std::vector<const cell::PointMotion*> motions;
@@ -78,7 +78,8 @@ std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPred
                                             .eigenvalues()
                                             .maxCoeff()))
           : ssm.default_human_speed;
-    radii.push_back(r + point_radius + (ssm.reaction_time + ssm.stopping_time) * uncertain_speed);
+    radii.push_back(r + point_radius);
+    allowances.push_back(uncertain_speed);
     centres.push_back(centre);
     noise.push_back(c.noise / n + kMinVariance * Eigen::Matrix3d::Identity());
     motions.push_back(m);
@@ -86,6 +87,7 @@ std::optional<collision::HumanPrediction> BuildPointsPrediction(const PointsPred
   const int steps = std::max(1, static_cast<int>(std::floor(params.horizon / params.time_step + 1e-9)));
   collision::HumanPrediction out(1, steps, radii);
   out.set_action_probability(0, 1.0);
+  for (std::size_t l = 0; l < allowances.size(); ++l) out.set_speed_allowance(static_cast<int>(l), allowances[l]);
   for (int k = 0; k < steps; ++k) {
     const double t = (k + 1) * params.time_step;
     for (std::size_t l = 0; l < centres.size(); ++l) {

@@ -13,14 +13,18 @@
 // c the centroid of the cell's points, S their mean noise covariance (at
 // least (1 mm)^2 per axis), v and C the part's velocity and its covariance
 // (0 for untracked points: they stay where they were seen); the radius
-// covers every point of the cell, max |p - c| + max(voxel_size / 2, 5 mm),
-// grown by what the separation monitor adds to the part's speed and the
-// planner's mean motion does not show: collision risk judges a tracked
-// point at v . u + speed_sigmas sqrt(u^T C u), an untracked one at the ISO
-// default speed, so the radius grows by (T_r + T_s) speed_sigmas sqrt(the
-// largest eigenvalue of C), or by (T_r + T_s) default_human_speed (the
-// planner predicts the monitor from the mean motion; with the grown radius
-// its margin is never above the monitor's: max(0, a + b) <= max(0, a) + b).
+// covers every point of the cell, max |p - c| + max(voxel_size / 2, 5 mm).
+// What the separation monitor adds to the part's speed and the planner's
+// mean motion does not show is the sphere's speed allowance
+// (HumanPrediction::speed_allowance): collision risk judges a tracked point
+// at v . u + speed_sigmas sqrt(u^T C u), an untracked one at the ISO default
+// speed, so the allowance is speed_sigmas sqrt(the largest eigenvalue of C),
+// or default_human_speed; the planner's predicted monitor adds it to the
+// mean motion towards the robot, so its margin is never above the monitor's.
+// (Until 2026-12-06 the radius was grown by (T_r + T_s) x the allowance
+// instead: the same separation prediction, but the bound and the keep-out
+// then saw a person 0.6 m larger than seen, and the camera-only demo's
+// planner held the arm at 0.9 m from a person standing still.)
 // One action ("as seen") of probability 1. So the planner's bound, its
 // keep-out and its prediction of the separation monitor (which takes the
 // human speed from consecutive steps' means) see the measured, directed

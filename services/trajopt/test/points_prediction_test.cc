@@ -41,12 +41,15 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
   ASSERT_EQ(seen.Check(), std::nullopt);
   PointsPredictionParams params;  // 0.2 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
   const safety::SsmParams ssm;  // T_r + T_s = 0.4 s, 1.6 m/s default
-  // The shipped default (as collision risk's): the tracked hand too stays where seen, grown by 1.6 m/s x 0.4 s.
+  // The shipped default (as collision risk's): the tracked hand too stays
+  // where seen, with the ISO 1.6 m/s as its speed allowance; its radius is
+  // what was seen (the ball, 6 cm, and the point's 1.5 cm), not grown.
   EXPECT_FALSE(params.tracked_speeds);
   const std::optional<collision::HumanPrediction> untracked = BuildPointsPrediction(params, seen, ssm);
   ASSERT_TRUE(untracked.has_value());
   for (int l = 0; l < untracked->num_spheres(); ++l) {
-    EXPECT_GE(untracked->radius(l), 0.64);
+    EXPECT_DOUBLE_EQ(untracked->speed_allowance(l), 1.6);
+    EXPECT_LE(untracked->radius(l), 0.12 + 0.015 + 1e-9);
     EXPECT_NEAR((untracked->sphere(0, untracked->num_steps() - 1, l).mean - untracked->sphere(0, 0, l).mean).norm(), 0.0, 1e-12);
   }
   params.tracked_speeds = true;
@@ -74,14 +77,16 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
       EXPECT_NEAR((step4 - step0).x(), -0.4 * 0.4, 1e-9);
       EXPECT_NEAR((last - step4).norm(), 0.0, 1e-9);
       EXPECT_NEAR(var14 - var0, (1.5 * 1.5 - 0.1 * 0.1) * 0.01, 1e-9);
-      // Grown by the monitor's 2 sigma (0.1 m/s) over T_r + T_s: 0.08 m.
-      EXPECT_GE(hp->radius(l), 0.08);
-      EXPECT_LE(hp->radius(l), 0.08 + 0.2 * std::sqrt(3.0) + 0.015);
-    } else {  // not tracked: where seen, the noise only; grown by 1.6 m/s x 0.4 s
+      // The monitor's 2 sigma (0.2 m/s) is the speed allowance; the radius
+      // covers the cell's points only.
+      EXPECT_NEAR(hp->speed_allowance(l), 0.2, 1e-12);
+      EXPECT_LE(hp->radius(l), 0.12 + 0.015 + 1e-9);
+    } else {  // not tracked: where seen, the noise only; the ISO 1.6 m/s as the allowance
       EXPECT_NEAR((last - step0).norm(), 0.0, 1e-12);
       EXPECT_NEAR(var14, var0, 1e-15);
       EXPECT_LT(var0, 1e-5);
-      EXPECT_GE(hp->radius(l), 0.64);
+      EXPECT_DOUBLE_EQ(hp->speed_allowance(l), 1.6);
+      EXPECT_LE(hp->radius(l), 0.12 + 0.015 + 1e-9);
     }
   }
   seen.means.resize(3, 0);

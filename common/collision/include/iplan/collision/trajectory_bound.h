@@ -50,6 +50,14 @@ class HumanPrediction {
   int num_spheres() const { return static_cast<int>(radii_.size()); }
   double radius(int sphere) const { return radii_[sphere]; }
   int segment(int sphere) const { return segments_[sphere]; }
+  /// m/s the separation monitor adds to this sphere's speed towards the
+  /// robot beyond its predicted mean motion (0 by default; a depth point not
+  /// tracked: the ISO default speed; a tracked part: its velocity's
+  /// uncertainty). Used where the planner predicts the monitor, not by the
+  /// bound: the sphere keeps its own radius.
+  double speed_allowance(int sphere) const { return speed_allowances_[sphere]; }
+  /// Sets speed_allowance(sphere); false (unchanged) unless finite and >= 0.
+  bool set_speed_allowance(int sphere, double v);
   double action_probability(int action) const { return probabilities_[action]; }
 
   /// Sets p(action) (>= 0; the probabilities should sum to at most 1, the
@@ -92,6 +100,7 @@ class HumanPrediction {
   int num_steps_;
   std::vector<double> radii_;
   std::vector<int> segments_;
+  std::vector<double> speed_allowances_;
   std::vector<double> probabilities_;
   std::vector<FactorizedGaussian> gaussians_;
   std::vector<Summary> summaries_;
