@@ -44,7 +44,9 @@ bool MotionTracker::Tracked(const MotionPart& part) const {
                                                                              Eigen::EigenvaluesOnly)
                                   .eigenvalues()
                                   .maxCoeff();
-  return max_variance <= params_.tracked_speed_sigma * params_.tracked_speed_sigma;
+  const double limit = params_.tracked_speed_sigma * params_.tracked_speed_sigma +
+                       (part.from_neighbour ? params_.neighbour_speed_sigma * params_.neighbour_speed_sigma : 0.0);
+  return max_variance <= limit;
 }
 
 // Constant velocity, continuous white-noise acceleration per axis (spectral
@@ -182,6 +184,7 @@ void MotionTracker::Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<in
       part.P.bottomRightCorner<3, 3>() = neighbour->velocity_covariance() +
                                          params_.neighbour_speed_sigma * params_.neighbour_speed_sigma * Eigen::Matrix3d::Identity();
       part.measured = 2;
+      part.from_neighbour = true;
     }
     const int index = static_cast<int>(parts_.size());
     for (std::size_t i = s; i < p_W.size(); ++i) {

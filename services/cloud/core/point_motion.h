@@ -40,7 +40,10 @@
 //     part (the same body, its visible region grown: an arm reaching out,
 //     a hand coming out from behind the robot), at that part's velocity
 //     with its covariance grown by neighbour_speed_sigma per axis (what one
-//     part of a body may move relative to the next);
+//     part of a body may move relative to the next), trusted as long as its
+//     velocity std stays within the neighbour's limit so grown (a part
+//     coming out from behind the arm is tracked from its first frame, not
+//     judged at the ISO speed until its own filter has converged);
 //  5. parts unmeasured for more than lost_frames frames are dropped; of two
 //     parts closer than merge_distance the younger is dropped.
 // Pure algorithm, no DDS types. Not thread-safe; allocates.
@@ -99,6 +102,9 @@ struct MotionPart {
   int measured = 0;  ///< measurements so far
   int unseen = 0;    ///< frames since the last measurement
   int points = 0;    ///< points that belong to it in the latest frame
+  /// Seeded next to a tracked part, from its velocity: trusted up to the
+  /// neighbour's limit grown by the relative motion allowed (Tracked).
+  bool from_neighbour = false;
 
   Eigen::Vector3d centre() const { return x.head<3>(); }
   Eigen::Vector3d velocity() const { return x.tail<3>(); }
@@ -115,7 +121,11 @@ class MotionTracker {
   /// one case that none is left for it (its part was dropped, and every other).
   std::vector<int> Update(const std::vector<Eigen::Vector3d>& p_W, int64_t stamp_ns);
   const std::vector<MotionPart>& parts() const { return parts_; }
-  /// True when the part's velocity may be trusted (file comment).
+  /// True when the part's velocity may be trusted: measured at least twice
+  /// (or seeded from a tracked neighbour) and its largest velocity std at
+  /// most tracked_speed_sigma, or, for a part seeded from a neighbour, at
+  /// most sqrt(tracked_speed_sigma^2 + neighbour_speed_sigma^2) (the
+  /// neighbour's limit and the relative motion it was seeded with).
   bool Tracked(const MotionPart& part) const;
 
  private:

@@ -3,7 +3,8 @@
 // moving cluster's parts converge on its velocity while their uncertainty
 // shrinks; a hand reaching out of a still body moves, the body does not; a
 // still cluster whose visible half changes does not gain a large speed; a
-// gap starts afresh.
+// region coming into view next to a tracked body is tracked at once; a gap
+// starts afresh.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -181,6 +182,49 @@ TEST(PointMotion, AGapStartsAfreshAndNewPartsAreNotTracked) {
   // Nobody left: the parts are lost after lost_frames.
   for (int f = 0; f <= MotionParams{}.lost_frames; ++f) tracker.Update({}, kStartNs + (8 + f) * kFrameNs);
   EXPECT_TRUE(tracker.parts().empty());
+}
+
+// A region of a still body that comes into view (from behind the robot's
+// arm) next to its tracked parts is tracked from its first frame, at their
+// velocity, with the relative motion allowed as its uncertainty; a blob far
+// from every part is not (the ISO speed until its own filter converges).
+TEST(PointMotion, ARegionComingIntoViewNextToATrackedBodyIsTrackedAtOnce) {
+  const MotionParams params;
+  MotionTracker tracker{params};
+  std::mt19937 rng(12);
+  const Eigen::Vector3d body(1.3, 0.0, 1.0);
+  // Followed for a few frames: tracked, some parts' velocity std still
+  // high enough that a part seeded from them is beyond tracked_speed_sigma.
+  constexpr int kFrames = 3;
+  for (int f = 0; f < kFrames; ++f) tracker.Update(Blob(body, 0.15, &rng), kStartNs + f * kFrameNs);
+  for (const MotionPart& p : tracker.parts()) ASSERT_TRUE(tracker.Tracked(p));
+  std::vector<Eigen::Vector3d> pts = Blob(body, 0.15, &rng);
+  const std::size_t body_points = pts.size();
+  // A forearm below the body (beyond the reach of its parts' balls, within two
+  // part radii of their centres), and a blob 1 m away.
+  for (const Eigen::Vector3d& q : Blob(body + Eigen::Vector3d(0.0, 0.0, -0.45), 0.05, &rng)) pts.push_back(q);
+  const std::size_t near_end = pts.size();
+  for (const Eigen::Vector3d& q : Blob(body + Eigen::Vector3d(0.0, -1.0, 0.0), 0.06, &rng)) pts.push_back(q);
+  const std::vector<int> part_of = tracker.Update(pts, kStartNs + kFrames * kFrameNs);
+  int near_new = 0, far_tracked = 0;
+  for (std::size_t i = body_points; i < pts.size(); ++i) {
+    ASSERT_GE(part_of[i], 0);
+    const MotionPart& p = tracker.parts()[static_cast<std::size_t>(part_of[i])];
+    if (i < near_end) {
+      if (!p.from_neighbour) continue;  // joined a body part
+      ++near_new;
+      EXPECT_TRUE(tracker.Tracked(p));
+      EXPECT_LT(p.velocity().norm(), 0.1);
+      // Beyond the limit of a part's own filter: trusted through its neighbour.
+      EXPECT_GT(MaxStd(p), params.tracked_speed_sigma);
+      EXPECT_LE(MaxStd(p), std::hypot(params.tracked_speed_sigma, params.neighbour_speed_sigma));
+    } else {
+      EXPECT_FALSE(p.from_neighbour);
+      far_tracked += tracker.Tracked(p);
+    }
+  }
+  EXPECT_GT(near_new, 0) << "the forearm joined the body's parts: the test shows nothing";
+  EXPECT_EQ(far_tracked, 0);
 }
 
 TEST(PointMotion, ParametersAreChecked) {
