@@ -29,9 +29,13 @@
 // keep-out and its prediction of the separation monitor (which takes the
 // human speed from consecutive steps' means) see the measured, directed
 // motion of each part. Coarse, so that a replanning cycle against a person
-// of a few hundred points stays within its budget: a person gives about as
-// many spheres as the skeleton's body model (16); more than max_spheres
-// and the grid is doubled until they fit.
+// of a few hundred points stays within its budget; more than max_spheres
+// and the grid is doubled until they fit. A 0.1 m grid (up to 96 spheres):
+// the 0.2 m grid of before gave spheres of up to 17 cm radius, and the
+// planner's bound beside a person standing at the hand-over was 0.04-0.06
+// against the monitor's 0.004 (the demo's hand-over waited on it); with
+// 0.1 m it was 0.01-0.02, planning p99 44-47 ms of the 50 ms budget
+// (docs/perception-clouds.md, "The camera-only cell").
 //
 // Frames and units: world frame W, m, s. No DDS types.
 #pragma once
@@ -47,11 +51,11 @@
 namespace iplan::trajopt {
 
 struct PointsPredictionParams {
-  double sphere_size = 0.2;     ///< m, grid the points of each part are coarsened on
+  double sphere_size = 0.1;     ///< m, grid the points of each part are coarsened on
   double time_step = 0.1;       ///< s between prediction steps
   double horizon = 1.5;         ///< s, time of the last step
   double motion_horizon = 0.5;  ///< s a tracked part moves at its velocity (its covariance grows all along)
-  int max_spheres = 48;         ///< at most this many spheres (the grid coarsens)
+  int max_spheres = 96;         ///< at most this many spheres (the grid coarsens)
   /// As collision_risk.yaml human_points.tracked_speeds (keep them equal):
   /// false, every sphere is untracked (where seen, grown by the ISO speed).
   bool tracked_speeds = false;

@@ -39,7 +39,7 @@ TEST(PointsPrediction, TrackedSpheresMoveWithGrowingCovarianceUntrackedOnesStay)
   AddBall(&seen, {1.0, 0.0, 1.0}, 0.06, 0);    // a hand, tracked, coming at -x
   AddBall(&seen, {1.4, 0.3, 1.0}, 0.06, -1);   // something not tracked
   ASSERT_EQ(seen.Check(), std::nullopt);
-  PointsPredictionParams params;  // 0.2 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
+  PointsPredictionParams params;  // 0.1 m grid, 0.1 s steps over 1.5 s, moving for 0.5 s
   const safety::SsmParams ssm;  // T_r + T_s = 0.4 s, 1.6 m/s default
   // The shipped default (as collision risk's): the tracked hand too stays
   // where seen, with the ISO 1.6 m/s as its speed allowance; its radius is
