@@ -37,6 +37,7 @@ class CloudService : public framework::Service {
     if (!config.Problems().empty()) return Result::Ok();  // reported by the configuration check
     CloudStageParams p = settings.StageParams();
     joint_state_timeout_ = settings.joint_state_timeout;
+    self_filter_ns_ = static_cast<int64_t>(std::llround(settings.self_filter_time * 1e9));
     frame_id_ = settings.frame_id;
     const std::string& robot_file = settings.robot;
     try {
@@ -89,7 +90,7 @@ class CloudService : public framework::Service {
   // can be 0.1 s or more away, the arm moving centimetres meanwhile, while
   // its path around the stamp is known on both sides); else the nearest
   // state, if within joint_state_timeout.
-  std::optional<Eigen::VectorXd> PoseAt(int64_t stamp) const {
+  std::optional<Eigen::VectorXd> PoseAt(int64_t stamp, bool count = true) const {
     const std::pair<int64_t, Eigen::VectorXd>* best = nullptr;
     const std::pair<int64_t, Eigen::VectorXd>*before = nullptr, *after = nullptr;
     for (const auto& h : history_) {
@@ -100,7 +101,7 @@ class CloudService : public framework::Service {
     if (!best) return std::nullopt;
     if (before && after && after->first > before->first && after->first - before->first <= kBracketNs) {
       const double u = static_cast<double>(stamp - before->first) / static_cast<double>(after->first - before->first);
-      if (static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) ++interpolated_;
+      if (count && static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 > joint_state_timeout_) ++interpolated_;
       return Eigen::VectorXd((1 - u) * before->second + u * after->second);
     }
     if (static_cast<double>(std::llabs(best->first - stamp)) * 1e-9 <= joint_state_timeout_) return best->second;
@@ -126,7 +127,14 @@ class CloudService : public framework::Service {
                                                      " s from the cloud's stamp, " + std::to_string(history_.size()) +
                                                      " in the last second");
     }
-    const StageOutput out = stage_->Process(&cloud_, q, stamp);
+    // And shortly before and after it (self_filter_time): where the joint
+    // states put the robot then, the cloud may have seen it.
+    std::vector<Eigen::VectorXd> around;
+    if (q && self_filter_ns_ > 0) {
+      for (int64_t t : {stamp - self_filter_ns_, stamp + self_filter_ns_})
+        if (std::optional<Eigen::VectorXd> qa = PoseAt(t, false)) around.push_back(std::move(*qa));
+    }
+    const StageOutput out = stage_->Process(&cloud_, q, stamp, around);
     Publish(node, m.header.stamp, out);
     ++processed_;
     node.SetDiagnosticValue("clouds", std::to_string(processed_));
@@ -158,6 +166,7 @@ class CloudService : public framework::Service {
   static constexpr int64_t kBracketNs = 600000000;            // 0.6 s: the widest gap interpolated across
   std::deque<std::pair<int64_t, Eigen::VectorXd>> history_;  // (stamp ns, q), oldest first
   double joint_state_timeout_ = 0.2;
+  int64_t self_filter_ns_ = 0;
   std::string frame_id_ = "world";
   cloud::Cloud cloud_;
   msg::ObstacleArray obstacles_;

@@ -25,6 +25,10 @@ struct CloudSettings {
   std::array<double, 3> workspace_max = {2.0, 1.0, 1.5};
   double human_voxel = 0.03;
   double joint_state_timeout = 0.2;
+  /// s; the robot is filtered out over its poses from this long before the
+  /// cloud's stamp to this long after it (each sphere grown by how far it
+  /// moves then): the joint states' stamps against the camera's.
+  double self_filter_time = 0.05;
   TrackerParams tracking;
   MotionParams motion;
 
@@ -39,6 +43,7 @@ struct CloudSettings {
     a->Visit(IPLAN_NVP(workspace_max, "m, W; above workspace_min on every axis"));
     a->Visit(IPLAN_NVP(human_voxel, "m, grid the human points are reduced on (0: every point), >= 0"));
     a->Visit(IPLAN_NVP(joint_state_timeout, "s between a cloud's stamp and the joint state used to filter the robot out, > 0"));
+    a->Visit(IPLAN_NVP(self_filter_time, "s; the robot is filtered out over its poses this long before and after a cloud's stamp, >= 0"));
     a->Visit(IPLAN_NVP(tracking, "the cluster tracker"));
     a->Visit(IPLAN_NVP(motion, "the human points' velocities: parts followed by constant-velocity Kalman filters"));
   }
@@ -51,6 +56,7 @@ struct CloudSettings {
     }
     if (!(human_voxel >= 0 && std::isfinite(human_voxel))) return "human_voxel must be >= 0 m";
     if (!(joint_state_timeout > 0 && std::isfinite(joint_state_timeout))) return "joint_state_timeout must be > 0 s";
+    if (!(self_filter_time >= 0 && self_filter_time < 1.0)) return "self_filter_time must be in [0, 1) s";
     if (std::string why = tracking.Validate(); !why.empty()) return "tracking: " + why;
     if (std::string why = motion.Validate(); !why.empty()) return "motion: " + why;
     return "";

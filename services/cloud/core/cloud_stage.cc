@@ -55,15 +55,23 @@ void CloudStage::Crop(cloud::Cloud* cloud, StageOutput* out) const {
   }
 }
 
-std::vector<cloud::Sphere> CloudStage::RobotSpheres(const Eigen::VectorXd& q) {
+std::vector<cloud::Sphere> CloudStage::RobotSpheres(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& around) {
   std::vector<cloud::Sphere> spheres;
   if (!robot_ || q.size() != robot_->nq || !q.allFinite()) return spheres;
   collision::CalcForwardKinematics(*robot_, q, robot_data_.get());
+  const Eigen::Matrix3Xd p_WS = robot_data_->p_WS;
+  Eigen::VectorXd grow = Eigen::VectorXd::Zero(p_WS.cols());
+  for (const Eigen::VectorXd& qa : around) {
+    if (qa.size() != robot_->nq || !qa.allFinite()) continue;
+    collision::CalcForwardKinematics(*robot_, qa, robot_data_.get());
+    grow = grow.cwiseMax((robot_data_->p_WS - p_WS).colwise().norm().transpose());
+  }
   spheres.reserve(robot_->spheres.size());
   for (std::size_t i = 0; i < robot_->spheres.size(); ++i) {
+    const Eigen::Index k = static_cast<Eigen::Index>(i);
     cloud::Sphere s;
-    s.centre = (X_SW_ * robot_data_->p_WS.col(static_cast<Eigen::Index>(i))).cast<float>();
-    s.radius = static_cast<float>(robot_->spheres[i].radius);
+    s.centre = (X_SW_ * p_WS.col(k)).cast<float>();
+    s.radius = static_cast<float>(robot_->spheres[i].radius + grow[k]);
     spheres.push_back(s);
   }
   return spheres;
@@ -111,11 +119,12 @@ void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& 
   if (human.motions.empty()) human.motion_of.clear();  // as FromHumanPoints: empty when none is tracked
 }
 
-StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns) {
+StageOutput CloudStage::Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns,
+                                const std::vector<Eigen::VectorXd>& around) {
   StageOutput out;
   Crop(cloud, &out);
   std::vector<cloud::Sphere> spheres;
-  if (q) spheres = RobotSpheres(*q);
+  if (q) spheres = RobotSpheres(*q, around);
   out.self_filtered = !spheres.empty();
   const cloud::Result r = pipeline_.Process(*cloud, spheres);
   out.table_found = r.table.found;

@@ -70,12 +70,17 @@ class CloudStage {
   /// NaN in place). `q` (model order, rad / m) places the robot's spheres;
   /// nullopt: no self-filter this frame, and then (with a robot) the frame
   /// does not update the tracking: every cluster is human, the known static
-  /// obstacles are output unchanged. Never throws on cloud content.
-  StageOutput Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns);
+  /// obstacles are output unchanged. `around`: the robot's poses shortly
+  /// before and after the stamp (same order as q); each sphere, placed at
+  /// q, grows by the farthest it is from there in them, so that the robot
+  /// is filtered out over its path while the joint states' timing against
+  /// the camera's is uncertain. Never throws on cloud content.
+  StageOutput Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns,
+                      const std::vector<Eigen::VectorXd>& around = {});
 
  private:
   void Crop(cloud::Cloud* cloud, StageOutput* out) const;
-  std::vector<cloud::Sphere> RobotSpheres(const Eigen::VectorXd& q);
+  std::vector<cloud::Sphere> RobotSpheres(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& around);
   /// The human points, voxel-reduced, with noise covariances; `track`: their
   /// parts' motions are updated from them (else they are all not tracked).
   void HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& indices, bool track, int64_t stamp_ns,

@@ -1,8 +1,8 @@
 // The cloud service's stage on frames of the simulated depth camera: a box
 // on the table becomes one static obstacle (stable id, centre and size
 // right), a moving person-sized body becomes human points near its truth,
-// the robot's own spheres are filtered from the joint state, the table is
-// removed. And the tracker on its own: settle, move, lose.
+// the robot's own spheres are filtered from the joint state (over its path
+// around the stamp), the table is removed. And the tracker on its own: settle, move, lose.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -13,6 +13,7 @@
 #include "services/cloud/core/cloud_stage.h"
 #include "services/perception/core/depth_camera.h"
 #include "iplan/cloud/camera.h"
+#include "iplan/collision/robot_model.h"
 
 namespace iplan::cloud_service {
 namespace {
@@ -190,6 +191,39 @@ TEST(CloudStageTest, RobotSpheresAreFilteredGivenTheJointState) {
   EXPECT_FALSE(without_q.self_filtered);
   EXPECT_EQ(without_q.clusters, 1);
   EXPECT_FALSE((without_q.human.size() == 0));  // the robot counts as human: cautious
+}
+
+// The camera saw the arm a little further along than the joint state at the
+// cloud's stamp says (the two clocks' timing): the arm's edge is left as a
+// human cluster; with the poses around the stamp (the service's
+// self_filter_time) each sphere covers its path and nothing is left.
+TEST(CloudStageTest, TheArmSeenAheadOfItsJointStateIsFilteredWithThePosesAroundTheStamp) {
+  const collision::RobotModel robot =
+      collision::LoadRobotModelFromYaml(std::string(IPLAN_SOURCE_DIR) + "/config/robots/panda.yaml");
+  Eigen::VectorXd q(7), seen(7);
+  q << 0.0, 0.2, 0.0, -1.8, 0.0, 2.0, 0.8;
+  seen = q;
+  seen[0] += 0.1;  // rad: the arm at 1 rad/s, 0.1 s apart
+  collision::RobotData d(robot);
+  collision::CalcForwardKinematics(robot, seen, &d);
+  DepthScene scene = Table();
+  for (std::size_t k = 0; k < robot.spheres.size(); ++k)
+    scene.spheres.push_back({d.p_WS.col(static_cast<Eigen::Index>(k)), robot.spheres[k].radius});
+  SimulatedDepthCamera cam = Camera();
+  cloud::Cloud c;
+  cam.Render(scene, &c);
+  cloud::Cloud copy = c;
+  CloudStage at_stamp(Params(), &robot), over_path(Params(), &robot);
+  const StageOutput left = at_stamp.Process(&c, q, 0);
+  EXPECT_TRUE(left.self_filtered);
+  EXPECT_GT(left.human.size(), 20) << "the pose error leaves no sliver: the test shows nothing";
+  Eigen::VectorXd before = q, after = q;
+  before[0] -= 0.1;
+  after[0] += 0.1;
+  const StageOutput none = over_path.Process(&copy, q, 0, {before, after});
+  EXPECT_TRUE(none.self_filtered);
+  EXPECT_EQ(none.human.size(), 0);
+  EXPECT_EQ(none.clusters, 0);
 }
 
 TEST(CloudStageTest, FramesWithoutJointStateLeaveTheTracksAlone) {
