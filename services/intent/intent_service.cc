@@ -84,7 +84,10 @@ class IntentService : public framework::Service {
     // keeps the estimator busy.
     const auto period = std::chrono::duration<double>(params_.body_timeout / 2);
     timer_ = node.AddTimer(std::chrono::duration_cast<std::chrono::nanoseconds>(period), [this, &node] {
-      if (estimator_->DropStale(msg::ToSeconds(msg::Now())) > 0) UpdateDiagnostics(node);
+      // The counts between the every-30th-frame updates reach the
+      // diagnostics here too (at most body_timeout / 2 late).
+      estimator_->DropStale(msg::ToSeconds(msg::Now()));
+      UpdateDiagnostics(node);
       // Baselines of bodies not seen for body_timeout go with them.
       const double now = msg::ToSeconds(msg::Now());
       for (auto b = last_baseline_stamp_.begin(); b != last_baseline_stamp_.end();) {

@@ -296,7 +296,9 @@ class CellHarness {
     for (auto& [name, p] : procs_) {
       if (!p) continue;
       const std::optional<int> code = p->Wait(std::chrono::seconds(10));
-      if (expect_clean) EXPECT_EQ(code, 0) << name << ":\n" << p->Stderr();
+      if (expect_clean) {
+        EXPECT_EQ(code, 0) << name << ":\n" << p->Stderr();
+      }
     }
   }
 
