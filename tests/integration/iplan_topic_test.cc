@@ -93,7 +93,7 @@ TEST_F(IplanTopic, PubDeliversAMessageToEcho) {
                    "--wait-readers", "20"});
   ASSERT_EQ(pub->Wait(30s), 0) << pub->Stderr();
   EXPECT_EQ(pub->Stderr().find("no reader"), std::string::npos) << pub->Stderr();
-  ASSERT_EQ(echo->Wait(60s), 0) << echo->Stderr();
+  ASSERT_EQ(echo->Wait(60s), 0) << echo->Stderr() << "pub:\n" << pub->Stdout() << pub->Stderr();
   const auto j = nlohmann::json::parse(echo->Stdout());
   EXPECT_EQ(j["seq"], 7);
   EXPECT_EQ(j["reason"], "operator");

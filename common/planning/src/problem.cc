@@ -78,6 +78,18 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   // A warm start longer than the horizon (it contains earlier waits) keeps
   // its length, up to twice the horizon, so its remaining motion is not cut.
   if (req.warm_start.cols() - 1 > at.n) at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
+  // keep_arrival: a warm start that already ends at this goal keeps its
+  // arrival; the motion's end does not recede a horizon with every replan.
+  // Its arrival is the first column of the run of goal columns that ends it
+  // (Planner::ShiftTrajectory pads a shifted plan with its last column).
+  if (P.keep_arrival && req.warm_start.cols() > 1) {
+    const auto at_goal = [&](Eigen::Index i) { return (req.warm_start.col(i) - q_goal).cwiseAbs().maxCoeff() < 1e-12; };
+    Eigen::Index arrival = req.warm_start.cols() - 1;
+    if (at_goal(arrival)) {
+      while (arrival > 0 && at_goal(arrival - 1)) --arrival;
+      at.n = std::min(at.n, std::max(static_cast<int>(arrival), req.num_frozen + kMinKeptArrivalFree));
+    }
+  }
   // A motion longer than the horizon allows within the velocity limits gets
   // the time it needs after the frozen prefix, up to twice the horizon, and a
   // straight line to the goal as its start; otherwise every attempt would

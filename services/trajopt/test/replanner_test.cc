@@ -3,6 +3,7 @@
 // the goal makes the robot wait (reported as delay), and unreachable goals
 // and cancellations end the task with the right outcome.
 #include <algorithm>
+#include <iostream>
 #include <limits>
 
 #include <gtest/gtest.h>
@@ -107,6 +108,51 @@ TEST_F(ReplannerTest, MotionLongerThanTheHorizonAllowsStillArrives) {
   EXPECT_EQ(outcome->status, TaskStatus::kSucceeded) << outcome->reason;
   EXPECT_EQ(outcome->delay, 0.0);
   EXPECT_GT(outcome->duration, 2.8 / 2.175);
+}
+
+// With keep_arrival (the cell's replanning settings) a replan keeps the
+// arrival of the plan before it: the motion ends about a horizon after it
+// started. Without it every replan plans a whole horizon to the goal again,
+// so the arrival recedes and the end of the motion decays.
+TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
+  planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+  ASSERT_TRUE(params.keep_arrival);
+  // Task duration (s) of a reach from Ready to Goal with an ideal robot.
+  auto reach = [&](bool keep_arrival) -> double {
+    params.keep_arrival = keep_arrival;
+    const planning::Planner planner(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                    collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), params);
+    Replanner replanner(planner, body_, ReplannerParams{});
+    int64_t t = 100 * kSec;
+    std::optional<CycleResult> last;
+    auto state = [&](int64_t at) {
+      const Eigen::VectorXd q = last ? At(*last, at) : Ready();
+      const Eigen::VectorXd qd = last ? Eigen::VectorXd((At(*last, at + kSec / 100) - q) / 0.01) : Eigen::VectorXd::Zero(7);
+      EXPECT_EQ(replanner.UpdateRobotState(at, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7),
+                                           std::vector<double>(qd.data(), qd.data() + 7)),
+                std::nullopt);
+    };
+    state(t);
+    EXPECT_EQ(replanner.StartTask({21, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+    for (int k = 0; k < 80; ++k) {
+      CycleResult c = replanner.Cycle(t);
+      if (c.outcome) {
+        EXPECT_EQ(c.outcome->status, TaskStatus::kSucceeded) << c.outcome->reason;
+        return c.outcome->duration;
+      }
+      if (c.publish) last = c;
+      t += kSec / 10;
+      state(t);
+    }
+    ADD_FAILURE() << "no outcome in 8 s";
+    return 1e9;
+  };
+  const double kept = reach(true);
+  const double receding = reach(false);
+  std::cout << "reach Ready -> Goal: " << kept << " s keeping the arrival, " << receding << " s receding\n";
+  // The horizon, the cycle in which the goal is seen reached and one more.
+  EXPECT_LE(kept, params.horizon + 0.2 + 1e-9);
+  EXPECT_GT(receding, kept + 0.3);
 }
 
 TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {

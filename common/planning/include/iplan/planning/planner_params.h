@@ -123,6 +123,13 @@ struct PlannerParams {
   /// and costs nothing. false: the plan's own speed (the monitor's slowing
   /// counts as a stop).
   bool ssm_predicts_slowing = false;
+  /// A replan towards the goal its warm start already ends at keeps the
+  /// warm start's arrival (its length, at least num_frozen + 3 waypoints)
+  /// instead of planning a whole horizon again. false: every plan arrives a
+  /// horizon after its start, so each replan moves the arrival later and the
+  /// last part of a motion decays (about 1 s for the last 0.2 rad of the
+  /// Panda with a 1.5 s horizon).
+  bool keep_arrival = false;
   safety::SsmParams ssm;
   double ssm_margin = 0.03;          ///< m, >= 0
   double ssm_activation = 0.05;      ///< m, >= ssm_margin
@@ -180,6 +187,7 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(human_separation, "m; soft keep-out from the predicted person, >= 0 (0 = off)"));
   a->Visit(IPLAN_NVP(predict_ssm, "judge plans by the separation monitor's rule against the predicted person"));
   a->Visit(IPLAN_NVP(ssm_predicts_slowing, "with the monitor's speed_reduction: judge pairs at min_speed_scale x the plan's speed (the monitor's stop, not its slowing)"));
+  a->Visit(IPLAN_NVP(keep_arrival, "a replan towards its warm start's goal keeps that arrival (at least num_frozen + 3 waypoints) instead of a whole horizon"));
   a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "the monitor's ISO/TS 15066 parameters (trajopt: from the cell's safety file)"));
   a->Visit(IPLAN_NVP(ssm_margin, "m; a safe plan keeps d - S_p >= this at every free waypoint within ssm_horizon, >= 0"));
   a->Visit(IPLAN_NVP(ssm_activation, "m; the ssm cost starts below this margin, >= ssm_margin"));
