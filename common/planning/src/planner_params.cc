@@ -53,6 +53,9 @@ std::string PlannerParams::Validate() const {
   if (!nonneg(ssm_margin)) return "ssm_margin must be >= 0, got " + Num(ssm_margin);
   if (!(std::isfinite(ssm_activation) && ssm_activation >= ssm_margin))
     return "ssm_activation must be >= ssm_margin (" + Num(ssm_margin) + "), got " + Num(ssm_activation);
+  if (!(motion_speed_fraction >= 0.0 && motion_speed_fraction <= 1.0))
+    return "motion_speed_fraction must be in [0, 1], got " + Num(motion_speed_fraction);
+  if (!nonneg(min_motion_time)) return "min_motion_time must be >= 0, got " + Num(min_motion_time);
   if (!positive(ssm_horizon)) return "ssm_horizon must be > 0, got " + Num(ssm_horizon);
   if (!(ssm_stop_probability > 0.0 && ssm_stop_probability <= 1.0))
     return "ssm_stop_probability must be in (0, 1], got " + Num(ssm_stop_probability);

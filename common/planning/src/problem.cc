@@ -66,6 +66,42 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
   }
 }
 
+namespace {
+
+// The plan's length in intervals, from `n` (the horizon's or a longer warm
+// start's): shorter with keep_arrival when the warm start already ends at
+// this goal (its arrival kept, the motion's end does not recede a horizon
+// with every replan; the arrival is the first column of the run of goal
+// columns that ends it, as Planner::ShiftTrajectory pads a shifted plan with
+// its last column), else shorter with motion_speed_fraction when the motion
+// to this new goal needs less than the horizon at that fraction of the
+// speed limits.
+int ArrivalLength(const PlannerParams& P, const PlanningRequest& req, const Eigen::VectorXd& q_goal,
+                  const Eigen::VectorXd& vmax, int n) {
+  const bool warm = req.warm_start.cols() > 1;
+  const int shortest = req.num_frozen + kMinKeptArrivalFree;
+  if (P.keep_arrival && warm) {
+    const auto at_goal = [&](Eigen::Index i) { return (req.warm_start.col(i) - q_goal).cwiseAbs().maxCoeff() < 1e-12; };
+    Eigen::Index arrival = req.warm_start.cols() - 1;
+    if (at_goal(arrival)) {
+      while (arrival > 0 && at_goal(arrival - 1)) --arrival;
+      return std::min(n, std::max(static_cast<int>(arrival), shortest));
+    }
+  }
+  if (P.motion_speed_fraction > 0) {
+    const int frozen = warm ? req.num_frozen : 1;
+    const Eigen::VectorXd q0 = warm ? Eigen::VectorXd(req.warm_start.col(frozen - 1)) : req.start_q;
+    double t = 0.0;
+    for (int j = 0; j < q_goal.size(); ++j) t = std::max(t, std::abs(q_goal[j] - q0[j]) / vmax[j]);
+    const double wanted = std::max(P.min_motion_time, kRestToRestPeakFactor * t / P.motion_speed_fraction);
+    const int fitted = (frozen - 1) + static_cast<int>(std::ceil(wanted / P.dt - 1e-9));
+    return std::min(n, std::max(fitted, shortest));
+  }
+  return n;
+}
+
+}  // namespace
+
 Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::VectorXd& q_goal) const {
   const int nq = robot.nq;
   const PlannerParams& P = params;
@@ -78,18 +114,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   // A warm start longer than the horizon (it contains earlier waits) keeps
   // its length, up to twice the horizon, so its remaining motion is not cut.
   if (req.warm_start.cols() - 1 > at.n) at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
-  // keep_arrival: a warm start that already ends at this goal keeps its
-  // arrival; the motion's end does not recede a horizon with every replan.
-  // Its arrival is the first column of the run of goal columns that ends it
-  // (Planner::ShiftTrajectory pads a shifted plan with its last column).
-  if (P.keep_arrival && req.warm_start.cols() > 1) {
-    const auto at_goal = [&](Eigen::Index i) { return (req.warm_start.col(i) - q_goal).cwiseAbs().maxCoeff() < 1e-12; };
-    Eigen::Index arrival = req.warm_start.cols() - 1;
-    if (at_goal(arrival)) {
-      while (arrival > 0 && at_goal(arrival - 1)) --arrival;
-      at.n = std::min(at.n, std::max(static_cast<int>(arrival), req.num_frozen + kMinKeptArrivalFree));
-    }
-  }
+  at.n = ArrivalLength(P, req, q_goal, vmax, at.n);
   // A motion longer than the horizon allows within the velocity limits gets
   // the time it needs after the frozen prefix, up to twice the horizon, and a
   // straight line to the goal as its start; otherwise every attempt would

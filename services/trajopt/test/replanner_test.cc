@@ -117,6 +117,7 @@ TEST_F(ReplannerTest, MotionLongerThanTheHorizonAllowsStillArrives) {
 TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
   planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
   ASSERT_TRUE(params.keep_arrival);
+  params.motion_speed_fraction = 0;  // every new goal gets the whole horizon (as shipped): keep_arrival alone
   // Task duration (s) of a reach from Ready to Goal with an ideal robot.
   auto reach = [&](bool keep_arrival) -> double {
     params.keep_arrival = keep_arrival;
@@ -153,6 +154,63 @@ TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
   // The horizon, the cycle in which the goal is seen reached and one more.
   EXPECT_LE(kept, params.horizon + 0.2 + 1e-9);
   EXPECT_GT(receding, kept + 0.3);
+}
+
+// With motion_speed_fraction (off in the cell's replanning settings) the
+// first plan to a new goal takes the time its distance needs, at least
+// min_motion_time; a motion the horizon is too short for keeps the horizon.
+TEST_F(ReplannerTest, APlanToANewGoalTakesTheTimeItsDistanceNeeds) {
+  planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+  ASSERT_LT(params.min_motion_time, params.horizon);
+  // The first plan's duration (s) and the task's, from Ready to `goal`.
+  auto first_plan_and_task = [&](double fraction, const Eigen::VectorXd& goal) -> std::pair<double, double> {
+    params.motion_speed_fraction = fraction;
+    const planning::Planner planner(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
+                                    collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), params);
+    Replanner replanner(planner, body_, ReplannerParams{});
+    int64_t t = 100 * kSec;
+    std::optional<CycleResult> last;
+    double first = -1;
+    auto state = [&](int64_t at) {
+      const Eigen::VectorXd q = last ? At(*last, at) : Ready();
+      const Eigen::VectorXd qd = last ? Eigen::VectorXd((At(*last, at + kSec / 100) - q) / 0.01) : Eigen::VectorXd::Zero(7);
+      EXPECT_EQ(replanner.UpdateRobotState(at, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7),
+                                           std::vector<double>(qd.data(), qd.data() + 7)),
+                std::nullopt);
+    };
+    state(t);
+    EXPECT_EQ(replanner.StartTask({22, "reach", planning::Goal::Joint(goal), 0}, t), std::nullopt);
+    for (int k = 0; k < 80; ++k) {
+      CycleResult c = replanner.Cycle(t);
+      if (c.outcome) {
+        EXPECT_EQ(c.outcome->status, TaskStatus::kSucceeded) << c.outcome->reason;
+        return {first, c.outcome->duration};
+      }
+      if (c.publish) {
+        if (first < 0) first = static_cast<double>(c.positions.cols() - 1) * c.dt;
+        last = c;
+      }
+      t += kSec / 10;
+      state(t);
+    }
+    ADD_FAILURE() << "no outcome in 8 s";
+    return {first, 1e9};
+  };
+  // Ready to Goal: 0.6 rad of joint 1 at most, 0.4 s at half its 2.175 rad/s
+  // limit with the peak factor 1.5: the floor, min_motion_time.
+  const auto [fitted_plan, fitted_task] = first_plan_and_task(0.5, Goal());
+  const auto [whole_plan, whole_task] = first_plan_and_task(0.0, Goal());
+  std::cout << "Ready -> Goal: first plan " << fitted_plan << " s, task " << fitted_task << " s (fitted); "
+            << whole_plan << " s, " << whole_task << " s (the whole horizon)\n";
+  EXPECT_NEAR(fitted_plan, params.min_motion_time, 1e-9);
+  EXPECT_NEAR(whole_plan, params.horizon, 1e-9);
+  EXPECT_LT(fitted_task, whole_task - 0.2);
+  // 2 rad of joint 1 needs 2.76 s at half its limit: the horizon caps it.
+  Eigen::VectorXd far = Ready();
+  far[0] += 2.0;
+  const auto [far_plan, far_task] = first_plan_and_task(0.5, far);
+  EXPECT_NEAR(far_plan, params.horizon, 1e-9);
+  EXPECT_LT(far_task, 8.0);
 }
 
 TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {

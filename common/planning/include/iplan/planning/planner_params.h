@@ -130,6 +130,13 @@ struct PlannerParams {
   /// last part of a motion decays (about 1 s for the last 0.2 rad of the
   /// Panda with a 1.5 s horizon).
   bool keep_arrival = false;
+  /// A plan towards a new goal (not one its warm start already ends at)
+  /// takes the time its distance needs, max(min_motion_time, 1.5 t_min /
+  /// motion_speed_fraction) with t_min = max_j |q_goal,j - q_j| / vmax_j, at
+  /// most the horizon: the motion's peak joint speed is about this fraction
+  /// of its limit. In [0, 1]; 0: every new goal gets the whole horizon.
+  double motion_speed_fraction = 0.0;
+  double min_motion_time = 1.0;  ///< s, >= 0; see motion_speed_fraction
   safety::SsmParams ssm;
   double ssm_margin = 0.03;          ///< m, >= 0
   double ssm_activation = 0.05;      ///< m, >= ssm_margin
@@ -188,6 +195,8 @@ void PlannerParams::Serialize(Archive* a) {
   a->Visit(IPLAN_NVP(predict_ssm, "judge plans by the separation monitor's rule against the predicted person"));
   a->Visit(IPLAN_NVP(ssm_predicts_slowing, "with the monitor's speed_reduction: judge pairs at min_speed_scale x the plan's speed (the monitor's stop, not its slowing)"));
   a->Visit(IPLAN_NVP(keep_arrival, "a replan towards its warm start's goal keeps that arrival (at least num_frozen + 3 waypoints) instead of a whole horizon"));
+  a->Visit(IPLAN_NVP(motion_speed_fraction, "a plan to a new goal takes max(min_motion_time, 1.5 t_min / this) (t_min: largest joint distance over its speed limit), at most the horizon; in [0, 1], 0: the whole horizon"));
+  a->Visit(IPLAN_NVP(min_motion_time, "s; the shortest plan to a new goal with motion_speed_fraction, >= 0"));
   a->Visit(core::MakeNameValue("iso_ts_15066", &ssm, "the monitor's ISO/TS 15066 parameters (trajopt: from the cell's safety file)"));
   a->Visit(IPLAN_NVP(ssm_margin, "m; a safe plan keeps d - S_p >= this at every free waypoint within ssm_horizon, >= 0"));
   a->Visit(IPLAN_NVP(ssm_activation, "m; the ssm cost starts below this margin, >= ssm_margin"));
