@@ -110,22 +110,21 @@ TEST_F(ReplannerTest, MotionLongerThanTheHorizonAllowsStillArrives) {
   EXPECT_GT(outcome->duration, 2.8 / 2.175);
 }
 
-// With keep_arrival (the cell's replanning settings) a replan keeps the
-// arrival of the plan before it: the motion ends about a horizon after it
-// started. Without it every replan plans a whole horizon to the goal again,
-// so the arrival recedes and the end of the motion decays.
-TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
-  planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
-  ASSERT_TRUE(params.keep_arrival);
-  params.motion_speed_fraction = 0;  // every new goal gets the whole horizon (as shipped): keep_arrival alone
-  // Task duration (s) of a reach from Ready to Goal with an ideal robot.
-  auto reach = [&](bool keep_arrival) -> double {
-    params.keep_arrival = keep_arrival;
+// Reaches with an ideal robot that follows every plan, under given planner
+// settings (the cell's replanning ones, changed).
+class ReplannerArrivalTest : public ReplannerTest {
+ protected:
+  struct Reach {
+    double first_plan = -1;  ///< s, duration of the first published plan
+    double task = 1e9;       ///< s, the task's duration (1e9: no outcome in 8 s)
+  };
+  Reach IdealReach(const planning::PlannerParams& params, const Eigen::VectorXd& goal) {
     const planning::Planner planner(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
                                     collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), params);
     Replanner replanner(planner, body_, ReplannerParams{});
     int64_t t = 100 * kSec;
     std::optional<CycleResult> last;
+    Reach out;
     auto state = [&](int64_t at) {
       const Eigen::VectorXd q = last ? At(*last, at) : Ready();
       const Eigen::VectorXd qd = last ? Eigen::VectorXd((At(*last, at + kSec / 100) - q) / 0.01) : Eigen::VectorXd::Zero(7);
@@ -134,22 +133,37 @@ TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
                 std::nullopt);
     };
     state(t);
-    EXPECT_EQ(replanner.StartTask({21, "reach", planning::Goal::Joint(Goal()), 0}, t), std::nullopt);
+    EXPECT_EQ(replanner.StartTask({21, "reach", planning::Goal::Joint(goal), 0}, t), std::nullopt);
     for (int k = 0; k < 80; ++k) {
       CycleResult c = replanner.Cycle(t);
       if (c.outcome) {
         EXPECT_EQ(c.outcome->status, TaskStatus::kSucceeded) << c.outcome->reason;
-        return c.outcome->duration;
+        out.task = c.outcome->duration;
+        return out;
       }
-      if (c.publish) last = c;
+      if (c.publish) {
+        if (out.first_plan < 0) out.first_plan = static_cast<double>(c.positions.cols() - 1) * c.dt;
+        last = c;
+      }
       t += kSec / 10;
       state(t);
     }
     ADD_FAILURE() << "no outcome in 8 s";
-    return 1e9;
-  };
-  const double kept = reach(true);
-  const double receding = reach(false);
+    return out;
+  }
+};
+
+// With keep_arrival (the cell's replanning settings) a replan keeps the
+// arrival of the plan before it: the motion ends about a horizon after it
+// started. Without it every replan plans a whole horizon to the goal again,
+// so the arrival recedes and the end of the motion decays.
+TEST_F(ReplannerArrivalTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
+  planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
+  ASSERT_TRUE(params.keep_arrival);
+  params.motion_speed_fraction = 0;  // every new goal gets the whole horizon (as shipped): keep_arrival alone
+  const double kept = IdealReach(params, Goal()).task;
+  params.keep_arrival = false;
+  const double receding = IdealReach(params, Goal()).task;
   std::cout << "reach Ready -> Goal: " << kept << " s keeping the arrival, " << receding << " s receding\n";
   // The horizon, the cycle in which the goal is seen reached and one more.
   EXPECT_LE(kept, params.horizon + 0.2 + 1e-9);
@@ -159,58 +173,26 @@ TEST_F(ReplannerTest, AReplanKeepsThePlansArrivalInsteadOfRecedingIt) {
 // With motion_speed_fraction (off in the cell's replanning settings) the
 // first plan to a new goal takes the time its distance needs, at least
 // min_motion_time; a motion the horizon is too short for keeps the horizon.
-TEST_F(ReplannerTest, APlanToANewGoalTakesTheTimeItsDistanceNeeds) {
+TEST_F(ReplannerArrivalTest, APlanToANewGoalTakesTheTimeItsDistanceNeeds) {
   planning::PlannerParams params = planning::LoadPlannerParams(kConfig + "planner_replanning.yaml");
   ASSERT_LT(params.min_motion_time, params.horizon);
-  // The first plan's duration (s) and the task's, from Ready to `goal`.
-  auto first_plan_and_task = [&](double fraction, const Eigen::VectorXd& goal) -> std::pair<double, double> {
-    params.motion_speed_fraction = fraction;
-    const planning::Planner planner(collision::LoadRobotModelFromYaml(kConfig + "robots/panda.yaml"),
-                                    collision::LoadSceneParams(kConfig + "scenes/cell.yaml"), params);
-    Replanner replanner(planner, body_, ReplannerParams{});
-    int64_t t = 100 * kSec;
-    std::optional<CycleResult> last;
-    double first = -1;
-    auto state = [&](int64_t at) {
-      const Eigen::VectorXd q = last ? At(*last, at) : Ready();
-      const Eigen::VectorXd qd = last ? Eigen::VectorXd((At(*last, at + kSec / 100) - q) / 0.01) : Eigen::VectorXd::Zero(7);
-      EXPECT_EQ(replanner.UpdateRobotState(at, replanner.joint_names(), std::vector<double>(q.data(), q.data() + 7),
-                                           std::vector<double>(qd.data(), qd.data() + 7)),
-                std::nullopt);
-    };
-    state(t);
-    EXPECT_EQ(replanner.StartTask({22, "reach", planning::Goal::Joint(goal), 0}, t), std::nullopt);
-    for (int k = 0; k < 80; ++k) {
-      CycleResult c = replanner.Cycle(t);
-      if (c.outcome) {
-        EXPECT_EQ(c.outcome->status, TaskStatus::kSucceeded) << c.outcome->reason;
-        return {first, c.outcome->duration};
-      }
-      if (c.publish) {
-        if (first < 0) first = static_cast<double>(c.positions.cols() - 1) * c.dt;
-        last = c;
-      }
-      t += kSec / 10;
-      state(t);
-    }
-    ADD_FAILURE() << "no outcome in 8 s";
-    return {first, 1e9};
-  };
   // Ready to Goal: 0.6 rad of joint 1 at most, 0.4 s at half its 2.175 rad/s
   // limit with the peak factor 1.5: the floor, min_motion_time.
-  const auto [fitted_plan, fitted_task] = first_plan_and_task(0.5, Goal());
-  const auto [whole_plan, whole_task] = first_plan_and_task(0.0, Goal());
-  std::cout << "Ready -> Goal: first plan " << fitted_plan << " s, task " << fitted_task << " s (fitted); "
-            << whole_plan << " s, " << whole_task << " s (the whole horizon)\n";
-  EXPECT_NEAR(fitted_plan, params.min_motion_time, 1e-9);
-  EXPECT_NEAR(whole_plan, params.horizon, 1e-9);
-  EXPECT_LT(fitted_task, whole_task - 0.2);
+  params.motion_speed_fraction = 0.5;
+  const Reach fitted = IdealReach(params, Goal());
   // 2 rad of joint 1 needs 2.76 s at half its limit: the horizon caps it.
   Eigen::VectorXd far = Ready();
   far[0] += 2.0;
-  const auto [far_plan, far_task] = first_plan_and_task(0.5, far);
-  EXPECT_NEAR(far_plan, params.horizon, 1e-9);
-  EXPECT_LT(far_task, 8.0);
+  const Reach far_reach = IdealReach(params, far);
+  params.motion_speed_fraction = 0.0;
+  const Reach whole = IdealReach(params, Goal());
+  std::cout << "Ready -> Goal: first plan " << fitted.first_plan << " s, task " << fitted.task << " s (fitted); "
+            << whole.first_plan << " s, " << whole.task << " s (the whole horizon)\n";
+  EXPECT_NEAR(fitted.first_plan, params.min_motion_time, 1e-9);
+  EXPECT_NEAR(whole.first_plan, params.horizon, 1e-9);
+  EXPECT_LT(fitted.task, whole.task - 0.2);
+  EXPECT_NEAR(far_reach.first_plan, params.horizon, 1e-9);
+  EXPECT_LT(far_reach.task, 8.0);
 }
 
 TEST_F(ReplannerTest, PersonOnTheGoalMakesTheRobotWaitThenItArrives) {
