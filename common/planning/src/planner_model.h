@@ -47,8 +47,9 @@ constexpr double kSeparationMinProbability = 0.3;
 // within the velocity limits: a motion whose largest joint distance over its
 // velocity limit is t_min gets at least this times t_min.
 constexpr double kRestToRestPeakFactor = 1.5;
-// Free waypoints a plan keeps at least when it keeps its warm start's
-// arrival (PlannerParams::keep_arrival).
+// Free waypoints a plan keeps at least when it is shortened to keep its
+// warm start's arrival or to fit its motion (PlannerParams::keep_arrival,
+// motion_speed_fraction).
 constexpr int kMinKeptArrivalFree = 3;
 // m: the ssm cost's band above the margin never shrinks below this (or
 // ssm_activation - ssm_margin, if smaller) with PlanningRequest::ssm_scale,

@@ -74,13 +74,12 @@ namespace {
 // with every replan; the arrival is the first column of the run of goal
 // columns that ends it, as Planner::ShiftTrajectory pads a shifted plan with
 // its last column), else shorter with motion_speed_fraction when the motion
-// to this new goal needs less than the horizon at that fraction of the
-// speed limits.
-int ArrivalLength(const PlannerParams& P, const PlanningRequest& req, const Eigen::VectorXd& q_goal,
-                  const Eigen::VectorXd& vmax, int n) {
-  const bool warm = req.warm_start.cols() > 1;
+// to this new goal, t_min (s) at the speed limits after `keep` waypoints,
+// needs less than the horizon at that fraction of the limits.
+int ArrivalLength(const PlannerParams& P, const PlanningRequest& req, const Eigen::VectorXd& q_goal, int keep,
+                  double t_min, int n) {
   const int shortest = req.num_frozen + kMinKeptArrivalFree;
-  if (P.keep_arrival && warm) {
+  if (P.keep_arrival && req.warm_start.cols() > 1) {
     const auto at_goal = [&](Eigen::Index i) { return (req.warm_start.col(i) - q_goal).cwiseAbs().maxCoeff() < 1e-12; };
     Eigen::Index arrival = req.warm_start.cols() - 1;
     if (at_goal(arrival)) {
@@ -89,12 +88,8 @@ int ArrivalLength(const PlannerParams& P, const PlanningRequest& req, const Eige
     }
   }
   if (P.motion_speed_fraction > 0) {
-    const int frozen = warm ? req.num_frozen : 1;
-    const Eigen::VectorXd q0 = warm ? Eigen::VectorXd(req.warm_start.col(frozen - 1)) : req.start_q;
-    double t = 0.0;
-    for (int j = 0; j < q_goal.size(); ++j) t = std::max(t, std::abs(q_goal[j] - q0[j]) / vmax[j]);
-    const double wanted = std::max(P.min_motion_time, kRestToRestPeakFactor * t / P.motion_speed_fraction);
-    const int fitted = (frozen - 1) + static_cast<int>(std::ceil(wanted / P.dt - 1e-9));
+    const double wanted = std::max(P.min_motion_time, kRestToRestPeakFactor * t_min / P.motion_speed_fraction);
+    const int fitted = (keep - 1) + static_cast<int>(std::ceil(wanted / P.dt - 1e-9));
     return std::min(n, std::max(fitted, shortest));
   }
   return n;
@@ -114,17 +109,18 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   // A warm start longer than the horizon (it contains earlier waits) keeps
   // its length, up to twice the horizon, so its remaining motion is not cut.
   if (req.warm_start.cols() - 1 > at.n) at.n = std::min(static_cast<int>(req.warm_start.cols()) - 1, 2 * at.n);
-  at.n = ArrivalLength(P, req, q_goal, vmax, at.n);
-  // A motion longer than the horizon allows within the velocity limits gets
-  // the time it needs after the frozen prefix, up to twice the horizon, and a
-  // straight line to the goal as its start; otherwise every attempt would
-  // break a velocity limit and the robot would never leave (measured on the
-  // Panda: 2.1 rad of joint 1 plans in a 1.5 s horizon, 2.8 rad does not).
+  // t_min: the motion after the frozen prefix at the velocity limits.
   const bool warm = req.warm_start.cols() > 1;
   const int keep = warm ? req.num_frozen : 1;
   const Eigen::VectorXd from = warm ? Eigen::VectorXd(req.warm_start.col(keep - 1)) : req.start_q;
   double t_min = 0.0;
   for (int j = 0; j < nq; ++j) t_min = std::max(t_min, std::abs(q_goal[j] - from[j]) / vmax[j]);
+  at.n = ArrivalLength(P, req, q_goal, keep, t_min, at.n);
+  // A motion longer than the horizon allows within the velocity limits gets
+  // the time it needs after the frozen prefix, up to twice the horizon, and a
+  // straight line to the goal as its start; otherwise every attempt would
+  // break a velocity limit and the robot would never leave (measured on the
+  // Panda: 2.1 rad of joint 1 plans in a 1.5 s horizon, 2.8 rad does not).
   const int need = (keep - 1) + static_cast<int>(std::ceil(kRestToRestPeakFactor * t_min / P.dt));
   const bool stretched = need > at.n;
   if (stretched) at.n = std::min(need, 2 * horizon_n);
