@@ -497,7 +497,7 @@ void Register(CLI::App& app) {
                  "skeleton: the skeleton stream; depth: also the simulated depth camera and the cloud service "
                  "(obstacles and human points, docs/perception-clouds.md); depth-only: the camera and the cloud "
                  "service alone, no skeleton anywhere (no intent; planner and collision risk on the cloud's outputs, the "
-                 "points at their measured speed + 1 sigma)")
+                 "points at their measured speed + " + std::string(kDepthOnlySpeedSigmas) + " sigma)")
       ->capture_default_str()
       ->check(CLI::IsMember({"skeleton", "depth", "depth-only"}));
   d->add_option("--robot", o.robot,
