@@ -38,6 +38,11 @@ ClusterTracker::ClusterTracker(const TrackerParams& params) : params_(params) {
   if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument(why);
 }
 
+bool ClusterTracker::InSettledBox(const Track& t, const ClusterObservation& o) const {
+  return t.cls == TrackClass::kStatic && (o.box_min.array() >= t.mean_min.array() - params_.static_motion).all() &&
+         (o.box_max.array() <= t.mean_max.array() + params_.static_motion).all();
+}
+
 void ClusterTracker::Observe(Track* t, const ClusterObservation& o) const {
   t->last = o;
   t->unseen = 0;
@@ -47,11 +52,7 @@ void ClusterTracker::Observe(Track* t, const ClusterObservation& o) const {
   // hand over it): the visible box lies within the settled box, grown by
   // static_motion. Its centroid moved, the object did not: it stays static,
   // its box as settled.
-  if (t->cls == TrackClass::kStatic &&
-      (o.box_min.array() >= t->mean_min.array() - params_.static_motion).all() &&
-      (o.box_max.array() <= t->mean_max.array() + params_.static_motion).all()) {
-    return;
-  }
+  if (InSettledBox(*t, o)) return;
   if ((o.centroid - t->anchor).norm() > params_.static_motion) {
     // It moved: whatever moves in the cell is taken for a person (a box
     // being carried moves with a hand), for the rest of the track's life.
@@ -94,6 +95,17 @@ std::vector<int> ClusterTracker::Update(const std::vector<ClusterObservation>& c
   for (std::size_t c = 0; c < clusters.size(); ++c) {
     if (track_of[c] >= 0) {
       Observe(&tracks_[static_cast<std::size_t>(track_of[c])], clusters[c]);
+      continue;
+    }
+    // A second piece of a static obstacle (the arm in front of it split it
+    // in two; the other piece took the track): it is that obstacle, seen in
+    // part, not something new. A new track would be pending, so human, and
+    // its points would be judged at the ISO speed 0.8 m from the person.
+    const auto piece_of = std::find_if(tracks_.begin(), tracks_.end(),
+                                       [&](const Track& t) { return InSettledBox(t, clusters[c]); });
+    if (piece_of != tracks_.end()) {
+      piece_of->unseen = 0;
+      track_of[c] = static_cast<int>(piece_of - tracks_.begin());
       continue;
     }
     Track t;

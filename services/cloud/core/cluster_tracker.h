@@ -4,7 +4,8 @@
 // `static_frames` frames is static; one that moves, or one as large as a
 // person, is human. A static one seen only in part (its visible box within
 // its settled box grown by `static_motion`: the arm in front of it) stays
-// static with its settled box. A static obstacle's box is the running mean
+// static with its settled box, and so does every piece of it when the arm
+// splits it in two. A static obstacle's box is the running mean
 // of its upright oriented boxes (z along W's z, the yaw that gives the
 // smallest footprint), so a rotated bin is as large as it is. Pure
 // algorithm, no DDS types.
@@ -86,8 +87,10 @@ class ClusterTracker {
   explicit ClusterTracker(const TrackerParams& params);
 
   /// One frame: matches the observations to the tracks (nearest centroids
-  /// first, within match_distance), starts tracks for the rest, ages and
-  /// drops unseen ones. Returns, per observation, the index into tracks()
+  /// first, within match_distance); an observation left over that lies in a
+  /// static track's settled box is another piece of that obstacle (several
+  /// observations may then share its track); starts tracks for the rest,
+  /// ages and drops unseen ones. Returns, per observation, the index into tracks()
   /// of its track (valid until the next Update).
   std::vector<int> Update(const std::vector<ClusterObservation>& clusters, int64_t stamp_ns);
 
@@ -99,6 +102,9 @@ class ClusterTracker {
 
  private:
   void Observe(Track* t, const ClusterObservation& o) const;
+  /// True when `t` is static and `o`'s box lies within its settled box grown
+  /// by static_motion: `o` is (a piece of) that obstacle seen in part.
+  bool InSettledBox(const Track& t, const ClusterObservation& o) const;
 
   TrackerParams params_;
   std::vector<Track> tracks_;

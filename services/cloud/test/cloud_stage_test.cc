@@ -326,5 +326,38 @@ TEST(ClusterTrackerTest, SettlesMovesAndIsLost) {
   EXPECT_THROW(ClusterTracker(TrackerParams{0}), std::invalid_argument);
 }
 
+// The arm in front of a static box splits what the camera sees of it in two
+// (the case `camera_only_cell_test`'s standing person met: the second piece
+// became a new, pending, so human, track 0.8 m from the person, judged at
+// the ISO speed, and the robot stopped). Both pieces are the box; a cluster
+// sticking out of its box (a hand over it) is not.
+TEST(ClusterTrackerTest, AStaticObstacleSplitInTwoByTheArmStaysOneStaticObstacle) {
+  TrackerParams p;
+  p.static_frames = 3;
+  ClusterTracker t(p);
+  for (int f = 0; f < 3; ++f) t.Update({Obs({0.5, 0, 0.1})}, f);  // box [0.45, 0.55] x [-0.05, 0.05] x [0.05, 0.15]
+  ASSERT_EQ(t.tracks().size(), 1u);
+  ASSERT_EQ(t.tracks()[0].cls, TrackClass::kStatic);
+  ClusterObservation left = Obs({0.47, 0, 0.1}), right = Obs({0.53, 0, 0.1});
+  left.box_min.x() = 0.45;
+  left.box_max.x() = 0.49;
+  right.box_min.x() = 0.51;
+  right.box_max.x() = 0.55;
+  const std::vector<int> idx = t.Update({left, right}, 3);
+  ASSERT_EQ(t.tracks().size(), 1u) << "a piece of the box started a track of its own";
+  EXPECT_EQ(idx, (std::vector<int>{0, 0}));
+  EXPECT_FALSE(t.IsHuman(t.tracks()[0]));
+  EXPECT_EQ(t.tracks()[0].cls, TrackClass::kStatic);
+  EXPECT_NEAR(t.tracks()[0].mean_min.x(), 0.45, 1e-12);  // the box as settled
+  EXPECT_NEAR(t.tracks()[0].mean_max.x(), 0.55, 1e-12);
+  // Beside the box's pieces, a cluster reaching 10 cm above it: a new track, human while pending.
+  ClusterObservation hand = Obs({0.5, 0, 0.2});
+  const std::vector<int> idx2 = t.Update({left, right, hand}, 4);
+  ASSERT_EQ(t.tracks().size(), 2u);
+  EXPECT_EQ(idx2[2], 1);
+  EXPECT_TRUE(t.IsHuman(t.tracks()[1]));
+  EXPECT_FALSE(t.IsHuman(t.tracks()[0]));
+}
+
 }  // namespace
 }  // namespace iplan::cloud_service
