@@ -145,14 +145,15 @@ Metrics Evaluate(const std::vector<Frame>& frames, const cloud_service::MotionPa
     const std::vector<int> part_of = tracker.Update(f.points, f.stamp_ns);
     points += f.points.size();
     for (std::size_t i = 0; i < f.points.size(); ++i) {
-      if (part_of[i] < 0 || !tracker.Tracked(tracker.parts()[static_cast<std::size_t>(part_of[i])])) continue;
-      const auto& part = tracker.parts()[static_cast<std::size_t>(part_of[i])];
+      if (part_of[i] < 0) continue;
+      const std::optional<cloud_service::PartVelocity> v = tracker.VelocityOf(static_cast<std::size_t>(part_of[i]));
+      if (!v) continue;
       const Eigen::Vector3d& u = f.u[i];
-      const double est = std::max(0.0, part.velocity().dot(u) + kSigmas * std::sqrt(u.dot(part.velocity_covariance() * u)));
+      const double est = std::max(0.0, v->velocity.dot(u) + kSigmas * std::sqrt(u.dot(v->covariance * u)));
       const double tru = f.v_true[i].dot(u);
       ++tracked;
       covered += tru <= est;
-      errors += (part.velocity() - f.v_true[i]).squaredNorm();
+      errors += (v->velocity - f.v_true[i]).squaredNorm();
       if (f.v_true[i].norm() >= kMoving) {
         ++moving;
         moving_covered += tru <= est;

@@ -107,10 +107,10 @@ void CloudStage::HumanPoints(const cloud::Cloud& cloud, const std::vector<int>& 
   const std::vector<int> part_of = motion_.Update(means, stamp_ns);
   std::vector<int> motion_of(motion_.parts().size(), -1);
   for (std::size_t k = 0; k < motion_.parts().size(); ++k) {
-    const MotionPart& part = motion_.parts()[k];
-    if (!motion_.Tracked(part)) continue;
+    const std::optional<PartVelocity> v = motion_.VelocityOf(k);
+    if (!v) continue;
     motion_of[k] = static_cast<int>(human.motions.size());
-    human.motions.push_back({part.velocity(), part.velocity_covariance(), part.id});
+    human.motions.push_back({v->velocity, v->covariance, motion_.parts()[k].id});
   }
   human.motion_of.assign(means.size(), -1);
   for (std::size_t i = 0; i < part_of.size(); ++i) {

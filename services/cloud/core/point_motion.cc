@@ -49,6 +49,27 @@ bool MotionTracker::Tracked(const MotionPart& part) const {
   return max_variance <= limit;
 }
 
+std::optional<PartVelocity> MotionTracker::VelocityOf(std::size_t k) const {
+  const MotionPart& part = parts_.at(k);
+  if (Tracked(part)) return PartVelocity{part.velocity(), part.velocity_covariance()};
+  const MotionPart* neighbour = NearestTracked(part.centre());
+  if (!neighbour) return std::nullopt;
+  return PartVelocity{neighbour->velocity(),
+                      neighbour->velocity_covariance() + params_.neighbour_speed_sigma *
+                                                             params_.neighbour_speed_sigma *
+                                                             Eigen::Matrix3d::Identity()};
+}
+
+const MotionPart* MotionTracker::NearestTracked(const Eigen::Vector3d& centre) const {
+  const MotionPart* neighbour = nullptr;
+  double nearest = 4 * params_.part_radius * params_.part_radius;  // two part radii, squared
+  for (const MotionPart& other : parts_) {
+    const double d = (other.centre() - centre).squaredNorm();
+    if (d <= nearest && other.measured >= 2 && Tracked(other)) nearest = d, neighbour = &other;
+  }
+  return neighbour;
+}
+
 // Constant velocity, continuous white-noise acceleration per axis (spectral
 // density q = acceleration_density): x' = F x, P' = F P F^T + Q with
 //   Q = q [dt^3/3  dt^2/2; dt^2/2  dt]
@@ -173,13 +194,7 @@ void MotionTracker::Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<in
     // its covariance grown by neighbour_speed_sigma per axis (what a part of
     // a body may move relative to the next), and counts as tracked when that
     // is within tracked_speed_sigma.
-    const MotionPart* neighbour = nullptr;
-    double nearest = 4 * r2;
-    for (const MotionPart& other : parts_) {
-      const double d = (other.centre() - centre).squaredNorm();
-      if (d <= nearest && other.measured >= 2 && Tracked(other)) nearest = d, neighbour = &other;
-    }
-    if (neighbour) {
+    if (const MotionPart* neighbour = NearestTracked(centre)) {
       part.x.tail<3>() = neighbour->velocity();
       part.P.bottomRightCorner<3, 3>() = neighbour->velocity_covariance() +
                                          params_.neighbour_speed_sigma * params_.neighbour_speed_sigma * Eigen::Matrix3d::Identity();

@@ -45,11 +45,18 @@
 //     coming out from behind the arm is tracked from its first frame, not
 //     judged at the ISO speed until its own filter has converged);
 //  5. parts unmeasured for more than lost_frames frames are dropped; of two
-//     parts closer than merge_distance the younger is dropped.
+//     parts closer than merge_distance the younger is dropped;
+//  6. a part that is not tracked (too few of its points seen this frame,
+//     its variance grown past the limit) but lies within two part radii of
+//     a tracked one is judged as a part seeded there would be: at that
+//     part's velocity with neighbour_speed_sigma more uncertainty
+//     (VelocityOf); only points with no tracked part near them are left to
+//     the ISO default speed.
 // Pure algorithm, no DDS types. Not thread-safe; allocates.
 #pragma once
 
 #include <cstdint>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -111,6 +118,13 @@ struct MotionPart {
   Eigen::Matrix3d velocity_covariance() const { return P.bottomRightCorner<3, 3>(); }
 };
 
+/// The velocity a part's points are judged at (m/s, W) and its covariance
+/// ((m/s)^2).
+struct PartVelocity {
+  Eigen::Vector3d velocity = Eigen::Vector3d::Zero();
+  Eigen::Matrix3d covariance = Eigen::Matrix3d::Zero();
+};
+
 class MotionTracker {
  public:
   /// Throws std::invalid_argument when params.Validate() fails.
@@ -127,6 +141,14 @@ class MotionTracker {
   /// most sqrt(tracked_speed_sigma^2 + neighbour_speed_sigma^2) (the
   /// neighbour's limit and the relative motion it was seeded with).
   bool Tracked(const MotionPart& part) const;
+  /// What the points of parts()[k] are judged at: its own velocity and
+  /// covariance when Tracked; otherwise, within two part radii of a tracked
+  /// part (the nearest), that part's velocity with its covariance grown by
+  /// neighbour_speed_sigma per axis, as a part is seeded there (a part of
+  /// the body whose own filter has lost track for a frame: too few of its
+  /// points seen, its variance grown past the limit); otherwise nullopt
+  /// (nothing tracked near it: the ISO default speed).
+  std::optional<PartVelocity> VelocityOf(std::size_t k) const;
 
  private:
   void Predict(double dt);
@@ -136,6 +158,9 @@ class MotionTracker {
   bool BallCentroid(const std::vector<Eigen::Vector3d>& p_W, const Eigen::Vector3d& centre, Eigen::Vector3d* m,
                     int* n) const;
   void Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<int>* part_of);
+  /// The tracked part (measured at least twice) nearest `centre` within two
+  /// part radii, or null.
+  const MotionPart* NearestTracked(const Eigen::Vector3d& centre) const;
   void Prune(std::vector<int>* part_of);
 
   MotionParams params_;

@@ -227,6 +227,55 @@ TEST(PointMotion, ARegionComingIntoViewNextToATrackedBodyIsTrackedAtOnce) {
   EXPECT_EQ(far_tracked, 0);
 }
 
+// A part of a tracked body whose own filter loses track (only 3 of its
+// points seen, fewer than min_points, for three frames: its velocity
+// variance grows past the limit) is judged at its tracked neighbour's
+// velocity with the relative motion allowed, as a part seeded there is, not
+// at the ISO speed; a blob with nothing tracked near it still is.
+TEST(PointMotion, APartThatLosesTrackNextToATrackedBodyIsJudgedAtItsNeighboursVelocity) {
+  const MotionParams params;
+  MotionTracker tracker{params};
+  std::mt19937 rng(13);
+  // The forearm beside the body: beyond the reach of the body part's ball, within two part radii of its centre.
+  const Eigen::Vector3d body(1.3, 0.0, 1.0), forearm = body + Eigen::Vector3d(0.37, 0.05, 0.0);
+  int64_t t = kStartNs;
+  for (int f = 0; f < 6; ++f, t += kFrameNs) {
+    std::vector<Eigen::Vector3d> pts = Blob(body, 0.15, &rng);
+    for (const Eigen::Vector3d& q : Blob(forearm, 0.05, &rng)) pts.push_back(q);
+    tracker.Update(pts, t);
+  }
+  std::vector<Eigen::Vector3d> pts;
+  std::vector<int> part_of;
+  for (int f = 0; f < params.lost_frames; ++f, t += kFrameNs) {
+    pts = Blob(body, 0.15, &rng);
+    const std::size_t body_points = pts.size();
+    const std::vector<Eigen::Vector3d> arm = Blob(forearm, 0.05, &rng);
+    pts.insert(pts.end(), arm.begin(), arm.begin() + 3);
+    pts.push_back(body + Eigen::Vector3d(0.0, -1.0, 0.0));  // far from everything
+    part_of = tracker.Update(pts, t);
+    ASSERT_EQ(part_of.size(), body_points + 4);
+  }
+  int judged_by_neighbour = 0;
+  for (std::size_t i = pts.size() - 4; i + 1 < pts.size(); ++i) {
+    ASSERT_GE(part_of[i], 0);
+    const std::size_t k = static_cast<std::size_t>(part_of[i]);
+    const MotionPart& p = tracker.parts()[k];
+    const std::optional<PartVelocity> v = tracker.VelocityOf(k);
+    ASSERT_TRUE(v.has_value()) << "a forearm point next to the tracked body is left to the ISO speed";
+    if (tracker.Tracked(p)) continue;
+    ++judged_by_neighbour;
+    EXPECT_GT(p.unseen, 0);
+    EXPECT_LT(v->velocity.norm(), 0.1);
+    const double extra = params.neighbour_speed_sigma * params.neighbour_speed_sigma;
+    EXPECT_GE(v->covariance.diagonal().minCoeff(), extra);
+    // The neighbour's own variance, no more: below the part's grown own one.
+    EXPECT_LT(v->covariance.trace() - 3 * extra, p.velocity_covariance().trace());
+  }
+  EXPECT_GT(judged_by_neighbour, 0) << "the forearm's part stayed tracked: the test shows nothing";
+  const std::size_t far = static_cast<std::size_t>(part_of.back());
+  EXPECT_FALSE(tracker.VelocityOf(far).has_value());
+}
+
 TEST(PointMotion, ParametersAreChecked) {
   MotionParams p;
   p.part_radius = 0;
