@@ -44,6 +44,9 @@ using Clock = std::chrono::steady_clock;
 using SI = const dds::SampleInfo&;
 
 const std::vector<double>& kReady = kPandaReady;
+// Standard deviations of a point's measured speed that collision risk and
+// trajopt add to it: the camera-only cell of `iplan demo --sensor depth-only`.
+const char* const kSpeedSigmas = "1";
 
 // The scripted person: the demo cell's synthetic person doing `action`,
 // moved by offset(t) (m, W) as a whole.
@@ -126,9 +129,13 @@ class CameraOnlyCell {
     const framework::Result r = depth_.Configure(section, s.depth, node);
     EXPECT_TRUE(r.ok) << r.reason;
     cell_.Start("robot_sim", {"--set", "robot_sim.permits.monitors=[iplan-collision_risk]"});
-    // The measured point speeds (off by default: docs/perception-clouds.md, "Not done (issue 29)").
-    cell_.Start("collision_risk", {"--set", "collision_risk.human_points.tracked_speeds=true"});
-    cell_.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--set", "trajopt.human_points.tracked_speeds=true"});
+    // The measured point speeds at the sigmas of `iplan demo --sensor depth-only` (kDepthOnlySpeedSigmas in
+    // tools/iplan/cmd_dds_demo.cc; off by default: docs/perception-clouds.md, "Not done (issue 29)").
+    cell_.Start("collision_risk", {"--set", "collision_risk.human_points.tracked_speeds=true", "--set",
+                                   "collision_risk.human_points.speed_sigmas=" + std::string(kSpeedSigmas)});
+    cell_.Start("trajopt", {"--set", "node.entitled_writers./iplan/task/command=[test_cell]", "--set",
+                            "trajopt.human_points.tracked_speeds=true", "--set",
+                            "trajopt.human_points.speed_sigmas=" + std::string(kSpeedSigmas)});
     cell_.Start("cloud", {"--set", "cloud.noise.focal_px=262.5"});
     start_ = Clock::now();
     depth_.Activate(node, [this] { return std::vector<std::vector<perception::JointSample>>{person_.At(Since())}; });
@@ -147,6 +154,14 @@ class CameraOnlyCell {
       tc_.node->SpinOnce(5ms);
       const bool tracked = run.last_points > 50 && run.last_tracked >= 0.8 * run.last_points;
       if (tracked && !run.risks.empty() && run.risks.back().r.verdict != msg::CollisionRisk::PROTECTIVE_STOP) return true;
+    }
+    return false;
+  }
+  // Spins until joint `j` moves at `speed` rad/s or faster (true), or until t_max (false).
+  bool SpinUntilMoving(std::size_t j, double speed, double t_max) {
+    while (Since() < t_max) {
+      tc_.node->SpinOnce(5ms);
+      if (!run.states.empty() && run.states.back().qd.size() > j && std::abs(run.states.back().qd[j]) >= speed) return true;
     }
     return false;
   }
@@ -315,7 +330,7 @@ TEST_P(CameraOnlyCellTest, APersonStandingAtTheTableSeenOnlyByTheCameraSlowsTheR
 // The person stands 4 s at the far end of the camera's workspace (torso at
 // x = 1.75 m), then walks at 1.5 m/s (0.1 s ramps) 0.9 m towards the robot,
 // stays 3 s and walks back; the robot is sent, as they set off, to where
-// their hand ends up.
+// their hand ends up; they set off once the arm moves.
 constexpr double kWalkStart = 0.0, kWalk = 0.9, kWalkSpeed = 1.5, kStay = 3.0;  // s after the command, m, m/s, s
 double WalkOffset(double s) {
   const double T = kWalk / kWalkSpeed;  // 0.6 s
@@ -335,7 +350,12 @@ TEST_P(CameraOnlyCellTest, APersonWalkingFastAtTheRobotIsStoppedBeforeContact) {
   // The goal: the arm reaching towards the person, its hand where theirs ends up.
   const std::vector<double> goal = {0.0, 0.45, 0.0, -1.45, 0.0, 1.9, 0.8};
   cell.Command(200, goal);
-  walk_from = cell.Since() + 0.3;  // the arm is on its way when they set off
+  // They set off once the arm is on its way (joint 2 at 0.15 rad/s): with a
+  // fixed delay after the command, the arm was sometimes still at rest
+  // (planning on a loaded host), and an arm at rest has nothing to stop.
+  const double t_command = cell.Since();
+  ASSERT_TRUE(cell.SpinUntilMoving(1, 0.15, t_command + 5.0)) << "the arm did not set off in 5 s; " << cell.run.Summary();
+  walk_from = cell.Since();
   const double t_walk = walk_from;
   cell.SpinUntil(t_walk + 0.6 + kStay + 2.0);
   cell.Stop();
