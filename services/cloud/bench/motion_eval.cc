@@ -21,6 +21,7 @@
 // on fold B.
 //
 //   build/bench/motion_eval [seconds per fold, default 26] [speed_sigmas, default 2]
+//                           [camera rate Hz, default 10] [image scale, default 1; 0.5: 320x240]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -39,7 +40,8 @@
 namespace {
 
 using namespace iplan;
-constexpr double kRate = 10.0;     // Hz, the shipped camera rate
+double kRate = 10.0;   // Hz, the camera rate (third argument; the shipped 10)
+double kScale = 1.0;   // image size over the shipped 640x480 (fourth argument: 0.5 is QVGA)
 double kSigmas = 2.0;  // collision risk's speed_sigmas (second argument)
 constexpr double kCoverage = 0.975;
 
@@ -77,6 +79,13 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
   perception::SyntheticPerson person(pp);
   person.StartScript(0);
   perception::DepthCameraParams cam_params = ps.depth.simulated.Camera();
+  cloud::CameraIntrinsics& k = cam_params.intrinsics;
+  k.width = static_cast<int>(std::lround(k.width * kScale));
+  k.height = static_cast<int>(std::lround(k.height * kScale));
+  k.fx *= kScale, k.fy *= kScale;
+  k.cx = (k.cx + 0.5) * kScale - 0.5, k.cy = (k.cy + 0.5) * kScale - 0.5;
+  cam_params.noise.focal_px *= kScale;
+  stage_params.noise.focal_px *= kScale;
   perception::SimulatedDepthCamera camera(cam_params);
   const collision::HumanBodyModel body(collision::LoadHumanBodyParams(Cfg("humans/upper_body.yaml")));
   const collision::RobotModel robot = collision::LoadRobotModelFromYaml(Cfg("robots/panda.yaml"));
@@ -185,7 +194,14 @@ void Print(const char* what, double a, double m, const Metrics& r) {
 int main(int argc, char** argv) {
   const double seconds = argc > 1 ? std::atof(argv[1]) : 26.0;
   if (argc > 2) kSigmas = std::atof(argv[2]);
-  std::printf("recording two folds of %.0f s at %.0f Hz; v_h with %.1f standard deviations ...\n", seconds, kRate, kSigmas);
+  if (argc > 3) kRate = std::atof(argv[3]);
+  if (argc > 4) kScale = std::atof(argv[4]);
+  if (!(kRate > 0 && kScale > 0)) {
+    std::fprintf(stderr, "usage: motion_eval [seconds per fold] [speed_sigmas] [camera Hz, > 0] [image scale, > 0]\n");
+    return 2;
+  }
+  std::printf("recording two folds of %.0f s at %.0f Hz, %dx%d; v_h with %.1f standard deviations ...\n", seconds, kRate,
+              static_cast<int>(std::lround(640 * kScale)), static_cast<int>(std::lround(480 * kScale)), kSigmas);
   // Each fold: the demo's person, and a faster one (reaches of 1.2 s, peak
   // hand speed about 1 m/s; fold B 1.0 s): the filter must follow a quick
   // reach, not only the demo's 3 s ones.
