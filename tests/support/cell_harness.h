@@ -64,7 +64,9 @@ class CellHarness {
   CellHarness(const std::string& tag, dds::Vendor vendor, int domain_offset, const std::string& security_dir = "",
               bool with_intent = true)
       : vendor_(vendor), domain_(UniqueDomain(domain_offset)), security_(security_dir) {
-    dir_ = std::filesystem::temp_directory_path() / ("iplan-" + tag + "-" + std::to_string(getpid()));
+    // Per vendor: a test's second vendor must not delete the logs its first one kept.
+    dir_ = std::filesystem::temp_directory_path() /
+           ("iplan-" + tag + "-" + dds::ToString(vendor) + "-" + std::to_string(getpid()));
     std::filesystem::remove_all(dir_);
     std::filesystem::create_directories(dir_);
     config_dir_ = std::string(IPLAN_SOURCE_DIR) + "/config";
