@@ -54,10 +54,12 @@ std::optional<PartVelocity> MotionTracker::VelocityOf(std::size_t k) const {
   if (Tracked(part)) return PartVelocity{part.velocity(), part.velocity_covariance()};
   const MotionPart* neighbour = NearestTracked(part.centre());
   if (!neighbour) return std::nullopt;
-  return PartVelocity{neighbour->velocity(),
-                      neighbour->velocity_covariance() + params_.neighbour_speed_sigma *
-                                                             params_.neighbour_speed_sigma *
-                                                             Eigen::Matrix3d::Identity()};
+  return NextTo(*neighbour);
+}
+
+PartVelocity MotionTracker::NextTo(const MotionPart& neighbour) const {
+  const double s2 = params_.neighbour_speed_sigma * params_.neighbour_speed_sigma;
+  return PartVelocity{neighbour.velocity(), neighbour.velocity_covariance() + s2 * Eigen::Matrix3d::Identity()};
 }
 
 const MotionPart* MotionTracker::NearestTracked(const Eigen::Vector3d& centre) const {
@@ -65,7 +67,7 @@ const MotionPart* MotionTracker::NearestTracked(const Eigen::Vector3d& centre) c
   double nearest = 4 * params_.part_radius * params_.part_radius;  // two part radii, squared
   for (const MotionPart& other : parts_) {
     const double d = (other.centre() - centre).squaredNorm();
-    if (d <= nearest && other.measured >= 2 && Tracked(other)) nearest = d, neighbour = &other;
+    if (d <= nearest && Tracked(other)) nearest = d, neighbour = &other;
   }
   return neighbour;
 }
@@ -195,9 +197,9 @@ void MotionTracker::Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<in
     // a body may move relative to the next), and counts as tracked when that
     // is within tracked_speed_sigma.
     if (const MotionPart* neighbour = NearestTracked(centre)) {
-      part.x.tail<3>() = neighbour->velocity();
-      part.P.bottomRightCorner<3, 3>() = neighbour->velocity_covariance() +
-                                         params_.neighbour_speed_sigma * params_.neighbour_speed_sigma * Eigen::Matrix3d::Identity();
+      const PartVelocity v = NextTo(*neighbour);
+      part.x.tail<3>() = v.velocity;
+      part.P.bottomRightCorner<3, 3>() = v.covariance;
       part.measured = 2;
       part.from_neighbour = true;
     }

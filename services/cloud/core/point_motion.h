@@ -158,9 +158,12 @@ class MotionTracker {
   bool BallCentroid(const std::vector<Eigen::Vector3d>& p_W, const Eigen::Vector3d& centre, Eigen::Vector3d* m,
                     int* n) const;
   void Seed(const std::vector<Eigen::Vector3d>& p_W, std::vector<int>* part_of);
-  /// The tracked part (measured at least twice) nearest `centre` within two
-  /// part radii, or null.
+  /// The tracked part nearest `centre` within two part radii, or null.
   const MotionPart* NearestTracked(const Eigen::Vector3d& centre) const;
+  /// A part next to `neighbour`: its velocity, its covariance grown by
+  /// neighbour_speed_sigma per axis (what one part of a body may move
+  /// relative to the next).
+  PartVelocity NextTo(const MotionPart& neighbour) const;
   void Prune(std::vector<int>* part_of);
 
   MotionParams params_;
