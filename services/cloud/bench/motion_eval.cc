@@ -30,6 +30,8 @@
 //                           [camera rate Hz, default 10] [image scale, default 1; 0.5: 320x240]
 //                           [robot, default 0: at its ready pose; 1: at the hand-over goal;
 //                            2: from one to the other and back every 4 s]
+//                           [person, default 0: as scripted; 1: frozen at each fold's first pose
+//                            (every point truly still: what the filter gives a person at rest)]
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -48,11 +50,17 @@
 namespace {
 
 using namespace iplan;
-double kRate = 10.0;   // Hz, the camera rate (third argument; the shipped 10)
-double kScale = 1.0;   // image size over the shipped 640x480 (fourth argument: 0.5 is QVGA)
-double kSigmas = 2.0;  // collision risk's speed_sigmas (second argument)
-int kRobot = 0;        // 0: at its ready pose; 1: at the hand-over goal; 2: between the two (fifth argument)
 constexpr double kRobotPeriod = 4.0;  // s, ready -> hand-over -> ready
+
+// The command line (file comment).
+struct Options {
+  double seconds = 26.0;  // s per fold
+  double sigmas = 2.0;    // collision risk's speed_sigmas
+  double rate = 10.0;     // Hz, the camera rate (the shipped 10)
+  double scale = 1.0;     // image size over the shipped 640x480 (0.5 is QVGA)
+  int robot = 0;          // 0: at its ready pose; 1: at the hand-over goal; 2: between the two
+  bool frozen = false;    // the person held still at the fold's first pose
+};
 constexpr double kCoverage = 0.975;
 
 std::string Cfg(const std::string& f) { return std::string(IPLAN_SOURCE_DIR) + "/config/" + f; }
@@ -77,20 +85,31 @@ struct Metrics {
 };
 constexpr double kMoving = 0.2;  // m/s
 
-// The robot's joint positions (rad) at time t (s), as kRobot says.
-Eigen::VectorXd RobotAt(double t) {
+// The robot's joint positions (rad) at time t (s), as `robot` says (Options).
+Eigen::VectorXd RobotAt(int robot, double t) {
   const Eigen::VectorXd ready = (Eigen::VectorXd(7) << 0.0, -0.785, 0.0, -2.356, 0.0, 1.571, 0.785).finished();
   // config/tasks/table_top.yaml's hand_over goal: the tool over the table, towards the person.
   const Eigen::VectorXd hand_over = (Eigen::VectorXd(7) << -0.274, 0.417, 0.0, -1.68, 0.0, 2.097, 0.8).finished();
-  if (kRobot == 0) return ready;
-  if (kRobot == 1) return hand_over;
+  if (robot == 0) return ready;
+  if (robot == 1) return hand_over;
   const double s = 0.5 - 0.5 * std::cos(2 * M_PI * t / kRobotPeriod);  // ready -> hand_over -> ready
   return ready + s * (hand_over - ready);
 }
 
+// The camera with its image `scale` times the shipped size (the same field of view).
+perception::DepthCameraParams Scaled(perception::DepthCameraParams cam, double scale) {
+  cloud::CameraIntrinsics& k = cam.intrinsics;
+  k.width = static_cast<int>(std::lround(k.width * scale));
+  k.height = static_cast<int>(std::lround(k.height * scale));
+  k.fx *= scale, k.fy *= scale;
+  k.cx = (k.cx + 0.5) * scale - 0.5, k.cy = (k.cy + 0.5) * scale - 0.5;
+  cam.noise.focal_px *= scale;
+  return cam;
+}
+
 // `seconds` of the script from `t0`, every action's period times `pace`
 // (< 1: a faster person).
-std::vector<Frame> Record(double t0, double seconds, double pace) {
+std::vector<Frame> Record(const Options& o, double t0, double pace) {
   cloud_service::CloudSettings cloud_settings;
   framework::ServiceFile(Cfg("cloud.yaml")).ReadSection("cloud", &cloud_settings).Finish();
   cloud_service::CloudStageParams stage_params = cloud_settings.StageParams();
@@ -102,15 +121,8 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
   for (auto& a : pp.actions) a.period *= pace;
   perception::SyntheticPerson person(pp);
   person.StartScript(0);
-  perception::DepthCameraParams cam_params = ps.depth.simulated.Camera();
-  cloud::CameraIntrinsics& k = cam_params.intrinsics;
-  k.width = static_cast<int>(std::lround(k.width * kScale));
-  k.height = static_cast<int>(std::lround(k.height * kScale));
-  k.fx *= kScale, k.fy *= kScale;
-  k.cx = (k.cx + 0.5) * kScale - 0.5, k.cy = (k.cy + 0.5) * kScale - 0.5;
-  cam_params.noise.focal_px *= kScale;
-  stage_params.noise.focal_px *= kScale;
-  perception::SimulatedDepthCamera camera(cam_params);
+  perception::SimulatedDepthCamera camera(Scaled(ps.depth.simulated.Camera(), o.scale));
+  stage_params.noise.focal_px *= o.scale;
   const collision::HumanBodyModel body(collision::LoadHumanBodyParams(Cfg("humans/upper_body.yaml")));
   const collision::RobotModel robot = collision::LoadRobotModelFromYaml(Cfg("robots/panda.yaml"));
   collision::RobotData data(robot);
@@ -133,11 +145,12 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
   cloud_service::CloudStage stage(stage_params, &robot);
   std::vector<Frame> frames;
   cloud::Cloud cloud;
-  const int n = static_cast<int>(seconds * kRate);
+  const int n = static_cast<int>(o.seconds * o.rate);
   for (int f = 0; f < n; ++f) {
-    const double t = t0 + f / kRate;
-    const auto c = centres(t), before = centres(t - 0.005), after = centres(t + 0.005);
-    const Eigen::VectorXd q = RobotAt(t);
+    const double t = t0 + f / o.rate;
+    const double t_person = o.frozen ? t0 : t;
+    const auto c = centres(t_person), before = centres(t_person - 0.005), after = centres(t_person + 0.005);
+    const Eigen::VectorXd q = RobotAt(o.robot, t);
     collision::CalcForwardKinematics(robot, q, &data);
     perception::DepthScene scene = fixed;
     for (std::size_t k = 0; k < robot.spheres.size(); ++k)
@@ -162,7 +175,7 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
         if (e < dr) dr = e, near = k;
       }
       fr.points.push_back(mean);
-      fr.v_true.push_back((after[best] - before[best]) / 0.01);
+      fr.v_true.push_back(o.frozen ? Eigen::Vector3d::Zero() : Eigen::Vector3d((after[best] - before[best]) / 0.01));
       fr.u.push_back((data.p_WS.col(near) - mean).normalized());
     }
     frames.push_back(std::move(fr));
@@ -170,7 +183,7 @@ std::vector<Frame> Record(double t0, double seconds, double pace) {
   return frames;
 }
 
-Metrics Evaluate(const std::vector<Frame>& frames, const cloud_service::MotionParams& params) {
+Metrics Evaluate(const std::vector<Frame>& frames, const cloud_service::MotionParams& params, double sigmas) {
   cloud_service::MotionTracker tracker(params);
   std::size_t points = 0, tracked = 0, covered = 0, moving = 0, moving_covered = 0, still = 0;
   double still_v_h = 0, errors = 0, still_errors = 0;
@@ -183,7 +196,7 @@ Metrics Evaluate(const std::vector<Frame>& frames, const cloud_service::MotionPa
       const std::optional<cloud_service::PartVelocity> v = tracker.VelocityOf(static_cast<std::size_t>(part_of[i]));
       if (!v) continue;
       const Eigen::Vector3d& u = f.u[i];
-      const double est = std::max(0.0, v->velocity.dot(u) + kSigmas * std::sqrt(u.dot(v->covariance * u)));
+      const double est = std::max(0.0, v->velocity.dot(u) + sigmas * std::sqrt(u.dot(v->covariance * u)));
       const double tru = f.v_true[i].dot(u);
       ++tracked;
       covered += tru <= est;
@@ -230,29 +243,32 @@ void Print(const char* what, double a, double m, const Metrics& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  const double seconds = argc > 1 ? std::atof(argv[1]) : 26.0;
-  if (argc > 2) kSigmas = std::atof(argv[2]);
-  if (argc > 3) kRate = std::atof(argv[3]);
-  if (argc > 4) kScale = std::atof(argv[4]);
-  if (argc > 5) kRobot = std::atoi(argv[5]);
-  if (!(kRate > 0 && kScale > 0 && kRobot >= 0 && kRobot <= 2)) {
+  Options o;
+  if (argc > 1) o.seconds = std::atof(argv[1]);
+  if (argc > 2) o.sigmas = std::atof(argv[2]);
+  if (argc > 3) o.rate = std::atof(argv[3]);
+  if (argc > 4) o.scale = std::atof(argv[4]);
+  if (argc > 5) o.robot = std::atoi(argv[5]);
+  if (argc > 6) o.frozen = std::atoi(argv[6]) != 0;
+  if (!(o.seconds > 0 && o.sigmas >= 0 && o.rate > 0 && o.scale > 0 && o.robot >= 0 && o.robot <= 2)) {
     std::fprintf(stderr,
-                 "usage: motion_eval [seconds per fold] [speed_sigmas] [camera Hz, > 0] [image scale, > 0] [robot: 0 ready, "
-                 "1 hand-over, 2 moving]\n");
+                 "usage: motion_eval [seconds per fold, > 0] [speed_sigmas, >= 0] [camera Hz, > 0] [image scale, > 0] "
+                 "[robot: 0 ready, 1 hand-over, 2 moving] [person: 0 as scripted, 1 frozen]\n");
     return 2;
   }
-  std::printf("recording two folds of %.0f s at %.0f Hz, %dx%d; v_h with %.1f standard deviations ...\n", seconds, kRate,
-              static_cast<int>(std::lround(640 * kScale)), static_cast<int>(std::lround(480 * kScale)), kSigmas);
+  std::printf("recording two folds of %.0f s at %.0f Hz, %dx%d; v_h with %.1f standard deviations%s ...\n", o.seconds,
+              o.rate, static_cast<int>(std::lround(640 * o.scale)), static_cast<int>(std::lround(480 * o.scale)), o.sigmas,
+              o.frozen ? "; the person frozen" : "");
   // Each fold: the demo's person, and a faster one (reaches of 1.2 s, peak
   // hand speed about 1 m/s; fold B 1.0 s): the filter must follow a quick
   // reach, not only the demo's 3 s ones.
-  std::vector<Frame> a = Record(0.0, seconds, 1.0), b = Record(seconds, seconds, 1.0);
-  for (Frame& f : Record(0.0, seconds, 0.4)) a.push_back(std::move(f));
-  for (Frame& f : Record(seconds, seconds, 1.0 / 3.0)) b.push_back(std::move(f));
+  std::vector<Frame> a = Record(o, 0.0, 1.0), b = Record(o, o.seconds, 1.0);
+  for (Frame& f : Record(o, 0.0, 0.4)) a.push_back(std::move(f));
+  for (Frame& f : Record(o, o.seconds, 1.0 / 3.0)) b.push_back(std::move(f));
   // Stamps run on: the second half of a fold starts 10 s after the first ends (the tracker starts afresh).
   for (std::vector<Frame>* fold : {&a, &b}) {
     for (std::size_t i = fold->size() / 2; i < fold->size(); ++i)
-      (*fold)[i].stamp_ns += static_cast<int64_t>((seconds + 10.0) * 1e9);
+      (*fold)[i].stamp_ns += static_cast<int64_t>((o.seconds + 10.0) * 1e9);
   }
   std::printf(
       "fold      acc_q meas_s | tracked | covered | moving, covered, shortfall p95 | still v_h mean p95 | rms err all still "
@@ -266,7 +282,7 @@ int main(int argc, char** argv) {
       cloud_service::MotionParams p = defaults;
       p.acceleration_density = acc;
       p.measurement_sigma = meas;
-      const Metrics r = Evaluate(a, p);
+      const Metrics r = Evaluate(a, p, o.sigmas);
       Print("A", acc, meas, r);
       const bool ok = r.tracked >= 0.9 && r.moving_coverage >= kCoverage && r.coverage >= kCoverage;
       if ((ok && (!met || r.still_v_h < best)) || (!met && !ok && r.tracked >= 0.9 && r.moving_coverage > best_coverage)) {
@@ -281,15 +297,15 @@ int main(int argc, char** argv) {
               chosen.measurement_sigma,
               met ? "the smallest v_h of still points with >= 90 % tracked and >= 97.5 % covered, moving and all"
                   : "no setting reaches 97.5 % of the moving points covered with >= 90 % tracked: the best coverage");
-  Print("B chosen", chosen.acceleration_density, chosen.measurement_sigma, Evaluate(b, chosen));
-  Print("B default", defaults.acceleration_density, defaults.measurement_sigma, Evaluate(b, defaults));
+  Print("B chosen", chosen.acceleration_density, chosen.measurement_sigma, Evaluate(b, chosen, o.sigmas));
+  Print("B default", defaults.acceleration_density, defaults.measurement_sigma, Evaluate(b, defaults, o.sigmas));
   // The whole grid on fold B too, for what each setting costs on data it was
   // not chosen on (a risk assessment may pick another trade than the rule
   // above; docs/perception-clouds.md).
   for (double acc : {0.1, 0.4, 0.9, 1.6}) {
     cloud_service::MotionParams p = defaults;
     p.acceleration_density = acc;
-    Print("B", acc, p.measurement_sigma, Evaluate(b, p));
+    Print("B", acc, p.measurement_sigma, Evaluate(b, p, o.sigmas));
   }
   return 0;
 }
