@@ -1,5 +1,6 @@
-// iplan-cloud: the depth camera's clouds (/iplan/depth/points, sensor frame)
-// into typed outputs in the cell frame: static unknown obstacles as boxes
+// iplan-cloud: the depth camera's clouds (/iplan/depth/points, sensor frame;
+// or its depth images, /iplan/depth/image, unprojected with the camera's
+// intrinsics) into typed outputs in the cell frame: static unknown obstacles as boxes
 // (/iplan/obstacles, stable ids) and the points of moving objects, people,
 // with the sensor's noise covariance (/iplan/human/points). The stage
 // (core/cloud_stage.h): workspace crop, robot self-filter from
@@ -60,6 +61,11 @@ class CloudService : public framework::Service {
                    std::function<void(const msg::PointCloud2&, SI)>([this, &node](const msg::PointCloud2& m, SI) {
                      OnCloud(node, m);
                    }));
+    intrinsics_ = settings.intrinsics;
+    node.Subscribe(framework::topics::DepthImage(),
+                   std::function<void(const msg::Image&, SI)>([this, &node](const msg::Image& m, SI) {
+                     OnImage(node, m);
+                   }));
     node.SetDiagnosticValue("self_filter", joint_names_.empty() ? "off (no robot)" : "waiting for joint states");
     return Result::Ok();
   }
@@ -111,7 +117,21 @@ class CloudService : public framework::Service {
   void OnCloud(Node& node, const msg::PointCloud2& m) {
     const auto t0 = std::chrono::steady_clock::now();
     if (node.CountRejection("depth_points", services::FromPointCloud2(m, &cloud_))) return;
-    const int64_t stamp = msg::ToNanoseconds(m.header.stamp);
+    Process(node, m.header.stamp, t0);
+  }
+
+  // A depth image, unprojected with the camera's intrinsics into the
+  // organised cloud a PointCloud2 would have carried.
+  void OnImage(Node& node, const msg::Image& m) {
+    const auto t0 = std::chrono::steady_clock::now();
+    if (node.CountRejection("depth_image", services::FromDepthImage(m, intrinsics_, &cloud_))) return;
+    node.SetDiagnosticValue("depth_images", std::to_string(++images_));
+    Process(node, m.header.stamp, t0);
+  }
+
+  // cloud_ (the sensor's frame) taken at `header_stamp`, received at t0.
+  void Process(Node& node, const msg::Time& header_stamp, std::chrono::steady_clock::time_point t0) {
+    const int64_t stamp = msg::ToNanoseconds(header_stamp);
     // The robot's pose when the cloud was taken: the nearest joint state, if
     // near enough; otherwise no self-filter (the robot's own points then
     // count as a person: cautious, and reported).
@@ -135,7 +155,7 @@ class CloudService : public framework::Service {
         if (std::optional<Eigen::VectorXd> qa = PoseAt(t, false)) around.push_back(std::move(*qa));
     }
     const StageOutput out = stage_->Process(&cloud_, q, stamp, around);
-    Publish(node, m.header.stamp, out);
+    Publish(node, header_stamp, out);
     ++processed_;
     node.SetDiagnosticValue("clouds", std::to_string(processed_));
     node.SetDiagnosticValue("obstacles", std::to_string(out.obstacles.size()));
@@ -168,6 +188,8 @@ class CloudService : public framework::Service {
   double joint_state_timeout_ = 0.2;
   int64_t self_filter_ns_ = 0;
   std::string frame_id_ = "world";
+  cloud::CameraIntrinsics intrinsics_;
+  uint64_t images_ = 0;  // depth images unprojected (of the clouds processed)
   cloud::Cloud cloud_;
   msg::ObstacleArray obstacles_;
   msg::HumanPoints human_;

@@ -20,6 +20,7 @@ struct DepthSource::Impl {
   std::string provider = "none";
   double rate_hz = 30;
   std::string frame_id = "depth_camera";
+  bool image = false;  // transport image: a depth image instead of the cloud
   // simulated
   std::unique_ptr<SimulatedDepthCamera> camera;
   DepthScene fixed;  // the scene files' objects
@@ -39,10 +40,12 @@ struct DepthSource::Impl {
 
   TruthFn truth;
   dds::Writer<msg::PointCloud2>* writer = nullptr;
+  dds::Writer<msg::Image>* image_writer = nullptr;
   int timer = 0;
   uint64_t published = 0;
   cloud::Cloud cloud;
   msg::PointCloud2 message;
+  msg::Image image_message;
   double render_ms_sum = 0;
 
   framework::Result ConfigureSimulated(const framework::ConfigSection& config, const SimulatedDepthSettings& sim);
@@ -64,11 +67,16 @@ framework::Result DepthSource::Configure(const framework::ConfigSection& config,
   s.provider = settings.provider;
   s.rate_hz = settings.rate_hz;
   s.frame_id = settings.frame_id;
+  s.image = settings.transport == "image";
   framework::Result r = framework::Result::Ok();
   if (s.provider == "simulated") r = s.ConfigureSimulated(config, settings.simulated);
   if (s.provider == "pcd") r = s.ConfigurePcd(config, settings.pcd);
   if (!r.ok || s.provider == "none") return r;
-  s.writer = &node.Advertise(framework::topics::DepthPoints());
+  if (s.image) {
+    s.image_writer = &node.Advertise(framework::topics::DepthImage());
+  } else {
+    s.writer = &node.Advertise(framework::topics::DepthPoints());
+  }
   if (s.provider == "simulated" && s.robot) {
     using SI = const dds::SampleInfo&;
     node.Subscribe(framework::topics::JointStates(),
@@ -214,9 +222,14 @@ void DepthSource::Impl::Tick(framework::Node& node) {
   const auto t0 = std::chrono::steady_clock::now();
   if (!Produce(node)) return;
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  services::ToPointCloud2(cloud, msg::Now(), frame_id, &message);
   std::string err;
-  if (!writer->Write(message, &err)) node.log().warn("cloud not published: {}", err);
+  if (image) {
+    services::ToDepthImage(cloud, msg::Now(), frame_id, &image_message);
+    if (!image_writer->Write(image_message, &err)) node.log().warn("depth image not published: {}", err);
+  } else {
+    services::ToPointCloud2(cloud, msg::Now(), frame_id, &message);
+    if (!writer->Write(message, &err)) node.log().warn("cloud not published: {}", err);
+  }
   ++published;
   render_ms_sum += ms;
   node.SetDiagnosticValue("clouds_published", std::to_string(published));

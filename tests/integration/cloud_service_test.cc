@@ -97,11 +97,21 @@ void CheckHumanPoints(const std::vector<msg::HumanPoints>& points, const std::ve
   EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
 }
 
-class CloudPathTest : public ::testing::TestWithParam<dds::Vendor> {};
+// The camera's frames as clouds (PointCloud2) or as depth images (16UC1,
+// unprojected by the cloud service with cloud.yaml's intrinsics): the same
+// obstacles and human points must come out.
+struct CloudPathCase {
+  dds::Vendor vendor;
+  std::string transport;  // perception.depth.transport
+};
+
+class CloudPathTest : public ::testing::TestWithParam<CloudPathCase> {};
 
 TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
-  const dds::Vendor vendor = GetParam();
-  CellHarness cell("cloud-path", vendor, vendor == dds::Vendor::kCyclone ? 41 : 42, "", /*with_intent=*/false);
+  const dds::Vendor vendor = GetParam().vendor;
+  const std::string transport = GetParam().transport;
+  CellHarness cell("cloud-path-" + transport, vendor, vendor == dds::Vendor::kCyclone ? 41 : 42, "",
+                   /*with_intent=*/false);
   ASSERT_TRUE(cell.ready());
   // A box left on the table, besides the cell's parts bin.
   const Eigen::Vector3d box_centre(0.75, -0.2, 0.075), box_size(0.15, 0.15, 0.15);
@@ -134,7 +144,8 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
               }), any);
   cell.Start("robot_sim");
   cell.Start("perception", {"--set", "perception.synthetic.start=loop", "--set", "perception.depth.provider=simulated",
-                            "--set", "perception.depth.rate_hz=10", "--set",
+                            "--set", "perception.depth.rate_hz=10", "--set", "perception.depth.transport=" + transport,
+                            "--set",
                             "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"});
   cell.Start("cloud");
   // Clouds may come before the robot's joint states are matched (DDS
@@ -156,11 +167,25 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
   cell.SpinUntil([&] { return cell.DiagNumber("cloud", "clouds") > 50; }, std::chrono::seconds(3));
   EXPECT_GT(cell.DiagNumber("cloud", "clouds"), 50);
   EXPECT_EQ(cell.DiagNumber("cloud", "clouds_without_self_filter", -1), unfiltered_at_start);
+  // The frames came the way asked: all of them as images, or none.
+  if (transport == "image") {
+    EXPECT_EQ(cell.DiagNumber("cloud", "depth_images", 0), cell.DiagNumber("cloud", "clouds"));
+  } else {
+    EXPECT_EQ(cell.DiagNumber("cloud", "depth_images", 0), 0);
+  }
+  EXPECT_EQ(cell.DiagNumber("cloud", "rejected_inputs/depth_image", 0), 0);
+  EXPECT_EQ(cell.DiagNumber("cloud", "rejected_inputs/depth_points", 0), 0);
   cell.Stop();
 }
 
-INSTANTIATE_TEST_SUITE_P(BothVendors, CloudPathTest, ::testing::Values(dds::Vendor::kCyclone, dds::Vendor::kFastDds),
-                         [](const ::testing::TestParamInfo<dds::Vendor>& i) { return dds::ToString(i.param); });
+INSTANTIATE_TEST_SUITE_P(BothVendorsBothTransports, CloudPathTest,
+                         ::testing::Values(CloudPathCase{dds::Vendor::kCyclone, "points"},
+                                           CloudPathCase{dds::Vendor::kFastDds, "points"},
+                                           CloudPathCase{dds::Vendor::kCyclone, "image"},
+                                           CloudPathCase{dds::Vendor::kFastDds, "image"}),
+                         [](const ::testing::TestParamInfo<CloudPathCase>& i) {
+                           return dds::ToString(i.param.vendor) + "_" + i.param.transport;
+                         });
 
 // perception's PCD replay publishes the files of a folder in name order, each
 // cloud point for point the file's (x, y, z, NaN where the file has NaN).
@@ -244,6 +269,35 @@ msg::PointCloud2 GoodCloud() {
   return m;
 }
 
+// Writes each message of `framework_bad` and `layout_bad` (one at a time:
+// the reader is best effort), then `good`; expects the cloud service to have
+// counted the first as refused by the framework on rt/iplan/<topic>, the
+// second as refused inputs `input`, and to have processed `processed`
+// frames in all.
+template <class Writer, class M>
+void ExpectRejectedThenProcessed(CellHarness& cell, Writer& writer, std::vector<M>* framework_bad,
+                                 std::vector<M>* layout_bad, M good, const std::string& topic,
+                                 const std::string& input, double processed) {
+  for (auto* set : {framework_bad, layout_bad}) {
+    for (auto& m : *set) {
+      m.header.stamp = msg::Now();
+      writer.Write(m);
+      cell.SpinFor(std::chrono::milliseconds(0));
+      std::this_thread::sleep_for(std::chrono::milliseconds(60));
+    }
+  }
+  good.header.stamp = msg::Now();
+  writer.Write(good);
+  const double nf = static_cast<double>(framework_bad->size()), nl = static_cast<double>(layout_bad->size());
+  const auto diag = [&](const std::string& key) { return cell.DiagNumber("cloud", key, -1); };
+  const std::string refused = "rejected/rt/iplan/" + topic, rejected = "rejected_inputs/" + input;
+  EXPECT_TRUE(cell.SpinUntil([&] { return diag(refused) == nf && diag(rejected) == nl && diag("clouds") == processed; },
+                             std::chrono::seconds(15)))
+      << "framework rejections " << diag(refused) << " of " << nf << ", layout rejections " << diag(rejected) << " of "
+      << nl << ", processed " << diag("clouds") << " of " << processed << "\n"
+      << cell.Logs("cloud");
+}
+
 TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
   CellHarness cell("cloud-bad", dds::Vendor::kCyclone, 43, "", /*with_intent=*/false);
   ASSERT_TRUE(cell.ready());
@@ -265,25 +319,27 @@ TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
   { auto m = GoodCloud(); const float nan = std::nanf(""); std::memcpy(m.data.data() + 12 * 5, &nan, 4); m.is_dense = false; layout_bad.push_back(m); }  // x NaN only
   { auto m = GoodCloud(); const float inf = std::numeric_limits<float>::infinity(); std::memcpy(m.data.data() + 8, &inf, 4); layout_bad.push_back(m); }
   { auto m = GoodCloud(); const float nan[3] = {std::nanf(""), std::nanf(""), std::nanf("")}; std::memcpy(m.data.data(), nan, 12); layout_bad.push_back(m); }  // NaN in a dense cloud
-  for (auto* set : {&framework_bad, &layout_bad}) {
-    for (auto& m : *set) {
-      m.header.stamp = msg::Now();
-      writer.Write(m);
-      cell.SpinFor(std::chrono::milliseconds(0));
-      std::this_thread::sleep_for(std::chrono::milliseconds(60));  // best-effort reader: one at a time
-    }
-  }
-  auto good = GoodCloud();
-  good.header.stamp = msg::Now();
-  writer.Write(good);
-  const double nf = static_cast<double>(framework_bad.size()), nl = static_cast<double>(layout_bad.size());
-  const auto diag = [&](const std::string& key) { return cell.DiagNumber("cloud", key, -1); };
-  EXPECT_TRUE(cell.SpinUntil([&] {
-    return diag("rejected/rt/iplan/depth/points") == nf && diag("rejected_inputs/depth_points") == nl && diag("clouds") == 1;
-  }, std::chrono::seconds(15)))
-      << "framework rejections " << diag("rejected/rt/iplan/depth/points") << " of " << nf << ", layout rejections "
-      << diag("rejected_inputs/depth_points") << " of " << nl << ", processed " << diag("clouds") << "\n"
-      << cell.Logs("cloud");
+  ExpectRejectedThenProcessed(cell, writer, &framework_bad, &layout_bad, GoodCloud(), "depth/points", "depth_points", 1);
+  // Depth images: the framework refuses one whose data does not fill step x
+  // height; the cloud service one it cannot unproject (another encoding, a
+  // size other than the camera's intrinsics, 640x480 in cloud.yaml); a good
+  // one is processed.
+  auto& images = cell.node().Advertise(framework::topics::DepthImage());
+  ASSERT_TRUE(cell.SpinUntil([&] { return images.MatchedReaders() > 0; }, std::chrono::seconds(20)));
+  const auto good_image = [] {
+    msg::Image m;
+    m.header.frame_id = "depth_camera";
+    m.width = 640, m.height = 480, m.encoding = "16UC1", m.step = 1280;
+    m.data.assign(std::size_t{1280} * 480, 0);
+    for (std::size_t i = 0; i < 100; ++i) m.data[2 * (240 * 640 + 200 + i)] = 0xdc, m.data[2 * (240 * 640 + 200 + i) + 1] = 0x05;  // 1.5 m
+    return m;
+  };
+  std::vector<msg::Image> image_framework_bad, image_layout_bad;
+  { auto m = good_image(); m.data.resize(1000); image_framework_bad.push_back(m); }                         // data vs step * height
+  { auto m = good_image(); m.encoding = "rgb8"; image_layout_bad.push_back(m); }                             // not a depth encoding
+  { auto m = good_image(); m.width = 320, m.height = 240, m.step = 640; m.data.resize(640 * 240); image_layout_bad.push_back(m); }  // not the camera's size
+  ExpectRejectedThenProcessed(cell, images, &image_framework_bad, &image_layout_bad, good_image(), "depth/image",
+                              "depth_image", 2);
   EXPECT_TRUE(cell["cloud"].Running());
   cell.Stop();
 }

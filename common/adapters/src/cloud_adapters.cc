@@ -2,7 +2,7 @@
 
 #include <cmath>
 #include <cstring>
-
+#include <limits>
 
 namespace iplan::services {
 namespace {
@@ -95,6 +95,69 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
     dense = dense && c.points[i].allFinite();
   }
   out->is_dense = dense;
+}
+
+std::optional<std::string> FromDepthImage(const msg::Image& m, const cloud::CameraIntrinsics& intrinsics,
+                                          cloud::Cloud* out) {
+  const bool mm = m.encoding == "16UC1";
+  if (!mm && m.encoding != "32FC1") {
+    return "depth image encoding '" + m.encoding + "' is not supported (16UC1 in mm or 32FC1 in m)";
+  }
+  if (m.is_bigendian) return std::string("big-endian depth images are not supported");
+  if (m.width != static_cast<uint32_t>(intrinsics.width) || m.height != static_cast<uint32_t>(intrinsics.height)) {
+    return "depth image is " + std::to_string(m.width) + "x" + std::to_string(m.height) + ", the camera's intrinsics " +
+           std::to_string(intrinsics.width) + "x" + std::to_string(intrinsics.height);
+  }
+  const uint32_t bytes = mm ? 2 : 4;
+  if (uint64_t{m.step} < uint64_t{bytes} * m.width || uint64_t{m.step} * m.height != m.data.size()) {
+    return "depth image step " + std::to_string(m.step) + " does not fit width " + std::to_string(m.width) + " x " +
+           std::to_string(bytes) + " bytes or data " + std::to_string(m.data.size()) + " bytes";
+  }
+  out->width = static_cast<int>(m.width);
+  out->height = static_cast<int>(m.height);
+  out->points.resize(std::size_t{m.width} * m.height);
+  out->rgba.clear();
+  out->label.clear();
+  constexpr float kNaN = std::numeric_limits<float>::quiet_NaN();
+  const double ifx = 1.0 / intrinsics.fx, ify = 1.0 / intrinsics.fy;
+  std::size_t i = 0;
+  for (uint32_t v = 0; v < m.height; ++v) {
+    const uint8_t* row = m.data.data() + std::size_t{v} * m.step;
+    for (uint32_t u = 0; u < m.width; ++u, ++i) {
+      double z;
+      if (mm) {
+        uint16_t d;
+        std::memcpy(&d, row + 2 * u, 2);  // little-endian host (x86, arm64)
+        z = d * 1e-3;
+      } else {
+        float d;
+        std::memcpy(&d, row + 4 * u, 4);
+        if (std::isnan(d)) d = 0;
+        if (!(d >= 0) || !std::isfinite(d)) return "pixel " + std::to_string(i) + " has depth " + std::to_string(d);
+        z = d;
+      }
+      out->points[i] = z > 0 ? Eigen::Vector3f(static_cast<float>((u - intrinsics.cx) * z * ifx),
+                                               static_cast<float>((v - intrinsics.cy) * z * ify), static_cast<float>(z))
+                             : Eigen::Vector3f(kNaN, kNaN, kNaN);
+    }
+  }
+  return std::nullopt;
+}
+
+void ToDepthImage(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id, msg::Image* out) {
+  out->header.stamp = stamp;
+  out->header.frame_id = frame_id;
+  out->height = static_cast<uint32_t>(c.height);
+  out->width = static_cast<uint32_t>(c.width);
+  out->encoding = "16UC1";
+  out->is_bigendian = 0;
+  out->step = 2 * out->width;
+  out->data.resize(2 * c.points.size());
+  for (std::size_t i = 0; i < c.points.size(); ++i) {
+    const double z_mm = static_cast<double>(c.points[i].z()) * 1e3;
+    const uint16_t d = std::isfinite(z_mm) && z_mm >= 0.5 && z_mm < 65535.5 ? static_cast<uint16_t>(std::lround(z_mm)) : 0;
+    std::memcpy(out->data.data() + 2 * i, &d, 2);
+  }
 }
 
 }  // namespace iplan::services

@@ -1,10 +1,12 @@
 // PointCloud2 <-> Cloud: our layout round-trips; a ROS 2 driver's layout
 // (x y z padded to 16 bytes, rgb after, rows padded) decodes; NaN pixels
-// stay NaN at their place.
+// stay NaN at their place. Depth images: a cloud on its pixels' rays comes
+// back within half a millimetre; malformed images are refused.
 #include <gtest/gtest.h>
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 
 #include "iplan/adapters/cloud_adapters.h"
 #include "iplan/core/params.h"
@@ -34,6 +36,93 @@ TEST(CloudAdaptersTest, RoundTripKeepsEveryPointAndNaN) {
       EXPECT_EQ(back.points[static_cast<std::size_t>(i)], c.points[static_cast<std::size_t>(i)]) << i;
     }
   }
+}
+
+// A 4x3 camera and a cloud whose points lie on their pixels' rays.
+cloud::CameraIntrinsics SmallCamera() {
+  cloud::CameraIntrinsics k;
+  k.width = 4, k.height = 3, k.fx = 5.0, k.fy = 6.0, k.cx = 1.5, k.cy = 1.0;
+  return k;
+}
+cloud::Cloud OnRays(const cloud::CameraIntrinsics& k) {
+  cloud::Cloud c;
+  c.width = k.width, c.height = k.height;
+  for (int v = 0; v < k.height; ++v) {
+    for (int u = 0; u < k.width; ++u) {
+      const double z = 0.8004 + 0.1234567 * (u + k.width * v);
+      c.points.emplace_back((u - k.cx) * z / k.fx, (v - k.cy) * z / k.fy, z);
+    }
+  }
+  return c;
+}
+
+TEST(CloudAdaptersTest, DepthImageRoundTripIsWithinHalfAMillimetre) {
+  const cloud::CameraIntrinsics k = SmallCamera();
+  cloud::Cloud c = OnRays(k);
+  c.points[6].setConstant(std::nanf(""));
+  msg::Image m;
+  ToDepthImage(c, msg::Time{}, "depth_camera", &m);
+  EXPECT_EQ(m.encoding, "16UC1");
+  EXPECT_EQ(m.step, 8u);
+  ASSERT_EQ(m.data.size(), 24u);  // a quarter of the cloud's 12 bytes per point
+  cloud::Cloud back;
+  ASSERT_EQ(FromDepthImage(m, k, &back), std::nullopt);
+  ASSERT_EQ(back.width, 4);
+  ASSERT_EQ(back.height, 3);
+  for (std::size_t i = 0; i < c.points.size(); ++i) {
+    if (i == 6) {
+      EXPECT_FALSE(back.points[i].allFinite());
+      continue;
+    }
+    // z to the millimetre; x and y scale with it along the ray.
+    EXPECT_LE((back.points[i] - c.points[i]).norm(), 0.0005 * 1.2) << i;
+    EXPECT_NE(back.points[i], c.points[i]) << i;  // no depth here is a whole millimetre
+  }
+}
+
+TEST(CloudAdaptersTest, FloatDepthImageDecodesAndZeroOrNaNIsNoReturn) {
+  const cloud::CameraIntrinsics k = SmallCamera();
+  msg::Image m;
+  m.width = 4, m.height = 3, m.encoding = "32FC1", m.step = 16;
+  m.data.resize(48);
+  float depth[12];
+  for (int i = 0; i < 12; ++i) depth[i] = 1.0f + 0.5f * i;
+  depth[2] = 0.0f;
+  depth[9] = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(m.data.data(), depth, 48);
+  cloud::Cloud c;
+  ASSERT_EQ(FromDepthImage(m, k, &c), std::nullopt);
+  EXPECT_FALSE(c.points[2].allFinite());
+  EXPECT_FALSE(c.points[9].allFinite());
+  // Pixel (u, v) = (3, 1), index 7, depth 4.5 m.
+  EXPECT_FLOAT_EQ(c.points[7].x(), static_cast<float>((3 - 1.5) * 4.5 / 5.0));
+  EXPECT_FLOAT_EQ(c.points[7].y(), 0.0f);
+  EXPECT_FLOAT_EQ(c.points[7].z(), 4.5f);
+  depth[4] = -1.0f;
+  std::memcpy(m.data.data(), depth, 48);
+  EXPECT_EQ(FromDepthImage(m, k, &c), std::string("pixel 4 has depth -1.000000"));
+}
+
+TEST(CloudAdaptersTest, MalformedDepthImagesAreRefused) {
+  const cloud::CameraIntrinsics k = SmallCamera();
+  msg::Image good;
+  ToDepthImage(OnRays(k), msg::Time{}, "depth_camera", &good);
+  cloud::Cloud c;
+  msg::Image m = good;
+  m.encoding = "rgb8";
+  EXPECT_EQ(FromDepthImage(m, k, &c),
+            std::string("depth image encoding 'rgb8' is not supported (16UC1 in mm or 32FC1 in m)"));
+  m = good;
+  m.is_bigendian = 1;
+  EXPECT_EQ(FromDepthImage(m, k, &c), std::string("big-endian depth images are not supported"));
+  m = good;
+  cloud::CameraIntrinsics vga;
+  EXPECT_EQ(FromDepthImage(m, vga, &c), std::string("depth image is 4x3, the camera's intrinsics 640x480"));
+  m = good;
+  m.step = 6;
+  m.data.resize(18);
+  EXPECT_EQ(FromDepthImage(m, k, &c),
+            std::string("depth image step 6 does not fit width 4 x 2 bytes or data 18 bytes"));
 }
 
 TEST(CloudAdaptersTest, RosDriverLayoutWithPaddingDecodes) {

@@ -14,7 +14,8 @@ using Q = dds::QosProfile;
 // The catalogue's wire names, before remapping.
 const std::vector<std::string>& CatalogueNames() {
   static const std::vector<std::string> kNames = {
-      "rt/iplan/human/skeleton", "rt/iplan/sim/human_truth", "rt/iplan/depth/points", "rt/iplan/obstacles",
+      "rt/iplan/human/skeleton", "rt/iplan/sim/human_truth", "rt/iplan/depth/points", "rt/iplan/depth/image",
+      "rt/iplan/obstacles",
       "rt/iplan/human/points", "rt/iplan/human/action_belief", "rt/iplan/human/prediction", "rt/joint_states",
       "rt/iplan/robot/trajectory", "rt/iplan/task/command", "rt/iplan/task/outcome", "rt/iplan/robot/plan_status",
       "rt/iplan/collision_risk", "rt/iplan/safety/permit/supervisor", "rt/iplan/safety/permit/collision_risk",
@@ -124,6 +125,10 @@ Topic<msg::PointCloud2> DepthPoints() {
   // Any provider may publish clouds (the depth camera is swappable).
   return {Named("rt/iplan/depth/points"), Q::SensorStream(milliseconds(200), milliseconds(300))};
 }
+Topic<msg::Image> DepthImage() {
+  // Any provider may publish depth images (the depth camera is swappable).
+  return {Named("rt/iplan/depth/image"), Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
 Topic<msg::ObstacleArray> Obstacles() {
   return {Named("rt/iplan/obstacles"), Q::SensorStream(milliseconds(1000), milliseconds(1000)), {"iplan-cloud"}, true};
 }
@@ -194,6 +199,7 @@ std::vector<TopicDescription> All() {
       Describe(HumanSkeleton(), "tracked human skeletons (perception)"),
       Describe(HumanTruth(), "true pose of the simulated person (simulation only)"),
       Describe(DepthPoints(), "depth camera point cloud, sensor frame (perception or any camera driver)"),
+      Describe(DepthImage(), "depth camera image, 16UC1 mm or 32FC1 m (perception or any camera driver)"),
       Describe(Obstacles(), "static unknown obstacles as boxes (cloud)"),
       Describe(HumanPoints(), "points of moving objects (people) with sensor noise (cloud)"),
       Describe(ActionBelief(), "probability of each human action (intent)"),

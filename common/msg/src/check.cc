@@ -177,6 +177,17 @@ std::optional<std::string> CheckSizes(const PointCloud2& m) {
   return std::nullopt;
 }
 
+std::optional<std::string> CheckSizes(const Image& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  const uint64_t pixels = uint64_t{m.width} * m.height;  // both 32-bit: cannot wrap
+  if (pixels > Limits::kCloudPoints) {
+    return "width x height = " + std::to_string(pixels) + " pixels, limit " + std::to_string(Limits::kCloudPoints);
+  }
+  if (auto e = CheckLength(m.encoding, Limits::kName, "encoding")) return e;
+  if (m.data.size() > Limits::kImageBytes) return Over("data", m.data.size(), Limits::kImageBytes, "bytes");
+  return std::nullopt;
+}
+
 std::optional<std::string> CheckSizes(const TFMessage& m) {
   if (m.transforms.size() > Limits::kTransforms) return Over("transforms", m.transforms.size(), Limits::kTransforms);
   for (std::size_t i = 0; i < m.transforms.size(); ++i) {
@@ -400,6 +411,15 @@ std::optional<std::string> CheckSemantics(const PointCloud2& m) {
   }
   for (const auto& f : m.fields) {
     if (f.datatype < 1 || f.datatype > 8) return "field '" + f.name + "' has datatype " + std::to_string(f.datatype);
+  }
+  return std::nullopt;
+}
+
+std::optional<std::string> CheckSemantics(const Image& m) {
+  if (auto e = CheckSemantics(m.header)) return e;
+  if (static_cast<uint64_t>(m.step) * m.height != m.data.size()) {
+    return "data has " + std::to_string(m.data.size()) + " bytes, expected step * height = " +
+           std::to_string(static_cast<uint64_t>(m.step) * m.height);
   }
   return std::nullopt;
 }

@@ -391,6 +391,31 @@ TEST(MsgLimits, PointCloud) {
   EXPECT_EQ(Check(c), std::string("data has 67108865 bytes, limit 67108864"));
 }
 
+TEST(MsgLimits, DepthImage) {
+  Image im;
+  im.width = 640;
+  im.height = 480;
+  im.encoding = "16UC1";
+  im.step = 2 * im.width;
+  im.data.resize(static_cast<std::size_t>(im.step) * im.height);
+  EXPECT_EQ(Check(im), std::nullopt);
+  im.data.pop_back();
+  EXPECT_EQ(Check(im), std::string("data has 614399 bytes, expected step * height = 614400"));
+  im.data.push_back(0);
+  im.width = 640 * 4;
+  im.height = 481;
+  EXPECT_EQ(Check(im), std::string("width x height = 1231360 pixels, limit 1228800"));
+  im.width = 640;
+  im.height = 480;
+  im.encoding = std::string(Limits::kName + 1, 'e');
+  EXPECT_EQ(Check(im), std::string("encoding has 257 characters, limit 256"));
+  im.encoding = "16UC1";
+  im.height = 1;
+  im.step = static_cast<uint32_t>(Limits::kImageBytes) + 1;
+  im.data.resize(im.step);
+  EXPECT_EQ(Check(im), std::string("data has 67108865 bytes, limit 67108864"));
+}
+
 TEST(MsgLimits, Diagnostics) {
   DiagnosticArray a;
   a.status.resize(Limits::kDiagnosticStatuses);

@@ -1,5 +1,5 @@
-// sensor_msgs/PointCloud2 <-> iplan::cloud::Cloud, and the camera settings
-// the depth providers and the cloud service read alike. The framework's Check has
+// sensor_msgs/PointCloud2 and sensor_msgs/Image (a depth image) <->
+// iplan::cloud::Cloud. The framework's Check has
 // already refused size mismatches (data vs row_step * height, point_step *
 // width vs row_step); here the field layout and the coordinates are checked,
 // so that a cloud the core reads is well-formed.
@@ -34,5 +34,25 @@ std::optional<std::string> FromPointCloud2(const msg::PointCloud2& m, cloud::Clo
 /// point_step 12, little-endian, is_dense when every point is finite.
 void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id,
                    msg::PointCloud2* out);
+
+/// Unprojects a depth image (encoding 16UC1: mm, or 32FC1: m; 0 or NaN =
+/// no return; little-endian, row-major) of a camera with `intrinsics` into
+/// an organised cloud in the image's frame (the optical frame: x right, y
+/// down, z forward): pixel (u, v) of depth z is
+///   p = ((u - cx) z / fx, (v - cy) z / fy, z),   no return: NaN.
+/// Returns why the image cannot be read: another encoding, big-endian, a
+/// size other than the intrinsics' width x height, step under width times
+/// the pixel's bytes or data other than step x height, a negative or
+/// infinite depth (32FC1). Reuses out's buffers.
+std::optional<std::string> FromDepthImage(const msg::Image& m, const cloud::CameraIntrinsics& intrinsics,
+                                          cloud::Cloud* out);
+
+/// An organised cloud (optical frame) as a 16UC1 depth image: each pixel's
+/// z in mm, rounded; no return (NaN) and z outside [0.5 mm, 65.535 m) as 0.
+/// Only z is sent, a quarter of the cloud's bytes: the receiver puts each
+/// point on its pixel's ray (FromDepthImage), so a point's offset from that
+/// ray (the simulated camera's lateral noise) and everything under 1 mm are
+/// lost.
+void ToDepthImage(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id, msg::Image* out);
 
 }  // namespace iplan::services

@@ -45,6 +45,11 @@ Topic<msg::HumanSkeleton> HumanTruth();
 /// simulated camera or PCD replay, or a ROS 2 camera driver. Frame: the
 /// sensor's (header.frame_id); the cloud stage knows its pose in the cell.
 Topic<msg::PointCloud2> DepthPoints();
+/// The same camera's depth image (16UC1 in mm or 32FC1 in m, the sensor's
+/// frame): a quarter of a cloud's bytes, so the camera can run at 30 Hz on
+/// loopback; the cloud service unprojects it with the camera's intrinsics
+/// (cloud.yaml intrinsics).
+Topic<msg::Image> DepthImage();
 /// Static unknown obstacles (boxes, cell frame) the cloud stage found.
 Topic<msg::ObstacleArray> Obstacles();
 /// Points of moving objects (people) the cloud stage found, each with the

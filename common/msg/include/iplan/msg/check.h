@@ -52,6 +52,9 @@ struct Limits {
   static constexpr std::size_t kCloudFields = 32;
   static constexpr std::size_t kCloudBytes = std::size_t{64} << 20;  ///< data, 64 MiB
 
+  // Image (a depth camera's): the same pixel limit as a cloud's points.
+  static constexpr std::size_t kImageBytes = std::size_t{64} << 20;  ///< data, 64 MiB
+
   // ObstacleArray and HumanPoints.
   static constexpr std::size_t kObstacles = 256;        ///< boxes per array
   static constexpr std::size_t kHumanPoints = 65536;    ///< a person on a 1 cm grid has ~20,000
@@ -83,6 +86,7 @@ std::optional<std::string> CheckSizes(const HumanPrediction& m);
 std::optional<std::string> CheckSizes(const JointState& m);
 std::optional<std::string> CheckSizes(const JointTrajectory& m);
 std::optional<std::string> CheckSizes(const PointCloud2& m);
+std::optional<std::string> CheckSizes(const Image& m);
 std::optional<std::string> CheckSizes(const ObstacleArray& m);
 std::optional<std::string> CheckSizes(const HumanPoints& m);
 std::optional<std::string> CheckSizes(const TaskCommand& m);
@@ -109,6 +113,7 @@ std::optional<std::string> CheckSemantics(const HumanPrediction& m);
 std::optional<std::string> CheckSemantics(const JointState& m);
 std::optional<std::string> CheckSemantics(const JointTrajectory& m);
 std::optional<std::string> CheckSemantics(const PointCloud2& m);
+std::optional<std::string> CheckSemantics(const Image& m);
 std::optional<std::string> CheckSemantics(const ObstacleArray& m);
 std::optional<std::string> CheckSemantics(const HumanPoints& m);
 std::optional<std::string> CheckSemantics(const TaskCommand& m);
