@@ -31,6 +31,12 @@ class DdsEvents : public ::testing::TestWithParam<Pairing> {
     o.name = "events_test";
     return dds::Participant::Create(o);
   }
+  // A node without the diagnostics timer (this test's timers are its own).
+  static std::unique_ptr<framework::Node> QuietNode(const std::string& name, dds::Participant& p) {
+    framework::NodeOptions opts;
+    opts.diagnostics_period = 0;
+    return std::make_unique<framework::Node>(name, p, opts);
+  }
   int Domain(int k) {
     return UniqueDomain(k * 11 + static_cast<int>(GetParam().writer.size() * 3 + GetParam().reader.size()));
   }
@@ -134,9 +140,8 @@ TEST_P(DdsEvents, WriterThatStopsPublishingIsReportedAsDeadlineMiss) {
 TEST_P(DdsEvents, Ros2DefaultPublisherMatchesAndItsSilenceIsADeadlineMiss) {
   const int domain = Domain(5);
   auto p = MakeParticipant(domain);
-  framework::NodeOptions opts;
-  opts.diagnostics_period = 0;
-  framework::Node node("ros2_compat_test", *p, opts);
+  auto owned = QuietNode("ros2_compat_test", *p);
+  framework::Node& node = *owned;
   const auto topic = framework::topics::HumanSkeleton();
   int callbacks = 0;
   std::optional<Clock::time_point> first_miss;
@@ -242,6 +247,45 @@ TEST_P(DdsEvents, BackwardsStampsAndWrongSizesAreRejected) {
     EXPECT_GE(static_cast<int>(c.stats.rejected), c.published - 2);
     EXPECT_EQ(c.stats.last_rejection, "skeleton has no joints");
   }
+}
+
+// A topic whose callback is slower than its rate does not keep the node's
+// executor to itself (Node, "Fairness"): skeletons at 100 Hz, each callback
+// 20 ms, and a 50 ms timer beside them. Before, the subscription's samples
+// were taken until none was left, which never happened, and the timer (as
+// the cloud service's diagnostics and its joint states with 30 Hz depth
+// images) did not run at all.
+TEST_P(DdsEvents, ASlowCallbackDoesNotStarveTimers) {
+  const int domain = Domain(6);
+  auto p = MakeParticipant(domain);
+  auto owned = QuietNode("fairness_test", *p);
+  framework::Node& node = *owned;
+  int callbacks = 0, ticks = 0;
+  node.Subscribe(framework::topics::HumanSkeleton(),
+                 std::function<void(const msg::HumanSkeleton&, const dds::SampleInfo&)>(
+                     [&](const msg::HumanSkeleton&, const dds::SampleInfo&) {
+                       ++callbacks;
+                       std::this_thread::sleep_for(20ms);
+                     }));
+  auto writer = Stream(domain, {"--rate", "100", "--duration", "6"});
+  // Until the stream is flowing (each SpinOnce returns after a slice; before,
+  // the first one returned only when the 6 s stream ended), then 2 s with
+  // the timer.
+  const auto flowing_by = Clock::now() + 10s;
+  const auto spin_limit = 1s;
+  while (callbacks < 5 && Clock::now() < flowing_by) {
+    const auto t0 = Clock::now();
+    node.SpinOnce(20ms);
+    ASSERT_LT(Clock::now() - t0, spin_limit) << "one SpinOnce held the executor for " << callbacks << " callbacks";
+  }
+  ASSERT_GE(callbacks, 5) << "the stream did not reach the node";
+  node.AddTimer(50ms, [&] { ++ticks; });
+  const int before = callbacks;
+  const auto end = Clock::now() + 2s;
+  while (Clock::now() < end) node.SpinOnce(20ms);
+  // 2 s of 20 ms callbacks and 50 ms ticks: about 40 of each share the time.
+  EXPECT_GE(ticks, 20) << callbacks - before << " callbacks meanwhile";
+  EXPECT_GE(callbacks - before, 40);
 }
 
 INSTANTIATE_TEST_SUITE_P(AllPairings, DdsEvents, AllVendorPairings(), PairingName);

@@ -94,7 +94,8 @@ void Node::RunTimers() {
 }
 
 void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
-  auto wait = max_wait;
+  // Samples left over from the last spin are due now: no waiting for more.
+  auto wait = backlog_.empty() ? max_wait : std::chrono::nanoseconds(0);
   const auto now = std::chrono::steady_clock::now();
   for (const auto& [id, t] : timers_) {
     wait = std::min<std::chrono::nanoseconds>(wait, std::max<std::chrono::nanoseconds>(t.next - now, std::chrono::nanoseconds(0)));
@@ -105,11 +106,22 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
   if (wait.count() > 0 || !subscriptions_.empty()) {
     participant_.Wait(std::max(wait, std::chrono::nanoseconds(1)), &ready_);
   }
+  // The ready readers, then the ones cut short last time (their data
+  // status was cleared by the first take: the wait set does not report them
+  // again until a new sample comes), each once.
+  std::vector<SubscriptionBase*> due;
   for (dds::AnyReader* r : ready_) {
     auto it = by_reader_.find(r);
     if (it == by_reader_.end()) continue;
     HandleEvents(*it->second);
-    it->second->Dispatch(*this);
+    due.push_back(it->second);
+  }
+  for (SubscriptionBase* sub : backlog_) {
+    if (std::find(due.begin(), due.end(), sub) == due.end()) due.push_back(sub);
+  }
+  backlog_.clear();
+  for (SubscriptionBase* sub : due) {
+    if (sub->Dispatch(*this)) backlog_.push_back(sub);
   }
   CheckDeadlines();
   RunTimers();

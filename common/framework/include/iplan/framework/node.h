@@ -36,6 +36,15 @@
 //
 // Threading: all callbacks and timers run on the thread that calls
 // SpinOnce()/SpinUntil(); the core of a service therefore needs no locks.
+//
+// Fairness: one SpinOnce takes a subscription's samples only until its
+// callbacks have run kDispatchSlice (at least one sample); what is left is
+// taken in the next SpinOnce, which then does not wait, after the other
+// ready subscriptions, the deadlines and the timers have had their turn. A
+// topic whose callback is slower than its rate (30 Hz depth images at 35 ms
+// each) would otherwise keep the executor to itself: the cloud service so
+// starved its own joint states (every frame went without the self-filter)
+// and its diagnostics timer.
 #pragma once
 
 #include <chrono>
@@ -133,6 +142,9 @@ constexpr int kResyncAfter = 3;
 
 class Node {
  public:
+  /// How long one SpinOnce lets a subscription's callbacks run before the
+  /// rest of its samples wait for the next (file comment, "Fairness").
+  static constexpr std::chrono::milliseconds kDispatchSlice{5};
   /// Throws std::runtime_error when the diagnostics writer cannot be created.
   Node(std::string name, dds::Participant& participant, NodeOptions options = {});
   ~Node();
@@ -195,7 +207,9 @@ class Node {
  private:
   struct SubscriptionBase {
     virtual ~SubscriptionBase() = default;
-    virtual void Dispatch(Node& node) = 0;
+    /// Takes and handles samples until none is left (false) or the
+    /// callbacks have run for kDispatchSlice (true: there may be more).
+    virtual bool Dispatch(Node& node) = 0;
     std::unique_ptr<dds::AnyReader> reader;
     TopicStats stats;
     SubscribeOptions options;
@@ -250,6 +264,7 @@ class Node {
   int next_timer_id_ = 1;
   std::function<void(const std::string&, const dds::ReaderEvent&)> on_event_;
   std::vector<dds::AnyReader*> ready_;
+  std::vector<SubscriptionBase*> backlog_;  // cut short by kDispatchSlice in the last SpinOnce
   // Diagnostics state.
   std::string state_ = "unconfigured";
   uint8_t level_ = msg::DiagnosticStatus::OK;
@@ -274,10 +289,12 @@ template <class T>
 struct Node::Subscription : Node::SubscriptionBase {
   std::function<void(const T&, const dds::SampleInfo&)> on_message;
   T msg;  // reused buffer
-  void Dispatch(Node& node) override {
+  bool Dispatch(Node& node) override {
     auto* r = static_cast<dds::Reader<T>*>(reader.get());
     dds::SampleInfo info;
+    const auto start = std::chrono::steady_clock::now();
     for (;;) {
+      if (std::chrono::steady_clock::now() - start >= kDispatchSlice) return true;
       bool took = false;
       try {
         took = r->Take(&msg, &info);
@@ -285,7 +302,7 @@ struct Node::Subscription : Node::SubscriptionBase {
         node.Reject(*this, std::string("cannot convert sample: ") + e.what());
         continue;
       }
-      if (!took) break;
+      if (!took) return false;
       if (!node.AcceptWriter(*this, info)) continue;
       if (auto why = msg::Check(msg)) {
         node.Reject(*this, *why);
