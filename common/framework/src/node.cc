@@ -109,18 +109,18 @@ void Node::SpinOnce(std::chrono::nanoseconds max_wait) {
   // The ready readers, then the ones cut short last time (their data
   // status was cleared by the first take: the wait set does not report them
   // again until a new sample comes), each once.
-  std::vector<SubscriptionBase*> due;
+  due_.clear();
   for (dds::AnyReader* r : ready_) {
     auto it = by_reader_.find(r);
     if (it == by_reader_.end()) continue;
     HandleEvents(*it->second);
-    due.push_back(it->second);
+    due_.push_back(it->second);
   }
   for (SubscriptionBase* sub : backlog_) {
-    if (std::find(due.begin(), due.end(), sub) == due.end()) due.push_back(sub);
+    if (std::find(due_.begin(), due_.end(), sub) == due_.end()) due_.push_back(sub);
   }
   backlog_.clear();
-  for (SubscriptionBase* sub : due) {
+  for (SubscriptionBase* sub : due_) {
     if (sub->Dispatch(*this)) backlog_.push_back(sub);
   }
   CheckDeadlines();

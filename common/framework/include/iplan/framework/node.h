@@ -265,6 +265,7 @@ class Node {
   std::function<void(const std::string&, const dds::ReaderEvent&)> on_event_;
   std::vector<dds::AnyReader*> ready_;
   std::vector<SubscriptionBase*> backlog_;  // cut short by kDispatchSlice in the last SpinOnce
+  std::vector<SubscriptionBase*> due_;      // this SpinOnce's, kept to reuse its buffer
   // Diagnostics state.
   std::string state_ = "unconfigured";
   uint8_t level_ = msg::DiagnosticStatus::OK;
