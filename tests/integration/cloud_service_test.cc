@@ -278,6 +278,11 @@ template <class Writer, class M>
 void ExpectRejectedThenProcessed(CellHarness& cell, Writer& writer, std::vector<M>* framework_bad,
                                  std::vector<M>* layout_bad, M good, const std::string& topic,
                                  const std::string& input, double processed) {
+  // The writer matching the reader does not mean the reader has matched the
+  // writer: the first sample may be dropped until the service sees its writer.
+  const std::string alive = "alive_writers/rt/iplan/" + topic;
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.DiagNumber("cloud", alive, 0) >= 1; }, std::chrono::seconds(20)))
+      << alive << "\n" << cell.Logs("cloud");
   for (auto* set : {framework_bad, layout_bad}) {
     for (auto& m : *set) {
       m.header.stamp = msg::Now();

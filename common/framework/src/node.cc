@@ -320,6 +320,7 @@ msg::DiagnosticArray Node::MakeDiagnostics() const {
     add("rejected/" + t, std::to_string(sub->stats.rejected));
     add("deadline_misses/" + t, std::to_string(sub->stats.deadline_misses));
     add("liveliness_lost/" + t, std::to_string(sub->stats.liveliness_lost));
+    add("alive_writers/" + t, std::to_string(sub->stats.alive_writers));
     if (!sub->stats.last_rejection.empty()) add("last_rejection/" + t, sub->stats.last_rejection);
     if (sub->stats.ignored_writers > 0) {
       add("ignored_writers/" + t, std::to_string(sub->stats.ignored_writers));
