@@ -1,6 +1,6 @@
 // iplan-cloud: the depth camera's clouds (/iplan/depth/points, sensor frame;
-// or its depth images, /iplan/depth/image, unprojected with the camera's
-// intrinsics) into typed outputs in the cell frame: static unknown obstacles as boxes
+// or its depth images, /iplan/depth/image, unprojected with the calibration
+// the camera publishes beside them, /iplan/depth/camera_info) into typed outputs in the cell frame: static unknown obstacles as boxes
 // (/iplan/obstacles, stable ids) and the points of moving objects, people,
 // with the sensor's noise covariance (/iplan/human/points). The stage
 // (core/cloud_stage.h): workspace crop, robot self-filter from
@@ -61,7 +61,10 @@ class CloudService : public framework::Service {
                    std::function<void(const msg::PointCloud2&, SI)>([this, &node](const msg::PointCloud2& m, SI) {
                      OnCloud(node, m);
                    }));
-    intrinsics_ = settings.intrinsics;
+    node.Subscribe(framework::topics::DepthCameraInfo(),
+                   std::function<void(const msg::CameraInfo&, SI)>([this, &node](const msg::CameraInfo& m, SI) {
+                     OnCameraInfo(node, m);
+                   }));
     node.Subscribe(framework::topics::DepthImage(),
                    std::function<void(const msg::Image&, SI)>([this, &node](const msg::Image& m, SI) {
                      OnImage(node, m);
@@ -120,11 +123,38 @@ class CloudService : public framework::Service {
     Process(node, m.header.stamp, t0);
   }
 
-  // A depth image, unprojected with the camera's intrinsics into the
-  // organised cloud a PointCloud2 would have carried.
+  // The camera's calibration: the intrinsics its next images are unprojected
+  // with (a calibration that cannot be used is refused, the last good one
+  // kept).
+  void OnCameraInfo(Node& node, const msg::CameraInfo& m) {
+    cloud::CameraIntrinsics k;
+    if (node.CountRejection("camera_info", services::FromCameraInfo(m, &k))) return;
+    if (!intrinsics_ || k.width != intrinsics_->width || k.height != intrinsics_->height || k.fx != intrinsics_->fx ||
+        k.fy != intrinsics_->fy || k.cx != intrinsics_->cx || k.cy != intrinsics_->cy) {
+      const std::string text = std::to_string(k.width) + "x" + std::to_string(k.height) + " pixels, fx " +
+                               core::ParamText(k.fx) + ", fy " + core::ParamText(k.fy) + ", cx " +
+                               core::ParamText(k.cx) + ", cy " + core::ParamText(k.cy);
+      node.log().info("camera calibration: {}", text);
+      node.SetDiagnosticValue("camera_info", text);
+    }
+    intrinsics_ = k;
+  }
+
+  // A depth image, unprojected with the camera's latest calibration into the
+  // organised cloud a PointCloud2 would have carried; none yet (DDS matches
+  // the two topics in any order): not processed, counted.
   void OnImage(Node& node, const msg::Image& m) {
     const auto t0 = std::chrono::steady_clock::now();
-    if (node.CountRejection("depth_image", services::FromDepthImage(m, intrinsics_, &cloud_))) return;
+    if (!intrinsics_) {
+      if (++images_without_info_ == 1) {
+        node.log().warn("a depth image came before any camera calibration on {}: not processed (counted in "
+                        "depth_images_without_camera_info)",
+                        framework::topics::DepthCameraInfo().name);
+      }
+      node.SetDiagnosticValue("depth_images_without_camera_info", std::to_string(images_without_info_));
+      return;
+    }
+    if (node.CountRejection("depth_image", services::FromDepthImage(m, *intrinsics_, &cloud_))) return;
     node.SetDiagnosticValue("depth_images", std::to_string(++images_));
     Process(node, m.header.stamp, t0);
   }
@@ -188,8 +218,9 @@ class CloudService : public framework::Service {
   double joint_state_timeout_ = 0.2;
   int64_t self_filter_ns_ = 0;
   std::string frame_id_ = "world";
-  cloud::CameraIntrinsics intrinsics_;
+  std::optional<cloud::CameraIntrinsics> intrinsics_;  // the camera's latest usable calibration
   uint64_t images_ = 0;  // depth images unprojected (of the clouds processed)
+  uint64_t images_without_info_ = 0;  // depth images that came before any calibration
   cloud::Cloud cloud_;
   msg::ObstacleArray obstacles_;
   msg::HumanPoints human_;

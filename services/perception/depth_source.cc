@@ -20,7 +20,6 @@ struct DepthSource::Impl {
   std::string provider = "none";
   double rate_hz = 30;
   std::string frame_id = "depth_camera";
-  bool image = false;  // transport image: a depth image instead of the cloud
   // simulated
   std::unique_ptr<SimulatedDepthCamera> camera;
   DepthScene fixed;  // the scene files' objects
@@ -40,12 +39,14 @@ struct DepthSource::Impl {
 
   TruthFn truth;
   dds::Writer<msg::PointCloud2>* writer = nullptr;
-  dds::Writer<msg::Image>* image_writer = nullptr;
+  dds::Writer<msg::Image>* image_writer = nullptr;  // set for transport image (then `writer` is not)
+  dds::Writer<msg::CameraInfo>* info_writer = nullptr;  // the image's calibration, beside each image
   int timer = 0;
   uint64_t published = 0;
   cloud::Cloud cloud;
   msg::PointCloud2 message;
   msg::Image image_message;
+  msg::CameraInfo info_message;
   double render_ms_sum = 0;
 
   framework::Result ConfigureSimulated(const framework::ConfigSection& config, const SimulatedDepthSettings& sim);
@@ -67,13 +68,13 @@ framework::Result DepthSource::Configure(const framework::ConfigSection& config,
   s.provider = settings.provider;
   s.rate_hz = settings.rate_hz;
   s.frame_id = settings.frame_id;
-  s.image = settings.transport == "image";
   framework::Result r = framework::Result::Ok();
   if (s.provider == "simulated") r = s.ConfigureSimulated(config, settings.simulated);
   if (s.provider == "pcd") r = s.ConfigurePcd(config, settings.pcd);
   if (!r.ok || s.provider == "none") return r;
-  if (s.image) {
+  if (settings.transport == "image") {
     s.image_writer = &node.Advertise(framework::topics::DepthImage());
+    s.info_writer = &node.Advertise(framework::topics::DepthCameraInfo());
   } else {
     s.writer = &node.Advertise(framework::topics::DepthPoints());
   }
@@ -223,8 +224,11 @@ void DepthSource::Impl::Tick(framework::Node& node) {
   if (!Produce(node)) return;
   const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   std::string err;
-  if (image) {
-    services::ToDepthImage(cloud, msg::Now(), frame_id, &image_message);
+  if (image_writer) {  // transport image: a depth image and its calibration instead of the cloud
+    const msg::Time stamp = msg::Now();
+    services::ToDepthImage(cloud, stamp, frame_id, &image_message);
+    services::ToCameraInfo(camera->params().intrinsics, stamp, frame_id, &info_message);
+    if (!info_writer->Write(info_message, &err)) node.log().warn("camera info not published: {}", err);
     if (!image_writer->Write(image_message, &err)) node.log().warn("depth image not published: {}", err);
   } else {
     services::ToPointCloud2(cloud, msg::Now(), frame_id, &message);

@@ -217,7 +217,7 @@ struct DepthSettings {
     a->Visit(IPLAN_NVP(provider, "none, simulated (a rendered camera) or pcd (recorded files)"));
     a->Visit(IPLAN_NVP(rate_hz, "Hz, clouds per second, in [0.1, 120]"));
     a->Visit(IPLAN_NVP(frame_id, "frame_id of the clouds (the camera's optical frame)"));
-    a->Visit(IPLAN_NVP(transport, "points: PointCloud2 on /iplan/depth/points (x, y, z: 12 bytes a pixel); image: a 16UC1 depth image in mm on /iplan/depth/image (2 bytes a pixel; the cloud service unprojects it with cloud.yaml intrinsics, which must be this camera's)"));
+    a->Visit(IPLAN_NVP(transport, "points: PointCloud2 on /iplan/depth/points (x, y, z: 12 bytes a pixel); image: a 16UC1 depth image in mm on /iplan/depth/image (2 bytes a pixel) and its calibration on /iplan/depth/camera_info, which the cloud service unprojects it with (provider simulated only)"));
     a->Visit(IPLAN_NVP(simulated, "provider simulated"));
     a->Visit(IPLAN_NVP(pcd, "provider pcd"));
   }

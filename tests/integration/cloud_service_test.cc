@@ -97,12 +97,16 @@ void CheckHumanPoints(const std::vector<msg::HumanPoints>& points, const std::ve
   EXPECT_LT(on_table, static_cast<int>(dist.size() / 100));
 }
 
-// The camera's frames as clouds (PointCloud2) or as depth images (16UC1,
-// unprojected by the cloud service with cloud.yaml's intrinsics): the same
-// obstacles and human points must come out.
+// The camera's frames as clouds (PointCloud2) at 10 Hz or as depth images
+// (16UC1, unprojected by the cloud service with the camera_info beside them) at
+// 30 Hz: the same obstacles and human points must come out, and at 30 Hz
+// the frames must not crowd out the service's joint states (every cloud
+// self-filtered) or its diagnostics timer (issue 29; the executor's
+// fairness, docs/architecture.md).
 struct CloudPathCase {
   dds::Vendor vendor;
   std::string transport;  // perception.depth.transport
+  int rate_hz;            // perception.depth.rate_hz
 };
 
 class CloudPathTest : public ::testing::TestWithParam<CloudPathCase> {};
@@ -144,7 +148,8 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
               }), any);
   cell.Start("robot_sim");
   cell.Start("perception", {"--set", "perception.synthetic.start=loop", "--set", "perception.depth.provider=simulated",
-                            "--set", "perception.depth.rate_hz=10", "--set", "perception.depth.transport=" + transport,
+                            "--set", "perception.depth.rate_hz=" + std::to_string(GetParam().rate_hz), "--set",
+                            "perception.depth.transport=" + transport,
                             "--set",
                             "perception.depth.simulated.scenes=[" + kConfig + "/scenes/cell.yaml, " + box_file + "]"});
   cell.Start("cloud");
@@ -158,9 +163,18 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
   arrays.clear();
   points.clear();
   centres_at.clear();
-  ASSERT_TRUE(cell.SpinUntil([&] { return arrays.size() >= 60 && points.size() >= 60; }, std::chrono::seconds(90)))
+  // Six seconds of frames (longer when the host cannot keep up).
+  const std::size_t frames = static_cast<std::size_t>(6 * GetParam().rate_hz);
+  const int reports_before = cell.DiagCount("cloud");
+  const auto window_start = std::chrono::steady_clock::now();
+  ASSERT_TRUE(cell.SpinUntil([&] { return arrays.size() >= frames && points.size() >= frames; },
+                             std::chrono::seconds(90)))
       << "obstacle arrays " << arrays.size() << ", human point sets " << points.size() << "\n" << cell.Logs("cloud")
       << cell.Logs("perception");
+  const double window_s = std::chrono::duration<double>(std::chrono::steady_clock::now() - window_start).count();
+  // node.diagnostics_period 1 s: half of the reports at least, even on a loaded host.
+  EXPECT_GE(cell.DiagCount("cloud") - reports_before, static_cast<int>(window_s / 2))
+      << "the cloud service's diagnostics timer did not run beside the frames (" << window_s << " s)";
 
   CheckObstacles(arrays, box_centre, box_size);
   CheckHumanPoints(points, centres_at, body);
@@ -179,10 +193,10 @@ TEST_P(CloudPathTest, SimulatedCameraToObstaclesAndHumanPoints) {
 }
 
 INSTANTIATE_TEST_SUITE_P(BothVendorsBothTransports, CloudPathTest,
-                         ::testing::Values(CloudPathCase{dds::Vendor::kCyclone, "points"},
-                                           CloudPathCase{dds::Vendor::kFastDds, "points"},
-                                           CloudPathCase{dds::Vendor::kCyclone, "image"},
-                                           CloudPathCase{dds::Vendor::kFastDds, "image"}),
+                         ::testing::Values(CloudPathCase{dds::Vendor::kCyclone, "points", 10},
+                                           CloudPathCase{dds::Vendor::kFastDds, "points", 10},
+                                           CloudPathCase{dds::Vendor::kCyclone, "image", 30},
+                                           CloudPathCase{dds::Vendor::kFastDds, "image", 30}),
                          [](const ::testing::TestParamInfo<CloudPathCase>& i) {
                            return dds::ToString(i.param.vendor) + "_" + i.param.transport;
                          });
@@ -325,12 +339,17 @@ TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
   { auto m = GoodCloud(); const float inf = std::numeric_limits<float>::infinity(); std::memcpy(m.data.data() + 8, &inf, 4); layout_bad.push_back(m); }
   { auto m = GoodCloud(); const float nan[3] = {std::nanf(""), std::nanf(""), std::nanf("")}; std::memcpy(m.data.data(), nan, 12); layout_bad.push_back(m); }  // NaN in a dense cloud
   ExpectRejectedThenProcessed(cell, writer, &framework_bad, &layout_bad, GoodCloud(), "depth/points", "depth_points", 1);
-  // Depth images: the framework refuses one whose data does not fill step x
-  // height; the cloud service one it cannot unproject (another encoding, a
-  // size other than the camera's intrinsics, 640x480 in cloud.yaml); a good
-  // one is processed.
+  // Depth images: one that comes before any calibration is counted, not
+  // processed. Calibrations: the framework refuses one with too many
+  // distortion coefficients, the cloud service one it cannot use (not
+  // calibrated, not rectified); a good one (640x480) is taken. Then the
+  // framework refuses an image whose data does not fill step x height; the
+  // cloud service one it cannot unproject (another encoding, a size other
+  // than the calibration's); a good one is processed.
   auto& images = cell.node().Advertise(framework::topics::DepthImage());
-  ASSERT_TRUE(cell.SpinUntil([&] { return images.MatchedReaders() > 0; }, std::chrono::seconds(20)));
+  auto& infos = cell.node().Advertise(framework::topics::DepthCameraInfo());
+  ASSERT_TRUE(cell.SpinUntil([&] { return cell.DiagNumber("cloud", "alive_writers/rt/iplan/depth/image", 0) >= 1; },
+                             std::chrono::seconds(20)));
   const auto good_image = [] {
     msg::Image m;
     m.header.frame_id = "depth_camera";
@@ -339,6 +358,26 @@ TEST(CloudServiceTest, MalformedCloudsAreRejectedAndCounted) {
     for (std::size_t i = 0; i < 100; ++i) m.data[2 * (240 * 640 + 200 + i)] = 0xdc, m.data[2 * (240 * 640 + 200 + i) + 1] = 0x05;  // 1.5 m
     return m;
   };
+  {
+    msg::Image early = good_image();
+    early.header.stamp = msg::Now();
+    images.Write(early);
+    EXPECT_TRUE(cell.SpinUntil([&] { return cell.DiagNumber("cloud", "depth_images_without_camera_info", 0) == 1; },
+                               std::chrono::seconds(15)))
+        << cell.Logs("cloud");
+  }
+  msg::CameraInfo good_info;
+  services::ToCameraInfo(cloud::CameraIntrinsics{}, msg::Time{}, "depth_camera", &good_info);  // 640x480
+  std::vector<msg::CameraInfo> info_framework_bad, info_layout_bad;
+  { auto m = good_info; m.d.assign(33, 0.0); info_framework_bad.push_back(m); }  // over the limit
+  { auto m = good_info; m.k.fill(0); info_layout_bad.push_back(m); }           // not calibrated
+  { auto m = good_info; m.d[0] = -0.2; info_layout_bad.push_back(m); }         // not rectified
+  ExpectRejectedThenProcessed(cell, infos, &info_framework_bad, &info_layout_bad, good_info, "depth/camera_info",
+                              "camera_info", 1);
+  EXPECT_TRUE(cell.SpinUntil(
+      [&] { return cell.Diag("cloud", "camera_info") == "640x480 pixels, fx 525.0, fy 525.0, cx 319.5, cy 239.5"; },
+      std::chrono::seconds(5)))
+      << cell.Diag("cloud", "camera_info");
   std::vector<msg::Image> image_framework_bad, image_layout_bad;
   { auto m = good_image(); m.data.resize(1000); image_framework_bad.push_back(m); }                         // data vs step * height
   { auto m = good_image(); m.encoding = "rgb8"; image_layout_bad.push_back(m); }                             // not a depth encoding

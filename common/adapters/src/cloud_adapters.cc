@@ -1,8 +1,11 @@
 #include "iplan/adapters/cloud_adapters.h"
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <limits>
+
+#include "iplan/core/params.h"
 
 namespace iplan::services {
 namespace {
@@ -95,6 +98,61 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
     dense = dense && c.points[i].allFinite();
   }
   out->is_dense = dense;
+}
+
+std::optional<std::string> FromCameraInfo(const msg::CameraInfo& m, cloud::CameraIntrinsics* out) {
+  constexpr uint32_t kMaxSide = 4096;  // pixels, as CameraIntrinsics
+  const auto& k = m.k;
+  if (std::all_of(k.begin(), k.end(), [](double x) { return x == 0; })) {
+    return std::string("the camera is not calibrated (k is all zero)");
+  }
+  if (!(k[0] > 0) || !(k[4] > 0)) {
+    return "focal lengths fx " + core::ParamText(k[0]) + ", fy " + core::ParamText(k[4]) + " are not positive";
+  }
+  if (k[1] != 0 || k[3] != 0 || k[6] != 0 || k[7] != 0 || k[8] != 1) {
+    return std::string("k is not a pinhole without skew (fx 0 cx; 0 fy cy; 0 0 1)");
+  }
+  for (double d : m.d) {
+    if (d != 0) {
+      return "distortion '" + m.distortion_model + "' has non-zero coefficients: the depth images must be rectified";
+    }
+  }
+  const uint32_t bx = std::max(m.binning_x, 1u), by = std::max(m.binning_y, 1u);
+  const bool whole = m.roi.width == 0 && m.roi.height == 0;
+  const uint64_t roi_w = whole ? m.width : m.roi.width, roi_h = whole ? m.height : m.roi.height;
+  if (!whole && (uint64_t{m.roi.x_offset} + roi_w > m.width || uint64_t{m.roi.y_offset} + roi_h > m.height)) {
+    return "region of interest " + std::to_string(roi_w) + "x" + std::to_string(roi_h) + " at (" +
+           std::to_string(m.roi.x_offset) + ", " + std::to_string(m.roi.y_offset) + ") is outside the " +
+           std::to_string(m.width) + "x" + std::to_string(m.height) + " image";
+  }
+  const uint64_t w = roi_w / bx, h = roi_h / by;
+  if (w == 0 || h == 0 || w > kMaxSide || h > kMaxSide) {
+    return "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not 1..4096 pixels a side";
+  }
+  const double x0 = whole ? 0.0 : m.roi.x_offset, y0 = whole ? 0.0 : m.roi.y_offset;
+  out->width = static_cast<int>(w);
+  out->height = static_cast<int>(h);
+  out->fx = k[0] / bx;
+  out->fy = k[4] / by;
+  out->cx = (k[2] - x0) / bx;
+  out->cy = (k[5] - y0) / by;
+  return std::nullopt;
+}
+
+void ToCameraInfo(const cloud::CameraIntrinsics& c, const msg::Time& stamp, const std::string& frame_id,
+                  msg::CameraInfo* out) {
+  out->header.stamp = stamp;
+  out->header.frame_id = frame_id;
+  out->width = static_cast<uint32_t>(c.width);
+  out->height = static_cast<uint32_t>(c.height);
+  out->distortion_model = "plumb_bob";
+  out->d.assign(5, 0.0);
+  out->k = {c.fx, 0, c.cx, 0, c.fy, c.cy, 0, 0, 1};
+  out->r = {1, 0, 0, 0, 1, 0, 0, 0, 1};
+  out->p = {c.fx, 0, c.cx, 0, 0, c.fy, c.cy, 0, 0, 0, 1, 0};
+  out->binning_x = 0;
+  out->binning_y = 0;
+  out->roi = msg::RegionOfInterest{};
 }
 
 std::optional<std::string> FromDepthImage(const msg::Image& m, const cloud::CameraIntrinsics& intrinsics,

@@ -125,6 +125,63 @@ TEST(CloudAdaptersTest, MalformedDepthImagesAreRefused) {
             std::string("depth image step 6 does not fit width 4 x 2 bytes or data 18 bytes"));
 }
 
+// A calibration round trip; binning and a region of interest as ROS's
+// image_geometry applies them: a 2x2-binned 320x240 window of the VGA
+// camera, 100 pixels right and 40 down, is 160x120 with fx / 2 and
+// (cx - 100) / 2.
+TEST(CloudAdaptersTest, CameraInfoGivesTheImagesIntrinsics) {
+  const cloud::CameraIntrinsics vga;  // 640x480, 525, 319.5, 239.5
+  msg::CameraInfo m;
+  ToCameraInfo(vga, msg::Time{12, 5}, "depth_camera", &m);
+  EXPECT_EQ(m.header.frame_id, "depth_camera");
+  EXPECT_EQ(m.header.stamp.sec, 12);
+  cloud::CameraIntrinsics k;
+  k.fx = 1;  // overwritten
+  ASSERT_EQ(FromCameraInfo(m, &k), std::nullopt);
+  EXPECT_EQ(k.width, 640);
+  EXPECT_EQ(k.height, 480);
+  EXPECT_EQ(k.fx, 525.0);
+  EXPECT_EQ(k.fy, 525.0);
+  EXPECT_EQ(k.cx, 319.5);
+  EXPECT_EQ(k.cy, 239.5);
+  m.binning_x = 2, m.binning_y = 2;
+  m.roi.x_offset = 100, m.roi.y_offset = 40, m.roi.width = 320, m.roi.height = 240;
+  ASSERT_EQ(FromCameraInfo(m, &k), std::nullopt);
+  EXPECT_EQ(k.width, 160);
+  EXPECT_EQ(k.height, 120);
+  EXPECT_EQ(k.fx, 262.5);
+  EXPECT_EQ(k.fy, 262.5);
+  EXPECT_EQ(k.cx, (319.5 - 100) / 2);
+  EXPECT_EQ(k.cy, (239.5 - 40) / 2);
+}
+
+TEST(CloudAdaptersTest, UnusableCalibrationsAreRefused) {
+  msg::CameraInfo good;
+  ToCameraInfo(cloud::CameraIntrinsics{}, msg::Time{}, "depth_camera", &good);
+  const cloud::CameraIntrinsics before;
+  const auto refused = [&](msg::CameraInfo m) {
+    cloud::CameraIntrinsics k = before;
+    const std::optional<std::string> why = FromCameraInfo(m, &k);
+    EXPECT_EQ(k.fx, before.fx) << "left as it was";
+    return why.value_or("(accepted)");
+  };
+  msg::CameraInfo m = good;
+  m.k.fill(0);
+  EXPECT_EQ(refused(m), "the camera is not calibrated (k is all zero)");
+  m = good, m.k[4] = -525;
+  EXPECT_EQ(refused(m), "focal lengths fx 525.0, fy -525.0 are not positive");
+  m = good, m.k[1] = 0.5;
+  EXPECT_EQ(refused(m), "k is not a pinhole without skew (fx 0 cx; 0 fy cy; 0 0 1)");
+  m = good, m.d[0] = 0.1;
+  EXPECT_EQ(refused(m), "distortion 'plumb_bob' has non-zero coefficients: the depth images must be rectified");
+  m = good, m.roi.x_offset = 400, m.roi.width = 320, m.roi.height = 240;
+  EXPECT_EQ(refused(m), "region of interest 320x240 at (400, 0) is outside the 640x480 image");
+  m = good, m.width = 0;
+  EXPECT_EQ(refused(m), "image size 0x480 is not 1..4096 pixels a side");
+  m = good, m.binning_x = 1000;
+  EXPECT_EQ(refused(m), "image size 0x480 is not 1..4096 pixels a side");
+}
+
 TEST(CloudAdaptersTest, RosDriverLayoutWithPaddingDecodes) {
   // As depth_image_proc publishes: x y z at 0 4 8, rgb at 16, point_step 32,
   // plus 8 bytes of row padding; fields in another order.

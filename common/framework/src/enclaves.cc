@@ -20,11 +20,11 @@ std::vector<dds::EnclaveGrant> CellEnclaves() {
   const std::string diag = Diagnostics().name;
   std::vector<dds::EnclaveGrant> g = {
       {EnclaveName("perception"),
-       {HumanSkeleton().name, HumanTruth().name, DepthPoints().name, DepthImage().name, diag},
+       {HumanSkeleton().name, HumanTruth().name, DepthPoints().name, DepthImage().name, DepthCameraInfo().name, diag},
        {TaskCommand().name, JointStates().name}},
       {EnclaveName("cloud"),
        {Obstacles().name, HumanPoints().name, diag},
-       {DepthPoints().name, DepthImage().name, JointStates().name}},
+       {DepthPoints().name, DepthImage().name, DepthCameraInfo().name, JointStates().name}},
       {EnclaveName("intent"), {ActionBelief().name, HumanPrediction().name, diag}, {HumanSkeleton().name}},
       {EnclaveName("collision_risk"),
        {CollisionRisk().name, CollisionRiskPermit().name, diag},

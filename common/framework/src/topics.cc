@@ -129,6 +129,10 @@ Topic<msg::Image> DepthImage() {
   // Any provider may publish depth images (the depth camera is swappable).
   return {Named("rt/iplan/depth/image"), Q::SensorStream(milliseconds(200), milliseconds(300))};
 }
+Topic<msg::CameraInfo> DepthCameraInfo() {
+  // Whoever publishes the depth images publishes their calibration.
+  return {Named("rt/iplan/depth/camera_info"), Q::SensorStream(milliseconds(200), milliseconds(300))};
+}
 Topic<msg::ObstacleArray> Obstacles() {
   return {Named("rt/iplan/obstacles"), Q::SensorStream(milliseconds(1000), milliseconds(1000)), {"iplan-cloud"}, true};
 }
@@ -200,6 +204,7 @@ std::vector<TopicDescription> All() {
       Describe(HumanTruth(), "true pose of the simulated person (simulation only)"),
       Describe(DepthPoints(), "depth camera point cloud, sensor frame (perception or any camera driver)"),
       Describe(DepthImage(), "depth camera image, 16UC1 mm or 32FC1 m (perception or any camera driver)"),
+      Describe(DepthCameraInfo(), "the depth camera's calibration, beside each image (perception or any camera driver)"),
       Describe(Obstacles(), "static unknown obstacles as boxes (cloud)"),
       Describe(HumanPoints(), "points of moving objects (people) with sensor noise (cloud)"),
       Describe(ActionBelief(), "probability of each human action (intent)"),

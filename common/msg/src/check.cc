@@ -188,6 +188,13 @@ std::optional<std::string> CheckSizes(const Image& m) {
   return std::nullopt;
 }
 
+std::optional<std::string> CheckSizes(const CameraInfo& m) {
+  if (auto e = CheckSizes(m.header)) return e;
+  if (auto e = CheckLength(m.distortion_model, Limits::kName, "distortion_model")) return e;
+  if (m.d.size() > Limits::kDistortionCoefficients) return Over("d", m.d.size(), Limits::kDistortionCoefficients);
+  return std::nullopt;
+}
+
 std::optional<std::string> CheckSizes(const TFMessage& m) {
   if (m.transforms.size() > Limits::kTransforms) return Over("transforms", m.transforms.size(), Limits::kTransforms);
   for (std::size_t i = 0; i < m.transforms.size(); ++i) {
@@ -423,6 +430,10 @@ std::optional<std::string> CheckSemantics(const Image& m) {
   }
   return std::nullopt;
 }
+
+// What the calibration means (a pinhole, rectified or not) is the
+// consumer's to judge (services::FromCameraInfo); here only the header.
+std::optional<std::string> CheckSemantics(const CameraInfo& m) { return CheckSemantics(m.header); }
 
 std::optional<std::string> CheckSemantics(const ObstacleArray& m) {
   if (auto e = CheckSemantics(m.header)) return e;

@@ -416,6 +416,24 @@ TEST(MsgLimits, DepthImage) {
   EXPECT_EQ(Check(im), std::string("data has 67108865 bytes, limit 67108864"));
 }
 
+TEST(MsgLimits, CameraInfo) {
+  CameraInfo c;
+  c.width = 640;
+  c.height = 480;
+  c.distortion_model = "plumb_bob";
+  c.d.assign(5, 0.0);
+  c.k = {525, 0, 319.5, 0, 525, 239.5, 0, 0, 1};
+  EXPECT_EQ(Check(c), std::nullopt);
+  c.d.assign(Limits::kDistortionCoefficients + 1, 0.0);
+  EXPECT_EQ(Check(c), std::string("d has 33 entries, limit 32"));
+  c.d.assign(5, 0.0);
+  c.distortion_model = std::string(Limits::kName + 1, 'm');
+  EXPECT_EQ(Check(c), std::string("distortion_model has 257 characters, limit 256"));
+  c.distortion_model = "plumb_bob";
+  c.k[2] = std::numeric_limits<double>::quiet_NaN();  // every number of every type: finite
+  EXPECT_EQ(Check(c), std::string("non-finite number at k[2]"));
+}
+
 TEST(MsgLimits, Diagnostics) {
   DiagnosticArray a;
   a.status.resize(Limits::kDiagnosticStatuses);

@@ -20,7 +20,6 @@ struct CloudSettings {
   std::string robot = "robots/panda.yaml";
   std::string frame_id = "world";
   cloud::CameraLookAt camera;
-  cloud::CameraIntrinsics intrinsics;
   cloud::DepthNoiseParams noise;
   std::array<double, 3> workspace_min = {-1.0, -1.0, -0.2};
   std::array<double, 3> workspace_max = {2.0, 1.0, 1.5};
@@ -39,7 +38,6 @@ struct CloudSettings {
     a->Visit(IPLAN_NVP(robot, "robot model for the self-filter, relative to the configuration file; \"\" = no robot in view"));
     a->Visit(IPLAN_NVP(frame_id, "frame of the outputs (the cell's)"));
     a->Visit(IPLAN_NVP(camera, "pose of the camera's optical frame in the cell frame"));
-    a->Visit(IPLAN_NVP(intrinsics, "the camera's pinhole intrinsics, to unproject its depth images (/iplan/depth/image; clouds carry their points)"));
     a->Visit(IPLAN_NVP(noise, "the camera's noise model (Nguyen et al. 2012), for the human points' covariance"));
     a->Visit(IPLAN_NVP(workspace_min, "m, W; points outside the box are removed"));
     a->Visit(IPLAN_NVP(workspace_max, "m, W; above workspace_min on every axis"));
@@ -52,7 +50,6 @@ struct CloudSettings {
   /// Empty when valid, else the reason.
   std::string Validate() const {
     if (std::string why = camera.Validate(); !why.empty()) return why;
-    if (std::string why = intrinsics.Validate(); !why.empty()) return "intrinsics: " + why;
     if (std::string why = noise.Validate(); !why.empty()) return "noise: " + why;
     for (int k = 0; k < 3; ++k) {
       if (!(workspace_min[k] < workspace_max[k])) return "workspace_min must be below workspace_max on every axis";

@@ -107,6 +107,9 @@ TEST(PerceptionSettings, BadValuesAreRefusedNamingTheKey) {
   EXPECT_NE(Refusal("perception:\n  depth:\n    provider: pcd\n").find(
                 "depth.pcd.path is required with provider pcd"),
             std::string::npos);
+  EXPECT_NE(Refusal("perception:\n  depth:\n    provider: pcd\n    transport: image\n    pcd: {path: scans}\n")
+                .find("depth.transport image needs provider simulated: a PCD file carries no camera intrinsics"),
+            std::string::npos);
   EXPECT_NE(Refusal("perception:\n  depth:\n    simulated:\n      intrinsics: {fx: 0}\n").find(
                 "depth.simulated.intrinsics.fx must be > 0"),
             std::string::npos);

@@ -55,4 +55,23 @@ std::optional<std::string> FromDepthImage(const msg::Image& m, const cloud::Came
 /// lost.
 void ToDepthImage(const cloud::Cloud& c, const msg::Time& stamp, const std::string& frame_id, msg::Image* out);
 
+/// The pinhole intrinsics of the images a camera's calibration describes,
+/// in pixels of those images: fx, fy, cx, cy from k (fx 0 cx; 0 fy cy;
+/// 0 0 1), with binning and the region of interest applied as ROS's
+/// image_geometry does (fx / binning_x, (cx - roi.x_offset) / binning_x, the
+/// image roi.width / binning_x wide, the full width when the region is
+/// empty; binning 0 is 1). Returns why they cannot be used, nullopt when
+/// *out is set: an image size that is 0 or over 4096 pixels, an
+/// uncalibrated camera (k all zero), fx or fy not positive, skew (k[1]) or a
+/// k whose last row is not 0 0 1, non-zero distortion coefficients (the
+/// images must be rectified: e.g. image_proc's image_rect), a region
+/// outside the image.
+std::optional<std::string> FromCameraInfo(const msg::CameraInfo& m, cloud::CameraIntrinsics* out);
+
+/// A rectified pinhole camera's calibration: plumb_bob with zero
+/// coefficients, k from `intrinsics`, r identity, p = [k | 0], no binning,
+/// the whole image.
+void ToCameraInfo(const cloud::CameraIntrinsics& intrinsics, const msg::Time& stamp, const std::string& frame_id,
+                  msg::CameraInfo* out);
+
 }  // namespace iplan::services

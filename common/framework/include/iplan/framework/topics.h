@@ -48,8 +48,12 @@ Topic<msg::PointCloud2> DepthPoints();
 /// The same camera's depth image (16UC1 in mm or 32FC1 in m, the sensor's
 /// frame): a quarter of a cloud's bytes, so the camera can run at 30 Hz on
 /// loopback; the cloud service unprojects it with the camera's intrinsics
-/// (cloud.yaml intrinsics).
+/// (DepthCameraInfo).
 Topic<msg::Image> DepthImage();
+/// The depth camera's calibration (pinhole intrinsics, pixels), published
+/// beside each depth image with its stamp, as ROS 2 camera drivers do: what
+/// the cloud service unprojects DepthImage with.
+Topic<msg::CameraInfo> DepthCameraInfo();
 /// Static unknown obstacles (boxes, cell frame) the cloud stage found.
 Topic<msg::ObstacleArray> Obstacles();
 /// Points of moving objects (people) the cloud stage found, each with the

@@ -54,6 +54,9 @@ struct Limits {
 
   // Image (a depth camera's): the same pixel limit as a cloud's points.
   static constexpr std::size_t kImageBytes = std::size_t{64} << 20;  ///< data, 64 MiB
+  // CameraInfo: ROS's models have 4 (equidistant), 5 (plumb_bob) or 8
+  // (rational_polynomial) coefficients.
+  static constexpr std::size_t kDistortionCoefficients = 32;  ///< d
 
   // ObstacleArray and HumanPoints.
   static constexpr std::size_t kObstacles = 256;        ///< boxes per array
@@ -87,6 +90,7 @@ std::optional<std::string> CheckSizes(const JointState& m);
 std::optional<std::string> CheckSizes(const JointTrajectory& m);
 std::optional<std::string> CheckSizes(const PointCloud2& m);
 std::optional<std::string> CheckSizes(const Image& m);
+std::optional<std::string> CheckSizes(const CameraInfo& m);
 std::optional<std::string> CheckSizes(const ObstacleArray& m);
 std::optional<std::string> CheckSizes(const HumanPoints& m);
 std::optional<std::string> CheckSizes(const TaskCommand& m);
@@ -114,6 +118,7 @@ std::optional<std::string> CheckSemantics(const JointState& m);
 std::optional<std::string> CheckSemantics(const JointTrajectory& m);
 std::optional<std::string> CheckSemantics(const PointCloud2& m);
 std::optional<std::string> CheckSemantics(const Image& m);
+std::optional<std::string> CheckSemantics(const CameraInfo& m);
 std::optional<std::string> CheckSemantics(const ObstacleArray& m);
 std::optional<std::string> CheckSemantics(const HumanPoints& m);
 std::optional<std::string> CheckSemantics(const TaskCommand& m);
