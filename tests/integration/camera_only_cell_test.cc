@@ -118,8 +118,12 @@ class CameraOnlyCell {
     // service, receiving 37 MB/s of clouds, got the robot's joint states
     // seconds late and could not filter the robot out of up to half of the
     // clouds (docs/perception-clouds.md, "The camera-only cell").
+    // The frames as clouds on Fast DDS, as depth images with their
+    // calibration (320x240, from the camera's own intrinsics) on Cyclone:
+    // both transports carry the cell.
     framework::ServiceFile file(kConfig + "/perception.yaml",
                                 {{"perception.depth.provider", "simulated"},
+                                 {"perception.depth.transport", vendor == dds::Vendor::kCyclone ? "image" : "points"},
                                  {"perception.depth.simulated.intrinsics",
                                   "{width: 320, height: 240, fx: 262.5, fy: 262.5, cx: 159.5, cy: 119.5}"},
                                  {"perception.depth.simulated.noise.focal_px", "262.5"}});
@@ -180,6 +184,11 @@ class CameraOnlyCell {
     return std::nullopt;
   }
   void Stop() { cell_.Stop(); }
+  /// Lets the cell's observer take the services' diagnostics of the last
+  /// 1.2 s (one a second; the test's own node does not receive them).
+  void TakeDiagnostics() { cell_.SpinFor(1200ms); }
+  /// A value of the cloud service's newest diagnostics taken (-1: none).
+  double CloudDiag(const std::string& key) const { return cell_.DiagNumber("cloud", key, -1); }
 
   // Robot spheres at q against the true body spheres: the smallest surface distance, m.
   double Distance(const std::vector<double>& q, const std::vector<Eigen::Vector3d>& centres) const {
@@ -292,6 +301,14 @@ TEST_P(CameraOnlyCellTest, APersonStandingAtTheTableSeenOnlyByTheCameraSlowsTheR
     outcomes.push_back(*o);
   }
   const double t_done = cell.Since();
+  // The frames came by the transport asked for (the constructor).
+  cell.TakeDiagnostics();
+  EXPECT_GT(cell.CloudDiag("clouds"), 30);
+  if (GetParam() == dds::Vendor::kCyclone) {
+    EXPECT_EQ(cell.CloudDiag("depth_images"), cell.CloudDiag("clouds"));
+  } else {
+    EXPECT_EQ(cell.CloudDiag("depth_images"), -1) << "clouds " << cell.CloudDiag("clouds");
+  }
   cell.Stop();
   const CellRun& run = cell.run;
   EXPECT_EQ(run.skeletons, 0) << "a skeleton in a camera-only cell";
