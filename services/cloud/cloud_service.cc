@@ -1,6 +1,7 @@
 // iplan-cloud: the depth camera's clouds (/iplan/depth/points, sensor frame;
 // or its depth images, /iplan/depth/image, unprojected with the calibration
-// the camera publishes beside them, /iplan/depth/camera_info) into typed outputs in the cell frame: static unknown obstacles as boxes
+// the camera publishes beside them, /iplan/depth/camera_info) into typed
+// outputs in the cell frame: static unknown obstacles as boxes
 // (/iplan/obstacles, stable ids) and the points of moving objects, people,
 // with the sensor's noise covariance (/iplan/human/points). The stage
 // (core/cloud_stage.h): workspace crop, robot self-filter from
@@ -129,15 +130,14 @@ class CloudService : public framework::Service {
   void OnCameraInfo(Node& node, const msg::CameraInfo& m) {
     cloud::CameraIntrinsics k;
     if (node.CountRejection("camera_info", services::FromCameraInfo(m, &k))) return;
-    if (!intrinsics_ || k.width != intrinsics_->width || k.height != intrinsics_->height || k.fx != intrinsics_->fx ||
-        k.fy != intrinsics_->fy || k.cx != intrinsics_->cx || k.cy != intrinsics_->cy) {
-      const std::string text = std::to_string(k.width) + "x" + std::to_string(k.height) + " pixels, fx " +
-                               core::ParamText(k.fx) + ", fy " + core::ParamText(k.fy) + ", cx " +
-                               core::ParamText(k.cx) + ", cy " + core::ParamText(k.cy);
-      node.log().info("camera calibration: {}", text);
-      node.SetDiagnosticValue("camera_info", text);
-    }
     intrinsics_ = k;
+    const std::string text = std::to_string(k.width) + "x" + std::to_string(k.height) + " pixels, fx " +
+                             core::ParamText(k.fx) + ", fy " + core::ParamText(k.fy) + ", cx " + core::ParamText(k.cx) +
+                             ", cy " + core::ParamText(k.cy);
+    if (text == calibration_text_) return;  // the same calibration again, as with every image
+    node.log().info("camera calibration: {}", text);
+    node.SetDiagnosticValue("camera_info", text);
+    calibration_text_ = text;
   }
 
   // A depth image, unprojected with the camera's latest calibration into the
@@ -219,6 +219,7 @@ class CloudService : public framework::Service {
   int64_t self_filter_ns_ = 0;
   std::string frame_id_ = "world";
   std::optional<cloud::CameraIntrinsics> intrinsics_;  // the camera's latest usable calibration
+  std::string calibration_text_;                       // as logged and in the diagnostics
   uint64_t images_ = 0;  // depth images unprojected (of the clouds processed)
   uint64_t images_without_info_ = 0;  // depth images that came before any calibration
   cloud::Cloud cloud_;

@@ -153,7 +153,8 @@ std::string DepthSettings::Validate() const {
   if (!(rate_hz >= 0.1 && rate_hz <= 120)) return "rate_hz must be in [0.1, 120], got " + Num(rate_hz);
   if (transport != "points" && transport != "image") return "transport must be points or image, got '" + transport + "'";
   if (provider == "pcd" && transport == "image") {
-    return "transport image needs provider simulated: a PCD file carries no camera intrinsics to publish with its images";
+    return "transport image needs provider simulated: a PCD file carries no camera intrinsics to publish with "
+           "its images";
   }
   if (provider == "pcd" && pcd.path.empty()) return "pcd.path is required with provider pcd (a .pcd file or a folder of them)";
   // Both providers' keys are checked always, so that switching keeps the file valid.

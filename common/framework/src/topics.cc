@@ -204,7 +204,7 @@ std::vector<TopicDescription> All() {
       Describe(HumanTruth(), "true pose of the simulated person (simulation only)"),
       Describe(DepthPoints(), "depth camera point cloud, sensor frame (perception or any camera driver)"),
       Describe(DepthImage(), "depth camera image, 16UC1 mm or 32FC1 m (perception or any camera driver)"),
-      Describe(DepthCameraInfo(), "the depth camera's calibration, beside each image (perception or any camera driver)"),
+      Describe(DepthCameraInfo(), "the depth camera's calibration, beside each image (perception or a camera driver)"),
       Describe(Obstacles(), "static unknown obstacles as boxes (cloud)"),
       Describe(HumanPoints(), "points of moving objects (people) with sensor noise (cloud)"),
       Describe(ActionBelief(), "probability of each human action (intent)"),
