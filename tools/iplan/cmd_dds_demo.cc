@@ -22,6 +22,7 @@
 #include <spdlog/spdlog.h>
 
 #include "command_registry.h"
+#include "services/collision_risk/risk_config.h"
 #include "services/supervisor/core/supervisor_settings.h"
 #include "services/supervisor/core/task_goals.h"
 #include "services/supervisor/core/task_planner.h"
@@ -113,6 +114,7 @@ class DemoRun {
     nopts.diagnostics_period = 0;
     framework::Node node("demo", *participant, nopts);
     CellMonitor mon(node, static_cast<int>(graph_.tasks.size()), t0_);
+    if (judge_) mon.AuditStops(node, std::move(judge_));
     Watch(node, mon);
     Stop(node, mon);
     const double contacts = mon.DiagNumber("robot_sim", "true_contacts", -1);
@@ -186,7 +188,9 @@ class DemoRun {
       supervisor::SupervisorSettings supervisor;
       sup.ReadSection("supervisor", &supervisor).Finish();  // as the supervisor reads it
       graph_ = supervisor::LoadTaskGraph(sup.ResolvePath(supervisor.task_graph));
+      resume_delay_ = supervisor.resume_delay;
       if (!o_.robot.empty()) PrepareRobot();
+      judge_ = MakeStopJudge();
     } catch (const std::exception& e) {
       std::cerr << "\niplan demo: " << e.what() << "\n";
       return 2;
@@ -210,6 +214,19 @@ class DemoRun {
     rest_text_ = q.str();
     std::cout << "  robot " << planner->robot().name << " (" << robot_file_ << ", " << planner->robot().nq
               << " joints), resting at " << rest_text_ << " rad\n";
+  }
+
+  // The collision-risk monitor's rule, as configured, for the true person
+  // (stop_audit.h); null, with a note, when it cannot be built.
+  std::unique_ptr<TrueSeparationJudge> MakeStopJudge() const {
+    try {
+      const collision_risk::RiskConfig c = collision_risk::LoadRiskConfig(Cfg("collision_risk"), robot_file_);
+      return std::make_unique<TrueSeparationJudge>(collision::LoadRobotModel(c.robot_file),
+                                                   collision::LoadHumanBodyParams(c.human_body_file), c.params);
+    } catch (const std::exception& e) {
+      std::cout << "  stops not audited against the true person: " << e.what() << "\n";
+      return nullptr;
+    }
   }
 
   std::vector<std::string> ServiceArguments(const std::string& exe, const std::string& name) const {
@@ -385,7 +402,7 @@ class DemoRun {
                 << Fixed(mon.DiagNumber("cloud", "motions", 0), 0) << " moving parts); "
                 << Fixed(mon.DiagNumber("cloud", "clouds_without_self_filter", 0), 0) << " clouds without self-filter\n";
     }
-    for (const auto& r : mon.stop_reasons_) std::cout << "    stop: " << r << "\n";
+    PrintStops(mon);
     std::cout << "\nLearning curve (completion time per episode)\n  episode  time_s  waiting_s  task order\n";
     for (const auto& [n, e] : mon.episodes()) {
       std::cout << "  " << std::setw(7) << n << "  " << std::setw(6) << (e.done ? Fixed(e.completion(), 1) : "-") << "  "
@@ -393,6 +410,46 @@ class DemoRun {
       for (const auto& t : e.order) std::cout << " " << t;
       std::cout << (e.done ? "" : " (incomplete)") << "\n";
     }
+  }
+
+  // Each stop, with the audit's timing against the true person.
+  void PrintStops(const CellMonitor& mon) const {
+    const StopAudit& audit = mon.stop_audit();
+    const bool audited = mon.auditing_stops() && audit.judgements() > 0;
+    if (mon.auditing_stops()) {
+      std::cout << "  stops against the true person "
+                << (audited ? Describe(Summarize(audit, mon.first_task_s(), resume_delay_))
+                            : "not audited (no true pose of the person came)")
+                << "\n";
+    }
+    for (std::size_t i = 0; i < mon.stop_reasons_.size(); ++i) {
+      const bool timed = audited && i < audit.stops().size();
+      std::cout << "    stop: " << (timed ? Describe(audit.stops()[i]) + " " : "") << mon.stop_reasons_[i] << "\n";
+    }
+  }
+
+  static nlohmann::json StopAuditJson(const CellMonitor& mon, double resume_delay) {
+    const StopAudit& audit = mon.stop_audit();
+    if (!mon.auditing_stops() || audit.judgements() == 0) return nullptr;
+    const StopAuditSummary a = Summarize(audit, mon.first_task_s(), resume_delay);
+    nlohmann::json j = {{"judgements", audit.judgements()},
+                        {"since_s", mon.first_task_s()},
+                        {"stops", a.stops},
+                        {"with_person_within_sp", a.with_person_within},
+                        {"outlasting_resume_delay", a.outlasting},
+                        {"resume_delay_s", resume_delay},
+                        {"outlast_s", {{"p50", a.outlast_p50_s}, {"max", a.outlast_max_s}}},
+                        {"after_s", {{"max", a.after_max_s}}},
+                        {"each", nlohmann::json::array()}};
+    for (const AuditedStop& s : audit.stops()) {
+      j["each"].push_back({{"start_s", s.start_s},
+                           {"duration_s", s.Duration()},
+                           {"person_within_sp_s", s.true_inside_s},
+                           {"outlast_s", s.Outlast()},
+                           {"after_s", s.After()},
+                           {"reason", s.reason}});
+    }
+    return j;
   }
 
   void WriteSummary(const CellMonitor& mon, double contacts) const {
@@ -420,6 +477,7 @@ class DemoRun {
     j["max_plan_collision_bound"] = mon.max_plan_bound_;
     j["protective_stops"] = mon.stops_;
     j["protective_stop_time_s"] = mon.stop_time_s_;
+    j["stop_audit"] = StopAuditJson(mon, resume_delay_);
     j["slow_downs"] = {{"count", mon.slow_downs_}, {"robot_slowed_s", mon.DiagNumber("robot_sim", "slowed_down_s", 0)}};
     j["security"] = {{"secured", security_->secured}, {"keystore", security_->keystore}, {"summary", security_->summary}};
     j["true_contacts"] = contacts;
@@ -455,6 +513,8 @@ class DemoRun {
   std::optional<DemoSecurity> security_;  // decided in Prepare (not for --prepare-only)
   supervisor::TaskGraph graph_;
   std::string robot_file_;  ///< --robot, absolute; empty: the configured robot
+  double resume_delay_ = 0;  ///< s, the supervisor's (the stop audit's allowance)
+  std::unique_ptr<TrueSeparationJudge> judge_;  ///< until the monitor takes it
   std::string rest_text_;   ///< its rest joint positions, as a YAML list
   std::unique_ptr<core::Process> recorder_;
   Clock::time_point t0_;

@@ -42,7 +42,6 @@ namespace {
 
 namespace fs = std::filesystem;
 using cell_sim::Predictor;
-using eval_common::Fixed;
 using eval_common::Json;
 using eval_common::RatioJson;
 using eval_common::SpreadJson;

@@ -27,7 +27,6 @@ namespace iplan::cli {
 namespace {
 
 using cell_sim::Predictor;
-using eval_common::Fixed;
 using eval_common::Json;
 using eval_common::SpreadText;
 

@@ -2,21 +2,27 @@
 // follows task commands and outcomes, plan statuses, collision-risk verdicts,
 // both monitors' permits and every service's diagnostics, and keeps what the
 // demo's progress line and summary show (episodes, stops and slow-downs,
-// separation, bound, latency). Single-threaded: its callbacks run on the
-// node's thread (Node::SpinOnce).
+// separation, bound, latency), and with a TrueSeparationJudge audits each
+// stop against the true person (stop_audit.h). Single-threaded: its
+// callbacks run on the node's thread (Node::SpinOnce).
 #pragma once
 
 #include <algorithm>
 #include <chrono>
 #include <iomanip>
+#include <limits>
 #include <map>
+#include <memory>
 #include <sstream>
 #include <string>
 #include <utility>
 #include <vector>
 
+#include "fixed_text.h"
+#include "iplan/adapters/adapters.h"
 #include "iplan/framework/node.h"
 #include "iplan/framework/topics.h"
+#include "stop_audit.h"
 
 namespace iplan::cli {
 
@@ -30,13 +36,6 @@ struct Episode {
   bool done = false;
   double completion() const { return end - start; }
 };
-
-// `v` with `digits` decimals.
-inline std::string Fixed(double v, int digits) {
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
 
 class CellMonitor {
  public:
@@ -80,8 +79,12 @@ class CellMonitor {
                          ++stops_;
                          stop_reasons_.push_back(m.source + ": " + m.reason);
                          stop_since_ = Now();
+                         audit_.StopStarted(stop_since_, stop_reasons_.back());
                        }
-                       if (!stopped_ && was_stopped) stop_time_s_ += Now() - stop_since_;
+                       if (!stopped_ && was_stopped) {
+                         stop_time_s_ += Now() - stop_since_;
+                         audit_.StopEnded(Now());
+                       }
                      }),
                      any_order);
     }
@@ -92,6 +95,43 @@ class CellMonitor {
                      }
                    }),
                    any_order);
+  }
+
+  // Judges every true pose of the simulated person against the robot's
+  // state and executing trajectory, so that each stop is timed against the
+  // true person's stay within S_p (stop_audit()).
+  void AuditStops(framework::Node& node, std::unique_ptr<TrueSeparationJudge> judge) {
+    using SI = const dds::SampleInfo&;
+    namespace topics = framework::topics;
+    judge_ = std::move(judge);
+    node.Subscribe(topics::JointStates(), std::function<void(const msg::JointState&, SI)>([this](const msg::JointState& m, SI) {
+                     judge_->UpdateRobotState(msg::ToNanoseconds(m.header.stamp), m.name, m.position);
+                   }));
+    node.Subscribe(topics::RobotTrajectory(),
+                   std::function<void(const msg::JointTrajectory&, SI)>([this](const msg::JointTrajectory& m, SI info) {
+                     std::vector<double> times;
+                     std::vector<std::vector<double>> pos;
+                     services::FromTrajectory(m, &times, &pos);
+                     judge_->UpdateTrajectory(services::TrajectoryStartNs(m, info.reception_ns), m.joint_names, times, pos);
+                   }));
+    node.Subscribe(topics::HumanTruth(), std::function<void(const msg::HumanSkeleton&, SI)>([this](const msg::HumanSkeleton& m, SI) {
+                     std::vector<std::string> names;
+                     std::vector<Eigen::Vector3d> p;
+                     for (const auto& j : m.joints) {
+                       names.push_back(j.name);
+                       p.emplace_back(j.position.x, j.position.y, j.position.z);
+                     }
+                     if (judge_->UpdateTruth(msg::ToNanoseconds(m.header.stamp), names, p)) return;
+                     if (const std::optional<bool> inside = judge_->Inside(msg::ToNanoseconds(msg::Now())))
+                       audit_.Judge(Now(), *inside);
+                   }));
+  }
+  const StopAudit& stop_audit() const { return audit_; }
+  bool auditing_stops() const { return judge_ != nullptr; }
+  /// s since the demo started of the first task command (the stops before
+  /// it are the cell's safe start); infinity before it.
+  double first_task_s() const {
+    return episodes_.empty() ? std::numeric_limits<double>::infinity() : episodes_.begin()->second.start;
   }
 
   double Now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
@@ -195,6 +235,8 @@ class CellMonitor {
   std::map<std::string, bool> permit_stops_;  // per monitor: its last permit is a STOP
   std::map<std::string, std::map<std::string, std::string>> diag_;
   std::vector<std::string> events_;
+  std::unique_ptr<TrueSeparationJudge> judge_;  // null: stops not audited
+  StopAudit audit_;
 };
 
 }  // namespace iplan::cli

@@ -21,6 +21,7 @@
 #include "tools/cell_sim/cell_config.h"
 #include "tools/cell_sim/core/interaction_benchmark.h"
 #include "dds_cell_model.h"
+#include "fixed_text.h"
 #include "iplan/framework/service.h"
 #include "iplan/intent/model_io.h"
 
@@ -29,13 +30,6 @@ namespace iplan::cli::eval_common {
 using Json = nlohmann::ordered_json;
 
 inline const char* kAllPredictors = "none,constant-position,constant-velocity,model,oracle";
-
-inline std::string Fixed(double v, int digits) {
-  if (std::isinf(v)) return "inf";
-  std::ostringstream s;
-  s << std::fixed << std::setprecision(digits) << v;
-  return s.str();
-}
 
 inline std::string SpreadText(const cell_sim::Spread& s, int digits) {
   return Fixed(s.median, digits) + " [" + Fixed(s.p10, digits) + ", " + Fixed(s.p90, digits) + "]";
