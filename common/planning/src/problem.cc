@@ -68,6 +68,13 @@ void PlannerModel::ValidateRequest(const PlanningRequest& req, int num_optimizer
 
 namespace {
 
+// Intervals of a plan whose first `keep` waypoints are fixed and whose
+// motion after them takes `seconds` (a whole number of intervals, up to
+// rounding, gets no extra one).
+int IntervalsFor(int keep, double seconds, double dt) {
+  return (keep - 1) + static_cast<int>(std::ceil(seconds / dt - 1e-9));
+}
+
 // The plan's length in intervals, from `n` (the horizon's or a longer warm
 // start's): shorter with keep_arrival when the warm start already ends at
 // this goal (its arrival kept, the motion's end does not recede a horizon
@@ -89,7 +96,7 @@ int ArrivalLength(const PlannerParams& P, const PlanningRequest& req, const Eige
   }
   if (P.motion_speed_fraction > 0) {
     const double wanted = std::max(P.min_motion_time, kRestToRestPeakFactor * t_min / P.motion_speed_fraction);
-    const int fitted = (keep - 1) + static_cast<int>(std::ceil(wanted / P.dt - 1e-9));
+    const int fitted = IntervalsFor(keep, wanted, P.dt);
     return std::min(n, std::max(fitted, shortest));
   }
   return n;
@@ -121,7 +128,7 @@ Problem PlannerModel::MakeProblem(const PlanningRequest& req, const Eigen::Vecto
   // straight line to the goal as its start; otherwise every attempt would
   // break a velocity limit and the robot would never leave (measured on the
   // Panda: 2.1 rad of joint 1 plans in a 1.5 s horizon, 2.8 rad does not).
-  const int need = (keep - 1) + static_cast<int>(std::ceil(kRestToRestPeakFactor * t_min / P.dt));
+  const int need = IntervalsFor(keep, kRestToRestPeakFactor * t_min, P.dt);
   const bool stretched = need > at.n;
   if (stretched) at.n = std::min(need, 2 * horizon_n);
   at.k = req.num_frozen;
