@@ -440,6 +440,7 @@ class DemoRun {
                         {"resume_delay_s", resume_delay},
                         {"outlast_s", {{"p50", a.outlast_p50_s}, {"max", a.outlast_max_s}}},
                         {"after_s", {{"max", a.after_max_s}}},
+                        {"unstopped_within_sp_s", {{"total", a.unstopped_inside_s}, {"longest", a.longest_unstopped_inside_s}}},
                         {"each", nlohmann::json::array()}};
     for (const AuditedStop& s : audit.stops()) {
       j["each"].push_back({{"start_s", s.start_s},

@@ -14,17 +14,22 @@ double AuditedStop::After() const {
 }
 
 void StopAudit::Advance(double t_s) {
-  if (open_ && inside_) {
-    const double from = std::max(judged_at_, open_->start_s);
-    if (t_s > from) {
-      open_->true_inside_s += t_s - from;
-      open_->last_inside_s = t_s;
-    }
+  if (!(t_s > accounted_to_)) return;
+  if (inside_ && open_) {
+    open_->true_inside_s += t_s - std::max(accounted_to_, open_->start_s);
+    open_->last_inside_s = t_s;
+  } else if (inside_) {
+    unstopped_inside_s_ += t_s - accounted_to_;
+    stretch_s_ += t_s - accounted_to_;
+    longest_unstopped_inside_s_ = std::max(longest_unstopped_inside_s_, stretch_s_);
   }
+  accounted_to_ = t_s;
 }
 
 void StopAudit::StopStarted(double t_s, std::string reason) {
   if (open_) StopEnded(t_s);  // two starts without an end: the first ends here
+  Advance(t_s);
+  stretch_s_ = 0;
   open_ = AuditedStop{};
   open_->start_s = t_s;
   open_->reason = std::move(reason);
@@ -43,6 +48,7 @@ void StopAudit::StopEnded(double t_s) {
 void StopAudit::Judge(double t_s, bool inside) {
   if (t_s < judged_at_) return;
   Advance(t_s);
+  if (!inside) stretch_s_ = 0;
   inside_ = inside;
   judged_at_ = t_s;
   ++judgements_;
@@ -64,6 +70,8 @@ StopAuditSummary Summarize(const StopAudit& audit, double since_s, double allowa
   const core::Summary o = core::Summarize(std::move(outlast));  // zeros when empty
   s.outlast_p50_s = o.p50;
   s.outlast_max_s = o.max;
+  s.unstopped_inside_s = audit.unstopped_inside_s();
+  s.longest_unstopped_inside_s = audit.longest_unstopped_inside_s();
   return s;
 }
 
@@ -79,7 +87,9 @@ std::string Describe(const StopAuditSummary& s) {
   return std::to_string(s.stops) + " after the safe start, " + std::to_string(s.with_person_within) +
          " with the person within S_p; a stop outlasts their stay there by median " + Fixed(s.outlast_p50_s, 2) +
          " s, max " + Fixed(s.outlast_max_s, 2) + " s (after they left: max " + Fixed(s.after_max_s, 2) + " s); " +
-         std::to_string(s.outlasting) + " by more than the resume delay (" + Fixed(s.allowance_s, 2) + " s)";
+         std::to_string(s.outlasting) + " by more than the resume delay (" + Fixed(s.allowance_s, 2) +
+         " s); the person within S_p with no stop in force " + Fixed(s.unstopped_inside_s, 2) + " s in all, at most " +
+         Fixed(s.longest_unstopped_inside_s, 2) + " s at a time";
 }
 
 namespace {

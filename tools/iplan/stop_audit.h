@@ -67,6 +67,11 @@ class StopAudit {
   const std::vector<AuditedStop>& stops() const { return ended_; }
   /// Number of judgements taken (0: the truth never came, nothing audited).
   int judgements() const { return judgements_; }
+  /// s, so far, with the true person within S_p and no stop in force (the
+  /// robot free to move, perhaps slowed, where the monitor's rule on the
+  /// truth would have stopped it), in total and the longest stretch.
+  double unstopped_inside_s() const { return unstopped_inside_s_; }
+  double longest_unstopped_inside_s() const { return longest_unstopped_inside_s_; }
 
  private:
   void Advance(double t_s);  // the current judgement holds until t_s
@@ -75,6 +80,9 @@ class StopAudit {
   std::optional<AuditedStop> open_;
   bool inside_ = false;
   double judged_at_ = -std::numeric_limits<double>::infinity();
+  double accounted_to_ = -std::numeric_limits<double>::infinity();  // time is accounted for up to here
+  double unstopped_inside_s_ = 0, longest_unstopped_inside_s_ = 0;
+  double stretch_s_ = 0;  // the current stretch within S_p without a stop
   int judgements_ = 0;
 };
 
@@ -91,6 +99,8 @@ struct StopAuditSummary {
   double allowance_s = 0;
   /// Outlast() and After() over the audited stops (nearest rank; 0 when none).
   double outlast_p50_s = 0, outlast_max_s = 0, after_max_s = 0;
+  /// StopAudit::unstopped_inside_s() and its longest stretch (whole run).
+  double unstopped_inside_s = 0, longest_unstopped_inside_s = 0;
 };
 StopAuditSummary Summarize(const StopAudit& audit, double since_s, double allowance_s);
 

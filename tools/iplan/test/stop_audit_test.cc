@@ -109,9 +109,27 @@ TEST(StopAudit, TheSummaryLeavesOutTheSafeStartAndCountsStopsBeyondTheAllowance)
   EXPECT_EQ(Summarize(a, 20.0, 0.5).stops, 0);
   EXPECT_EQ(Describe(s),
             "3 after the safe start, 2 with the person within S_p; a stop outlasts their stay there by median 1.25 s, "
-            "max 1.50 s (after they left: max 1.50 s); 2 by more than the resume delay (0.50 s)");
+            "max 1.50 s (after they left: max 1.50 s); 2 by more than the resume delay (0.50 s); the person within "
+            "S_p with no stop in force 1.00 s in all, at most 1.00 s at a time");
   EXPECT_EQ(Describe(a.stops()[1]), "at 5.0 s for 1.25 s (person within S_p 1.00 s, 0.25 s after they left)");
   EXPECT_EQ(Describe(a.stops()[2]), "at 8.0 s for 1.50 s (person never within S_p)");
+}
+
+TEST(StopAudit, TimeWithinSpWithNoStopInForceIsCountedInStretches) {
+  StopAudit a;
+  a.Judge(1.0, true);
+  a.Judge(1.5, false);  // 0.5 s within S_p, no stop
+  a.Judge(2.0, true);
+  a.StopStarted(2.25, "r");  // 0.25 s, then the stop
+  a.StopEnded(3.0);  // ended with the person still within S_p: 1 s more until 4.0
+  a.Judge(3.5, true);
+  a.Judge(4.0, false);
+  EXPECT_DOUBLE_EQ(a.unstopped_inside_s(), 1.75);
+  // The stretch before the stop does not add up with the one after it.
+  EXPECT_DOUBLE_EQ(a.longest_unstopped_inside_s(), 1.0);
+  ASSERT_EQ(a.stops().size(), 1u);
+  EXPECT_DOUBLE_EQ(a.stops()[0].true_inside_s, 0.75);
+  EXPECT_DOUBLE_EQ(a.stops()[0].After(), 0.0);
 }
 
 const std::vector<std::string> kJoints = {"head", "neck", "torso", "shoulder_l", "elbow_l", "hand_l",
