@@ -95,12 +95,11 @@ std::string Describe(const StopAuditSummary& s) {
 namespace {
 
 // The monitor's parameters, judging the truth: the human speed always
-// measured (the truth is exact, so over a short window), never degraded to
-// the default speed for want of a forecast, and a person always there.
-collision_risk::RiskParams TruthParams(collision_risk::RiskParams p, double speed_window) {
+// measured, never degraded to the default speed for want of a forecast,
+// and a person always there.
+collision_risk::RiskParams TruthParams(collision_risk::RiskParams p) {
   p.ssm.measure_human_speed = true;
   p.ssm.degrade_without_prediction = false;
-  p.ssm.speed_window = speed_window;
   p.person_required = false;
   return p;
 }
@@ -108,8 +107,8 @@ collision_risk::RiskParams TruthParams(collision_risk::RiskParams p, double spee
 }  // namespace
 
 TrueSeparationJudge::TrueSeparationJudge(collision::RobotModel robot, collision::HumanBodyParams body,
-                                         collision_risk::RiskParams params, double speed_window)
-    : monitor_(std::move(robot), std::move(body), TruthParams(std::move(params), speed_window)) {}
+                                         collision_risk::RiskParams params)
+    : monitor_(std::move(robot), std::move(body), TruthParams(std::move(params))) {}
 
 std::optional<std::string> TrueSeparationJudge::UpdateRobotState(int64_t stamp_ns, const std::vector<std::string>& names,
                                                                  const std::vector<double>& positions) {
@@ -127,12 +126,24 @@ std::optional<std::string> TrueSeparationJudge::UpdateTrajectory(int64_t start_n
 std::optional<std::string> TrueSeparationJudge::UpdateTruth(int64_t stamp_ns, const std::vector<std::string>& names,
                                                             const std::vector<Eigen::Vector3d>& positions) {
   auto why = monitor_.UpdateSkeleton(stamp_ns, names, positions);
-  has_truth_ = has_truth_ || !why;
+  if (!why) {
+    truth_stamps_.push_back(stamp_ns);
+    const auto window = static_cast<int64_t>(monitor_.params().ssm.speed_window * 1e9);
+    while (truth_stamps_.size() > 2 && stamp_ns - truth_stamps_[1] >= window) truth_stamps_.pop_front();
+  }
   return why;
 }
 
 std::optional<bool> TrueSeparationJudge::Inside(int64_t now_ns) {
-  if (!has_state_ || !has_truth_) return std::nullopt;
+  // The monitor measures the speed over a truth at least half its window
+  // old; before that it would take the default speed, which is no truth.
+  const auto window = static_cast<int64_t>(monitor_.params().ssm.speed_window * 1e9);
+  const bool measured =
+      truth_stamps_.size() >= 2 && std::any_of(truth_stamps_.begin(), truth_stamps_.end(), [&](int64_t t) {
+        const int64_t dt = truth_stamps_.back() - t;
+        return dt <= window && dt >= window / 2;
+      });
+  if (!has_state_ || !measured) return std::nullopt;
   last_ = monitor_.Evaluate(now_ns);
   // No fresh truth or robot state: nothing to judge (Evaluate then reports
   // nobody seen).

@@ -24,6 +24,7 @@
 #pragma once
 
 #include <cstdint>
+#include <deque>
 #include <limits>
 #include <optional>
 #include <string>
@@ -114,11 +115,10 @@ std::string Describe(const StopAuditSummary& summary);
 class TrueSeparationJudge {
  public:
   /// `params`: the cell's collision-risk parameters (its ISO/TS 15066
-  /// section); the human speed is always measured from the truth
-  /// (over `speed_window` s), never the default speed. Throws
+  /// section); the human speed is always measured from the truth, over the
+  /// monitor's own speed_window, never the default speed. Throws
   /// std::invalid_argument on invalid parameters.
-  TrueSeparationJudge(collision::RobotModel robot, collision::HumanBodyParams body,
-                      collision_risk::RiskParams params, double speed_window = 0.1);
+  TrueSeparationJudge(collision::RobotModel robot, collision::HumanBodyParams body, collision_risk::RiskParams params);
 
   /// Inputs, as the collision-risk monitor takes them; each returns why it
   /// was refused, or nullopt.
@@ -131,14 +131,16 @@ class TrueSeparationJudge {
                                          const std::vector<Eigen::Vector3d>& positions);
 
   /// Whether the true person is within S_p at now_ns: nullopt until the
-  /// robot state and the truth are known (and fresh).
+  /// robot state and the truth are known and fresh, and while the truth
+  /// does not yet span half the speed window (no measured speed).
   std::optional<bool> Inside(int64_t now_ns);
   /// The last judgement's report (its reason names the binding pair).
   const collision_risk::RiskReport& last_report() const { return last_; }
 
  private:
   collision_risk::RiskMonitor monitor_;
-  bool has_state_ = false, has_truth_ = false;
+  bool has_state_ = false;
+  std::deque<int64_t> truth_stamps_;  // ns, within the speed window of the newest
   collision_risk::RiskReport last_;
 };
 

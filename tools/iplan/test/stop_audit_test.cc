@@ -184,6 +184,21 @@ TEST_F(TrueSeparationJudgeTest, NothingIsJudgedWithoutTheRobotOrTheTruth) {
   EXPECT_EQ(judge_.Inside(t + 2 * kSec), std::nullopt);
 }
 
+TEST_F(TrueSeparationJudgeTest, NoJudgementBeforeTheTruthGivesASpeed) {
+  // A truth at 10 Hz: one pose, then 0.1 s of them, are less than half the
+  // monitor's 0.3 s speed window, where it would take the default speed.
+  const int64_t t = 100 * kSec;
+  ASSERT_EQ(judge_.UpdateRobotState(t, kRobotJoints, kReady), std::nullopt);
+  const Eigen::Vector3d torso(1.0, 0, 0.55);
+  ASSERT_EQ(judge_.UpdateTruth(t - kSec / 10, kJoints, Person(torso)), std::nullopt);
+  EXPECT_EQ(judge_.Inside(t - kSec / 10), std::nullopt);
+  ASSERT_EQ(judge_.UpdateTruth(t, kJoints, Person(torso)), std::nullopt);
+  EXPECT_EQ(judge_.Inside(t), std::nullopt);
+  ASSERT_EQ(judge_.UpdateTruth(t + kSec / 10, kJoints, Person(torso)), std::nullopt);
+  ASSERT_EQ(judge_.Inside(t + kSec / 10), std::optional<bool>(false));
+  EXPECT_NEAR(judge_.last_report().human_speed, 0.0, 1e-9);
+}
+
 TEST_F(TrueSeparationJudgeTest, ThePersonsTrueSpeedTowardsTheRobotDecides) {
   const int64_t t = 100 * kSec;
   ASSERT_EQ(judge_.UpdateRobotState(t, kRobotJoints, kReady), std::nullopt);
