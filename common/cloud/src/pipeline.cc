@@ -1,5 +1,6 @@
 // Our obstacle pipeline on the organised image (docs/perception-clouds.md):
-//  1. keep mask: finite, in the workspace box, not the robot;
+//  1. kept points: finite, in the workspace box, not the robot (tested where
+//     each stage reads a point, not in a pass of its own);
 //  2. table: RANSAC plane on a strided sample of the kept pixels, then every
 //     kept point within a depth-dependent band of the plane is table;
 //  3. candidates: kept points above the table (below max_object_height);
@@ -15,6 +16,7 @@
 //     surface, a part too), smaller ones join the part they border most;
 //  6. each full-resolution candidate takes the segment of the closest of the
 //     strided pixels around it.
+#include <pcl/common/eigen.h>
 #include <pcl/segmentation/comparator.h>
 #include <pcl/segmentation/organized_connected_component_segmentation.h>
 
@@ -24,7 +26,6 @@
 #include <limits>
 #include <stdexcept>
 
-#include <Eigen/Eigenvalues>
 
 #include "iplan/cloud/pipeline.h"
 #include "split_segments.h"
@@ -67,7 +68,6 @@ class SegmentComparator : public pcl::Comparator<pcl::PointXYZ> {
 struct ObstaclePipeline::Impl {
   CloudParams params;
   float step_cos = 1.0f, step_sin = 2.0f;  // from step_normal_deg, step_angle_deg
-  std::vector<std::uint8_t> keep;
   std::vector<int> segment;
   PointCloud::Ptr sample{new PointCloud};
   PointCloud::Ptr small{new PointCloud};
@@ -79,8 +79,9 @@ struct ObstaclePipeline::Impl {
   std::vector<int> small_segment;          // strided pixel -> segment or kSegNone
   std::vector<int> group_of;               // segment -> its geometric segment (depth-connected)
 
-  bool FindTable(const Cloud& cloud, Eigen::Vector4f* plane);
-  void MarkTableAndCandidates(const Cloud& cloud, const Eigen::Vector4f& plane, bool table_found);
+  bool FindTable(const Cloud& cloud, const internal::KeepTest& kept, Eigen::Vector4f* plane);
+  void MarkTableAndCandidates(const Cloud& cloud, const internal::KeepTest& kept, const Eigen::Vector4f& plane,
+                              bool table_found);
   std::vector<int> Components(const std::vector<std::uint8_t>* classes);
   void EstimateNormals();
   bool Crease(int a, int b) const;
@@ -91,26 +92,29 @@ struct ObstaclePipeline::Impl {
   void AssignFullResolution(const Cloud& cloud);
 };
 
-bool ObstaclePipeline::Impl::FindTable(const Cloud& cloud, Eigen::Vector4f* plane) {
+// The kept points are tested where they are used (the strided sample here,
+// every point in MarkTableAndCandidates), not in a pass of their own: the
+// cloud is read from memory once less.
+bool ObstaclePipeline::Impl::FindTable(const Cloud& cloud, const internal::KeepTest& kept, Eigen::Vector4f* plane) {
   const int s = params.plane_sample_stride;
   const int w = cloud.width, h = cloud.height;
   sample->clear();
   for (int r = 0; r < h; r += s)
     for (int c = 0; c < w; c += s) {
       const std::size_t i = static_cast<std::size_t>(r) * w + c;
-      if (keep[i]) sample->push_back(pcl::PointXYZ(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z()));
+      if (kept(cloud.points[i])) sample->push_back(pcl::PointXYZ(cloud.points[i].x(), cloud.points[i].y(), cloud.points[i].z()));
     }
   return internal::FitPlane(*sample, params.plane_max_iterations, params.plane_fit_distance, plane);
 }
 
 // segment[i]: kSegTable on the table band, 0 for a candidate (above the
 // table), kSegNone otherwise.
-void ObstaclePipeline::Impl::MarkTableAndCandidates(const Cloud& cloud, const Eigen::Vector4f& plane,
-                                                    bool table_found) {
+void ObstaclePipeline::Impl::MarkTableAndCandidates(const Cloud& cloud, const internal::KeepTest& kept,
+                                                    const Eigen::Vector4f& plane, bool table_found) {
   segment.assign(cloud.size(), kSegNone);
   for (std::size_t i = 0; i < cloud.size(); ++i) {
-    if (!keep[i]) continue;
     const Eigen::Vector3f& p = cloud.points[i];
+    if (!kept(p)) continue;
     if (!table_found) {
       segment[i] = 0;
       continue;
@@ -192,10 +196,12 @@ void ObstaclePipeline::Impl::EstimateNormals() {
       outer << sxx, sxy, sxz, sxy, syy, syz, sxz, syz, szz;
       if (count < 5) continue;
       const Eigen::Vector3d mean = sum / count;
-      const Eigen::Matrix3d cov = outer / count - mean * mean.transpose();
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig;
-      eig.computeDirect(cov);
-      Eigen::Vector3f v = eig.eigenvectors().col(0).cast<float>();
+      const Eigen::Matrix3f cov = (outer / count - mean * mean.transpose()).cast<float>();
+      // The normal: the eigenvector of the smallest eigenvalue, as PCL's
+      // normal estimation takes it (pcl::eigen33, in float).
+      float smallest = 0;
+      Eigen::Vector3f v;
+      pcl::eigen33(cov, smallest, v);
       if (v.dot(pi) > 0) v = -v;  // towards the sensor
       n.normal_x = v.x();
       n.normal_y = v.y();
@@ -402,16 +408,16 @@ Result ObstaclePipeline::Process(const Cloud& in, const std::vector<Sphere>& rob
                                 " * " + std::to_string(in.height) + ") != " + std::to_string(in.points.size()) +
                                 " points");
   Impl& m = *impl_;
-  internal::KeepMask(in, m.params, robot_spheres, &m.keep);
+  const internal::KeepTest kept(m.params, robot_spheres);
   Eigen::Vector4f plane = Eigen::Vector4f::Zero();
-  bool table_found = in.size() > 0 && m.FindTable(in, &plane);
-  m.MarkTableAndCandidates(in, plane, table_found);
+  bool table_found = in.size() > 0 && m.FindTable(in, kept, &plane);
+  m.MarkTableAndCandidates(in, kept, plane, table_found);
   if (table_found) {
     long on_table = 0;
     for (const int s : m.segment) on_table += s == kSegTable;
     if (on_table < m.params.min_table_points) {
       table_found = false;
-      m.MarkTableAndCandidates(in, plane, false);
+      m.MarkTableAndCandidates(in, kept, plane, false);
     }
   }
   if (in.size() > 0) {

@@ -14,23 +14,20 @@
 
 namespace iplan::cloud::internal {
 
+KeepTest::KeepTest(const CloudParams& params, const std::vector<Sphere>& robot_spheres)
+    : crop_min_(params.crop_min), crop_max_(params.crop_max) {
+  for (const Sphere& s : robot_spheres) {
+    const float r = s.radius + params.self_filter_margin;
+    centres_.push_back(s.centre);
+    r2_.push_back(r * r);
+  }
+}
+
 void KeepMask(const Cloud& cloud, const CloudParams& params, const std::vector<Sphere>& robot_spheres,
               std::vector<std::uint8_t>* keep) {
-  keep->assign(cloud.size(), 0);
-  std::vector<float> r2(robot_spheres.size());
-  for (std::size_t s = 0; s < robot_spheres.size(); ++s) {
-    const float r = robot_spheres[s].radius + params.self_filter_margin;
-    r2[s] = r * r;
-  }
-  for (std::size_t i = 0; i < cloud.size(); ++i) {
-    const Eigen::Vector3f& p = cloud.points[i];
-    if (!p.allFinite()) continue;
-    if ((p.array() < params.crop_min.array()).any() || (p.array() > params.crop_max.array()).any()) continue;
-    bool robot = false;
-    for (std::size_t s = 0; s < robot_spheres.size() && !robot; ++s)
-      robot = (p - robot_spheres[s].centre).squaredNorm() <= r2[s];
-    (*keep)[i] = robot ? 0 : 1;
-  }
+  const KeepTest kept(params, robot_spheres);
+  keep->resize(cloud.size());
+  for (std::size_t i = 0; i < cloud.size(); ++i) (*keep)[i] = kept(cloud.points[i]) ? 1 : 0;
 }
 
 bool FitPlane(const pcl::PointCloud<pcl::PointXYZ>& sample, int max_iterations, float distance,

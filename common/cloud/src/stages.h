@@ -11,8 +11,26 @@
 
 namespace iplan::cloud::internal {
 
-/// keep[i] = 1 when point i is finite, inside the crop box and outside every
-/// robot sphere grown by params.self_filter_margin; else 0. Resizes *keep.
+/// Which points a pipeline keeps: finite, inside the crop box and outside
+/// every robot sphere grown by params.self_filter_margin.
+class KeepTest {
+ public:
+  KeepTest(const CloudParams& params, const std::vector<Sphere>& robot_spheres);
+  bool operator()(const Eigen::Vector3f& p) const {
+    if (!p.allFinite()) return false;
+    if ((p.array() < crop_min_.array()).any() || (p.array() > crop_max_.array()).any()) return false;
+    for (std::size_t s = 0; s < centres_.size(); ++s)
+      if ((p - centres_[s]).squaredNorm() <= r2_[s]) return false;
+    return true;
+  }
+
+ private:
+  Eigen::Vector3f crop_min_, crop_max_;
+  std::vector<Eigen::Vector3f> centres_;
+  std::vector<float> r2_;  // squared grown radii
+};
+
+/// keep[i] = 1 when KeepTest keeps point i, else 0. Resizes *keep.
 void KeepMask(const Cloud& cloud, const CloudParams& params, const std::vector<Sphere>& robot_spheres,
               std::vector<std::uint8_t>* keep);
 
