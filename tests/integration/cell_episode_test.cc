@@ -64,6 +64,20 @@ TEST_P(CellEpisode, TasksCompleteWithoutContact) {
   EXPECT_GT(j["latency_ms"]["p50"].get<double>(), 0.0);
   EXPECT_LT(j["latency_ms"]["p99"].get<double>(), 1000.0);  // sanity only: the target lives in the demo figures
   for (const auto& [service, code] : j["service_exit_codes"].items()) EXPECT_EQ(code, 0) << service;
+  // The stops, timed against the true person (the truth, the joint states
+  // and the trajectories reached the demo's own participant).
+  const nlohmann::json& audit = j["stop_audit"];
+  ASSERT_TRUE(audit.is_object()) << demo.Stdout();
+  EXPECT_GT(audit["judgements"].get<int>(), 50);
+  EXPECT_GE(audit["each"].size(), 1u);  // the safe start at least
+  EXPECT_LE(audit["each"].size(), j["protective_stops"].get<std::size_t>());
+  for (const auto& stop : audit["each"]) {
+    EXPECT_GE(stop["person_within_sp_s"].get<double>(), 0.0);
+    EXPECT_NEAR(stop["outlast_s"].get<double>(),
+                stop["duration_s"].get<double>() - stop["person_within_sp_s"].get<double>(), 1e-9);
+  }
+  EXPECT_GE(audit["unstopped_within_sp_s"]["total"].get<double>(), 0.0);
+  EXPECT_NE(demo.Stdout().find("stops against the true person "), std::string::npos) << demo.Stdout();
   if (GetParam().name == "ur5e") {
     EXPECT_NE(demo.Stdout().find("robot ur5e ("), std::string::npos) << demo.Stdout();
     EXPECT_NE(demo.Stdout().find("6 joints), resting at ["), std::string::npos) << demo.Stdout();
@@ -148,8 +162,18 @@ TEST_P(DemoEnds, NoServiceOutlivesTheDemo) {
   const auto end = std::chrono::steady_clock::now() + 2s;
   while (!ServicesOnDomain(domain).empty() && std::chrono::steady_clock::now() < end) std::this_thread::sleep_for(20ms);
   const auto left = ServicesOnDomain(domain);
-  for (const int pid : left) kill(pid, SIGKILL);
-  EXPECT_TRUE(left.empty()) << left.size() << " services still running 2 s after the demo ended by signal " << sig;
+  std::string which;  // the services left, and whether they end later
+  for (const int pid : left) {
+    std::ifstream cmd("/proc/" + std::to_string(pid) + "/cmdline");
+    std::string exe;
+    std::getline(cmd, exe, '\0');
+    const auto give_up = std::chrono::steady_clock::now() + 10s;
+    while (kill(pid, 0) == 0 && std::chrono::steady_clock::now() < give_up) std::this_thread::sleep_for(20ms);
+    which += " " + exe + (kill(pid, 0) == 0 ? " (still there 10 s later)" : " (ended within 10 s more)");
+    kill(pid, SIGKILL);
+  }
+  EXPECT_TRUE(left.empty()) << left.size() << " services still running 2 s after the demo ended by signal " << sig
+                            << ":" << which;
   std::filesystem::remove_all(dir);
 }
 
