@@ -62,7 +62,7 @@ StopAuditSummary Summarize(const StopAudit& audit, double since_s, double allowa
   for (const AuditedStop& stop : audit.stops()) {
     if (stop.start_s < since_s) continue;
     ++s.stops;
-    if (stop.true_inside_s > 0 || stop.last_inside_s >= stop.start_s) ++s.with_person_within;
+    if (stop.true_inside_s > 0) ++s.with_person_within;  // as Describe(stop) says it
     if (stop.Outlast() > allowance_s) ++s.outlasting;
     outlast.push_back(stop.Outlast());
     s.after_max_s = std::max(s.after_max_s, stop.After());
