@@ -17,7 +17,6 @@
 #include <chrono>
 #include <ctime>
 #include <functional>
-#include <limits>
 
 #include "services/cloud/core/cloud_stage.h"
 #include "services/perception/core/depth_camera.h"
@@ -155,17 +154,13 @@ void BM_PipelineOnly(benchmark::State& state) {
 // inflate the textbook's time); no self-filter: issue 29's yardstick for
 // the whole stage ("at most half the textbook pipeline's time").
 void BM_Textbook(benchmark::State& state) {
-  const cloud_service::CloudStageParams& stage = TheCell().stage;
+  const Cell& cell = TheCell();
+  const cloud_service::CloudStage stage(cell.stage, nullptr);
   std::vector<cloud::Cloud> frames = Frames();
-  const Eigen::Isometry3f X_WS = stage.X_WS.cast<float>();
-  const Eigen::Array3f lo = stage.workspace_min.cast<float>().array(), hi = stage.workspace_max.cast<float>().array();
-  for (cloud::Cloud& c : frames)
-    for (Eigen::Vector3f& p : c.points) {
-      const Eigen::Array3f w = (X_WS * p).array();
-      if (!p.allFinite() || (w < lo).any() || (w > hi).any()) p.setConstant(std::numeric_limits<float>::quiet_NaN());
-    }
+  cloud_service::StageOutput cropped;
+  for (cloud::Cloud& c : frames) stage.Crop(&c, &cropped);
   Run(state, [&](int f) {
-    benchmark::DoNotOptimize(cloud::TextbookPipeline(frames[static_cast<std::size_t>(f)], stage.pipeline));
+    benchmark::DoNotOptimize(cloud::TextbookPipeline(frames[static_cast<std::size_t>(f)], cell.stage.pipeline));
   });
 }
 

@@ -78,8 +78,12 @@ class CloudStage {
   StageOutput Process(cloud::Cloud* cloud, const std::optional<Eigen::VectorXd>& q, int64_t stamp_ns,
                       const std::vector<Eigen::VectorXd>& around = {});
 
- private:
+  /// Process's first step alone: sets the finite points outside the
+  /// workspace (S frame in, bounds in W) to NaN in place and counts them in
+  /// out->cropped_points.
   void Crop(cloud::Cloud* cloud, StageOutput* out) const;
+
+ private:
   std::vector<cloud::Sphere> RobotSpheres(const Eigen::VectorXd& q, const std::vector<Eigen::VectorXd>& around);
   /// The human points, voxel-reduced, with noise covariances; `track`: their
   /// parts' motions are updated from them (else they are all not tracked).
