@@ -101,7 +101,7 @@ void ToPointCloud2(const cloud::Cloud& c, const msg::Time& stamp, const std::str
 }
 
 std::optional<std::string> FromCameraInfo(const msg::CameraInfo& m, cloud::CameraIntrinsics* out) {
-  constexpr uint32_t kMaxSide = 4096;  // pixels, as CameraIntrinsics
+  constexpr uint32_t kMaxSide = cloud::CameraIntrinsics::kMaxSide;
   const auto& k = m.k;
   if (std::all_of(k.begin(), k.end(), [](double x) { return x == 0; })) {
     return std::string("the camera is not calibrated (k is all zero)");
@@ -127,7 +127,7 @@ std::optional<std::string> FromCameraInfo(const msg::CameraInfo& m, cloud::Camer
   }
   const uint64_t w = roi_w / bx, h = roi_h / by;
   if (w == 0 || h == 0 || w > kMaxSide || h > kMaxSide) {
-    return "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not 1..4096 pixels a side";
+    return "image size " + std::to_string(w) + "x" + std::to_string(h) + " is not 1.." + std::to_string(kMaxSide) + " pixels a side";
   }
   const double x0 = whole ? 0.0 : m.roi.x_offset, y0 = whole ? 0.0 : m.roi.y_offset;
   out->width = static_cast<int>(w);

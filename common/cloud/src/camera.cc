@@ -14,8 +14,9 @@ std::string Num(double v) { return core::ParamText(v); }
 }  // namespace
 
 std::string CameraIntrinsics::Validate() const {
-  if (width < 1 || width > 4096) return "width must be in 1..4096 pixels, got " + std::to_string(width);
-  if (height < 1 || height > 4096) return "height must be in 1..4096 pixels, got " + std::to_string(height);
+  const std::string range = "1.." + std::to_string(kMaxSide) + " pixels, got ";
+  if (width < 1 || width > kMaxSide) return "width must be in " + range + std::to_string(width);
+  if (height < 1 || height > kMaxSide) return "height must be in " + range + std::to_string(height);
   if (!(std::isfinite(fx) && fx > 0)) return "fx must be > 0, got " + Num(fx);
   if (!(std::isfinite(fy) && fy > 0)) return "fy must be > 0, got " + Num(fy);
   if (!std::isfinite(cx) || !std::isfinite(cy)) return "cx and cy must be finite";

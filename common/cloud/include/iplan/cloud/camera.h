@@ -20,6 +20,7 @@ namespace iplan::cloud {
 
 /// Pinhole intrinsics of a depth image (no distortion).
 struct CameraIntrinsics {
+  static constexpr int kMaxSide = 4096;  ///< pixels, the largest width or height accepted
   int width = 640;    ///< pixels
   int height = 480;   ///< pixels
   double fx = 525.0;  ///< focal length, pixels (Kinect v1 at 640x480)
