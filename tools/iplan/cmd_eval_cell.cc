@@ -73,6 +73,7 @@ Json EpisodeJson(const cell_sim::EpisodeSpec& e, const cell_sim::CellEpisodeResu
   for (const auto& t : r.tasks) {
     tasks.push_back(Json{{"task", t.task},
                          {"person_action", t.person_action},
+                         {"person_for_s", t.person_for},
                          {"believed_action", t.believed_action},
                          {"believed_for_s", t.believed_for},
                          {"expected_conflict_s", t.expected_conflict},
@@ -105,6 +106,11 @@ Json SummaryJson(const cell_sim::CellSummary& s) {
   j["robot_at_rest_contacts"] = s.robot_at_rest_contacts;
   j["tasks_done"] = s.tasks_done;
   j["tasks_total"] = s.tasks_total;
+  if (s.choices_with_belief > 0) {
+    j["belief_at_choice"] = Json{{"choices", s.choices_with_belief},
+                                 {"right", s.belief_right},
+                                 {"age_error_s", s.belief_right > 0 ? eval_common::SpreadJson(s.age_error) : Json()}};
+  }
   if (s.has_reference) {
     j["vs_none"] = Json{{"episode_time_median_ratio", eval_common::RatioJson(s.episode_time_ratio)},
                         {"episode_time_paired_ratio", eval_common::SpreadJson(s.episode_time_paired_ratio)},
@@ -145,6 +151,13 @@ void PrintTable(const std::vector<cell_sim::CellSummary>& summary) {
               << s.protective_stops << std::setw(9) << s.robot_moving_contacts << std::setw(9) << s.robot_at_rest_contacts
               << std::setw(12) << (std::to_string(s.tasks_done) + "/" + std::to_string(s.tasks_total)) << s.complete << "/"
               << s.episodes << "\n";
+  }
+  for (const auto& s : summary) {
+    if (s.choices_with_belief == 0) continue;
+    std::cout << "  " << cell_sim::ToString(s.predictor) << "'s task choices: the person's action right in "
+              << s.belief_right << " of " << s.choices_with_belief;
+    if (s.belief_right > 0) std::cout << ", its age off by " << SpreadText(s.age_error, 2) << " s there";
+    std::cout << "\n";
   }
   if (summary.empty() || !summary.front().has_reference) return;
   std::cout << "\nagainst none: ratio of medians (median of the paired per-episode ratios [p10, p90])\n";

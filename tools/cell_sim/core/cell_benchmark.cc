@@ -106,7 +106,9 @@ CellEpisodeResult RunOne(const CellBenchmarkSetup& setup, const EpisodeSpec& spe
     const supervisor::RobotTask& task = graph.tasks[static_cast<std::size_t>(current)];
     ChosenTask chosen;
     chosen.task = task.name;
-    chosen.person_action = spec.actions[SpanAt(spec.actions, t)].action;
+    const supervisor::HumanActionSpan& truth = spec.actions[SpanAt(spec.actions, t)];
+    chosen.person_action = truth.action;
+    chosen.person_for = t - truth.start;
     chosen.expected_conflict = planner->ExpectedConflict(current, o);
     if (!o.belief.empty()) {
       chosen.believed_action = std::max_element(o.belief.begin(), o.belief.end(), [](const auto& a, const auto& b) {
@@ -246,7 +248,7 @@ std::vector<CellSummary> SummarizeCell(const std::vector<Predictor>& predictors,
   for (std::size_t p = 0; p < predictors.size(); ++p) {
     CellSummary s;
     s.predictor = predictors[p];
-    std::vector<double> time, idle, none_time, none_idle, time_ratio, idle_ratio;
+    std::vector<double> time, idle, none_time, none_idle, time_ratio, idle_ratio, age_error;
     for (const auto& episode : results) {
       const CellEpisodeResult& r = episode.at(p);
       ++s.episodes;
@@ -259,6 +261,13 @@ std::vector<CellSummary> SummarizeCell(const std::vector<Predictor>& predictors,
       s.robot_at_rest_contacts += r.robot_at_rest_contacts;
       s.tasks_done += r.tasks_done;
       s.tasks_total += tasks_per_episode;
+      for (const ChosenTask& t : r.tasks) {
+        if (t.believed_action.empty()) continue;
+        ++s.choices_with_belief;
+        if (t.believed_action != t.person_action) continue;
+        ++s.belief_right;
+        age_error.push_back(std::abs(t.believed_for - t.person_for));
+      }
       if (none >= 0) {
         const CellEpisodeResult& n = episode.at(static_cast<std::size_t>(none));
         none_time.push_back(n.episode_time);
@@ -269,6 +278,7 @@ std::vector<CellSummary> SummarizeCell(const std::vector<Predictor>& predictors,
     }
     s.episode_time = SpreadOf(time);
     s.robot_idle = SpreadOf(idle);
+    if (!age_error.empty()) s.age_error = SpreadOf(age_error);
     if (none >= 0) {
       s.has_reference = true;
       s.episode_time_ratio = ratio(s.episode_time.median, SpreadOf(none_time).median);

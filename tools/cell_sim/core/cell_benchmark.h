@@ -77,6 +77,7 @@ std::vector<EpisodeSpec> MakeCellEpisodes(const CellBenchmarkSetup& setup, int c
 struct ChosenTask {
   std::string task;
   std::string person_action;        ///< what the person truly did at the command
+  double person_for = 0;            ///< s the person had been doing it at the command
   double expected_conflict = 0;     ///< s, the planner's ExpectedConflict of the chosen task (0 without a forecast)
   /// What the task planner was told: the belief's most likely action ("":
   /// nothing) and how long it had lasted (s).
@@ -129,6 +130,12 @@ struct CellSummary {
   int robot_at_rest_contacts = 0;
   int tasks_done = 0;  ///< total
   int tasks_total = 0; ///< episodes x tasks of the graph
+  /// What the task planner was told at its choices (predictors that give it
+  /// a belief: model, oracle): the choices, those whose most likely action
+  /// was the person's true one, and for those |believed_for - person_for|.
+  int choices_with_belief = 0;
+  int belief_right = 0;
+  Spread age_error;  ///< s; empty (0) without a right belief
   /// Against `none` (when it ran): ratio of medians, and the median of the
   /// paired per-episode ratios, of episode time and robot idle.
   bool has_reference = false;

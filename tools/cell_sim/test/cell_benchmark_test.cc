@@ -121,5 +121,29 @@ TEST_F(CellBenchmarkTest, TheSummaryPairsEveryPredictorWithNone) {
   EXPECT_TRUE(std::isnan(GainRecovered(20, 18, 21)));
 }
 
+TEST_F(CellBenchmarkTest, TheSummaryCountsTheChoicesWhoseBeliefWasRight) {
+  auto choice = [](const std::string& truth, double truth_for, const std::string& belief, double belief_for) {
+    ChosenTask t;
+    t.person_action = truth;
+    t.person_for = truth_for;
+    t.believed_action = belief;
+    t.believed_for = belief_for;
+    return t;
+  };
+  CellEpisodeResult model, none;
+  model.predictor = Predictor::kModel;
+  model.tasks = {choice("reach", 3.0, "reach", 2.5), choice("reach", 3.2, "idle", 0.0), choice("assemble", 1.0, "assemble", 2.0),
+                 choice("idle", 0.5, "idle", 0.5)};
+  none.predictor = Predictor::kNone;
+  none.tasks = {choice("reach", 3.0, "", 0.0)};  // no belief: not a choice told anything
+  const std::vector<CellSummary> s = SummarizeCell({Predictor::kModel, Predictor::kNone}, {{model, none}}, 5);
+  EXPECT_EQ(s[0].choices_with_belief, 4);
+  EXPECT_EQ(s[0].belief_right, 3);
+  EXPECT_DOUBLE_EQ(s[0].age_error.median, 0.5);  // nearest rank of {0, 0.5, 1}
+  EXPECT_DOUBLE_EQ(s[0].age_error.p90, 1.0);
+  EXPECT_EQ(s[1].choices_with_belief, 0);
+  EXPECT_EQ(s[1].belief_right, 0);
+}
+
 }  // namespace
 }  // namespace iplan::cell_sim
