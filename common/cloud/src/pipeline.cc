@@ -26,7 +26,6 @@
 #include <limits>
 #include <stdexcept>
 
-
 #include "iplan/cloud/pipeline.h"
 #include "split_segments.h"
 #include "stages.h"
