@@ -2,8 +2,9 @@
 // trained on the first run, as `iplan demo` would): a one-episode run of
 // three predictors writes every documented JSON field for every predictor
 // and one entry per episode and predictor, the same seed gives the same
-// JSON byte for byte, and bad requests are refused with exit code 2 naming
-// the problem.
+// JSON byte for byte, oracle-action tells the task planner the person's
+// action and its age, --oracle-error changes the oracles' runs and no
+// other, and bad requests are refused with exit code 2 naming the problem.
 #include <filesystem>
 
 #include <gtest/gtest.h>
@@ -98,6 +99,35 @@ TEST_F(EvalCell, OneEpisodeWritesEveryFieldAndRepeatsForASeed) {
   }
   ASSERT_EQ(j["episodes"][2]["predictor"], "oracle");
   for (const auto& t : j["episodes"][2]["tasks"]) EXPECT_EQ(t["believed_action"], t["person_action"]);
+}
+
+TEST_F(EvalCell, OracleActionKnowsTheActionAndTheOracleErrorMovesOnlyTheOracles) {
+  const std::string exact = (dir_ / "exact.json").string(), off = (dir_ / "off.json").string();
+  const std::vector<std::string> args = {"--episodes", "1", "--seed", "3", "--predictors", "none,oracle,oracle-action",
+                                         "--episode-limit", "40"};
+  std::string out;
+  std::vector<std::string> first = args;
+  first.insert(first.end(), {"--json", exact});
+  ASSERT_EQ(Run(first, &out), 0) << out;
+  std::vector<std::string> second = args;
+  second.insert(second.end(), {"--json", off, "--oracle-error", "0.05"});
+  ASSERT_EQ(Run(second, &out), 0) << out;
+  const nlohmann::json a = nlohmann::json::parse(core::ReadFile(exact)), b = nlohmann::json::parse(core::ReadFile(off));
+  EXPECT_EQ(a["oracle_error_std_m"], 0.0);
+  EXPECT_EQ(b["oracle_error_std_m"], 0.05);
+  ASSERT_TRUE(a["predictors"].contains("oracle-action"));
+  ASSERT_EQ(a["episodes"].size(), 3u);
+  ASSERT_EQ(a["episodes"][2]["predictor"], "oracle-action");
+  for (const auto& t : a["episodes"][2]["tasks"]) {
+    EXPECT_EQ(t["believed_action"], t["person_action"]);
+    EXPECT_EQ(t["believed_for_s"], t["person_for_s"]);
+  }
+  // none plans against nothing: its run is the same; the oracles' plans change.
+  EXPECT_EQ(a["episodes"][0].dump(), b["episodes"][0].dump());
+  for (std::size_t i : {1u, 2u}) {
+    SCOPED_TRACE(a["episodes"][i]["predictor"].get<std::string>());
+    EXPECT_NE(a["episodes"][i].dump(), b["episodes"][i].dump());
+  }
 }
 
 TEST_F(EvalCell, BadRequestsAreRefusedWithExitCode2) {

@@ -93,6 +93,9 @@ TEST_F(EvalInteraction, BadRequestsAreRefusedWithExitCode2) {
   std::string out;
   EXPECT_EQ(Run({"--predictors", "none,psychic", "--scenarios", "2"}, &out), 2) << out;
   EXPECT_NE(out.find("unknown predictor 'psychic'"), std::string::npos) << out;
+  // oracle-action continues the person's actions: eval cell's persons only.
+  EXPECT_EQ(Run({"--predictors", "none,oracle-action", "--scenarios", "2"}, &out), 2) << out;
+  EXPECT_NE(out.find("it runs in iplan eval cell only"), std::string::npos) << out;
   EXPECT_EQ(Run({"--scenarios", "0"}, &out), 2) << out;
   EXPECT_NE(out.find("--scenarios must be at least 1"), std::string::npos) << out;
   recordings_ = (dir_ / "missing.csv").string();

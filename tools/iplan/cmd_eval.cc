@@ -315,6 +315,11 @@ int RunInteraction(const InteractionOptions& o) {
   const std::optional<std::vector<Predictor>> parsed = eval_common::ParsePredictors(o.predictors, "iplan eval interaction");
   if (!parsed || !CheckOptions(o)) return 2;
   const std::vector<Predictor>& predictors = *parsed;
+  if (std::find(predictors.begin(), predictors.end(), Predictor::kOracleAction) != predictors.end()) {
+    std::cerr << "iplan eval interaction: the oracle-action predictor needs the person's actions; it runs in iplan "
+                 "eval cell only\n";
+    return 2;
+  }
   const auto wall0 = std::chrono::steady_clock::now();
   EvalInputs in;
   cell_sim::BenchmarkSetup setup;
@@ -410,7 +415,9 @@ const bool kRegistered = RegisterCommand("eval", [](CLI::App& app) {
       "Predictors: none (the planner gets no prediction; only the monitor protects, with the model's), constant-position,\n"
       "constant-velocity (least-squares velocity over 0.25 s), model (the cell's trained intent model, trained\n"
       "or cached as `iplan demo --prepare-only` does), oracle (the true future with the model's covariances).");
-  c->add_option("--predictors", o->predictors, "comma-separated predictors to compare")->capture_default_str();
+  c->add_option("--predictors", o->predictors,
+                "comma-separated predictors to compare (none, constant-position, constant-velocity, model, oracle)")
+      ->capture_default_str();
   c->add_option("--scenarios", o->scenarios, "number of scenarios (>= 1)")->capture_default_str();
   c->add_option("--suite", o->suite,
                 "which scenarios: 'default' (tasks and reaches, the person near or across the path) or 'shared-space' "

@@ -42,6 +42,7 @@ struct CellOptions {
   int anticipation_depth = 0;       // 0: supervisor.yaml's
   double duration_weight = -1;      // < 0: supervisor.yaml's
   double travel_weight = -1;        // < 0: supervisor.yaml's
+  double oracle_error = 0;          // m, CellBenchmarkSetup::oracle_error_std
   bool retrain = false, quiet = false;
 };
 
@@ -129,10 +130,11 @@ const cell_sim::CellSummary* Find(const std::vector<cell_sim::CellSummary>& summ
 
 // The oracle's gain over none that the model recovers, per figure (when
 // all three ran), for the JSON and the table.
-Json GainJson(const std::vector<cell_sim::CellSummary>& summary) {
+// What the model recovers of `oracle`'s gain over none; null without the three.
+Json GainJson(const std::vector<cell_sim::CellSummary>& summary, Predictor reference) {
   const auto* none = Find(summary, Predictor::kNone);
   const auto* model = Find(summary, Predictor::kModel);
-  const auto* oracle = Find(summary, Predictor::kOracle);
+  const auto* oracle = Find(summary, reference);
   if (!none || !model || !oracle) return Json(nullptr);
   return Json{{"episode_time", eval_common::RatioJson(cell_sim::GainRecovered(none->episode_time.median, model->episode_time.median,
                                                                       oracle->episode_time.median))},
@@ -166,12 +168,39 @@ void PrintTable(const std::vector<cell_sim::CellSummary>& summary) {
               << Fixed(s.episode_time_ratio, 2) << " (" << SpreadText(s.episode_time_paired_ratio, 2) << ")  robot idle "
               << Fixed(s.robot_idle_ratio, 2) << " (" << SpreadText(s.robot_idle_paired_ratio, 2) << ")\n";
   }
-  const Json gain = GainJson(summary);
-  if (!gain.is_null()) {
+  for (Predictor reference : {Predictor::kOracle, Predictor::kOracleAction}) {
+    const Json gain = GainJson(summary, reference);
+    if (gain.is_null()) continue;
     auto text = [](const Json& v) { return v.is_null() ? std::string("n/a") : Fixed(v.get<double>(), 2); };
-    std::cout << "model recovers of the oracle's gain over none (medians): episode time " << text(gain["episode_time"])
-              << ", robot idle " << text(gain["robot_idle"]) << "\n";
+    std::cout << "model recovers of the " << cell_sim::ToString(reference)
+              << "'s gain over none (medians): episode time " << text(gain["episode_time"]) << ", robot idle "
+              << text(gain["robot_idle"]) << "\n";
   }
+}
+
+// The JSON's run settings and figures per predictor (the people and the
+// episodes follow them).
+Json HeaderJson(const CellOptions& o, const cell_sim::CellBenchmarkSetup& setup,
+                const std::vector<cell_sim::CellSummary>& summary, std::size_t num_episodes) {
+  Json per = Json::object();
+  for (const auto& s : summary) per[cell_sim::ToString(s.predictor)] = SummaryJson(s);
+  Json doc;
+  doc["command"] = kCommand;
+  doc["seed"] = o.seed;
+  doc["num_episodes"] = num_episodes;
+  doc["episode_limit_s"] = o.episode_limit;
+  doc["time_limit_s"] = o.time_limit;
+  doc["anticipation_weight"] = setup.learning.anticipation_weight;
+  doc["anticipation_depth"] = setup.learning.anticipation_depth;
+  doc["duration_weight"] = setup.learning.duration_weight;
+  doc["travel_weight"] = setup.learning.travel_weight;
+  doc["oracle_error_std_m"] = setup.oracle_error_std;
+  doc["predictors"] = std::move(per);
+  doc["model_recovers_oracle_gain"] = GainJson(summary, Predictor::kOracle);
+  if (Find(summary, Predictor::kOracleAction)) {
+    doc["model_recovers_oracle_action_gain"] = GainJson(summary, Predictor::kOracleAction);
+  }
+  return doc;
 }
 
 // Sets up the benchmark; prints why and returns false on a failure.
@@ -192,6 +221,7 @@ bool Prepare(const CellOptions& o, eval_common::CellInputs* in, cell_sim::CellBe
     if (o.anticipation_depth > 0) setup->learning.anticipation_depth = o.anticipation_depth;
     if (o.duration_weight >= 0) setup->learning.duration_weight = o.duration_weight;
     if (o.travel_weight >= 0) setup->learning.travel_weight = o.travel_weight;
+    setup->oracle_error_std = o.oracle_error;
     try {
       cell_sim::CalibrateBaselines(RecordCellDemonstrations(in->cell.person), &setup->base);
     } catch (const std::exception& e) {
@@ -267,20 +297,7 @@ int RunCell(const CellOptions& o) {
     return 1;
   }
   const auto summary = cell_sim::SummarizeCell(predictors, results, static_cast<int>(setup.graph.tasks.size()));
-  Json per = Json::object();
-  for (const auto& s : summary) per[cell_sim::ToString(s.predictor)] = SummaryJson(s);
-  Json doc;
-  doc["command"] = kCommand;
-  doc["seed"] = o.seed;
-  doc["num_episodes"] = episodes.size();
-  doc["episode_limit_s"] = o.episode_limit;
-  doc["time_limit_s"] = o.time_limit;
-  doc["anticipation_weight"] = setup.learning.anticipation_weight;
-  doc["anticipation_depth"] = setup.learning.anticipation_depth;
-  doc["duration_weight"] = setup.learning.duration_weight;
-  doc["travel_weight"] = setup.learning.travel_weight;
-  doc["predictors"] = std::move(per);
-  doc["model_recovers_oracle_gain"] = GainJson(summary);
+  Json doc = HeaderJson(o, setup, summary, episodes.size());
   doc["people"] = std::move(people);
   doc["episodes"] = std::move(runs);
   PrintTable(summary);
@@ -313,8 +330,14 @@ void AddEvalCellCommand(CLI::App* eval) {
       "standing still while tasked), protective stops, contacts with the robot moving / at rest, tasks done; ratios\n"
       "against none and the share of the oracle's gain the model recovers. The task planner gets nothing from none and\n"
       "the baselines, the action belief and how long its action has lasted from model, the true current action, when it\n"
-      "ends and the true next action from oracle. Deterministic for a seed. Exit code 2 on bad input.");
-  c->add_option("--predictors", o->predictors, "comma-separated predictors to compare")->capture_default_str();
+      "ends and the true next action from oracle. oracle-action (not in the default list) plans against the true motion\n"
+      "of the person's current action as if it went on for ever, and tells the task planner the true current action and\n"
+      "how long it has lasted, not when it ends: the best a forecaster of each action's motion with a perfect recogniser\n"
+      "could do. Deterministic for a seed. Exit code 2 on bad input.");
+  c->add_option("--predictors", o->predictors,
+                "comma-separated predictors to compare (none, constant-position, constant-velocity, model, oracle, "
+                "oracle-action)")
+      ->capture_default_str();
   c->add_option("--episodes", o->episodes, "number of episodes (>= 1)")->capture_default_str();
   c->add_option("--seed", o->seed, "seed of the episodes (the person's actions, motion and sensor noise)")
       ->capture_default_str();
@@ -337,6 +360,12 @@ void AddEvalCellCommand(CLI::App* eval) {
   c->add_option("--travel-weight", o->travel_weight,
                 "the task planners' travel_weight (choice penalty per second of estimated travel to a task's goal) "
                 "instead of supervisor.yaml's (0: off)")
+      ->check(CLI::NonNegativeNumber);
+  c->add_option("--oracle-error", o->oracle_error,
+                "m per axis: the oracles' forecast means are off by an error drawn per frame and joint, N(0, this^2) "
+                "at the last step, growing linearly from 0 over the steps (how precise a forecast must be to gain what "
+                "they gain)")
+      ->capture_default_str()
       ->check(CLI::NonNegativeNumber);
   c->add_option("--threads", o->threads, "planner threads (0: as planner_replanning.yaml; results do not depend on it)")
       ->capture_default_str()

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <stdexcept>
 
 #include "tools/cell_sim/core/person_motion.h"
@@ -23,8 +24,9 @@ double StreamDuration(const CellBenchmarkSetup& setup) {
 }
 
 // The person of an episode: the cell's synthetic person doing the drawn
-// actions, already part way through the first at the episode's start.
-PersonStream EpisodePerson(const CellBenchmarkSetup& setup, const EpisodeSpec& spec) {
+// actions, already part way through the first at the episode's start,
+// sampled for `duration` s.
+PersonStream EpisodePerson(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, double duration) {
   perception::SyntheticPersonParams person = setup.base.person;
   person.script.clear();
   for (const auto& a : spec.actions) person.script.push_back({a.action, a.duration});
@@ -32,7 +34,7 @@ PersonStream EpisodePerson(const CellBenchmarkSetup& setup, const EpisodeSpec& s
   SyntheticPlacement place;
   place.script_start = spec.actions.front().start;
   return SyntheticPersonStream(person, place, setup.base.models.body->params().joints, setup.base.sensor_rate_hz,
-                               StreamDuration(setup), setup.base.sensor_noise_std, spec.noise_seed);
+                               duration, setup.base.sensor_noise_std, spec.noise_seed);
 }
 
 // The span of `actions` going on at t (the last one after them all).
@@ -43,6 +45,37 @@ std::size_t SpanAt(const std::vector<supervisor::HumanActionSpan>& actions, doub
   return actions.size() - 1;
 }
 
+// ContinuedActionStream without the checks (span < spec.actions.size()).
+PersonStream ContinuedPerson(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, std::size_t span) {
+  EpisodeSpec continued = spec;
+  continued.actions.resize(span + 1);
+  const auto& config = setup.base.intent_model->config;
+  const double duration =
+      std::min(StreamDuration(setup), spec.actions[span].end() + config.horizon / config.rate + 1.0);
+  continued.actions[span].duration += StreamDuration(setup);  // beyond any time asked for
+  return EpisodePerson(setup, continued, duration);
+}
+
+// oracle-action's future at a frame: ContinuedPerson of the span going on
+// then, made when first asked for.
+class ContinuedActions {
+ public:
+  ContinuedActions(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, const PersonStream& person)
+      : setup_(setup), spec_(spec), person_(person), streams_(spec.actions.size()) {}
+
+  const PersonStream& At(int frame) {
+    const std::size_t i = SpanAt(spec_.actions, person_.stamp(frame));
+    if (!streams_[i]) streams_[i] = ContinuedPerson(setup_, spec_, i);
+    return *streams_[i];
+  }
+
+ private:
+  const CellBenchmarkSetup& setup_;
+  const EpisodeSpec& spec_;
+  const PersonStream& person_;
+  std::vector<std::optional<PersonStream>> streams_;
+};
+
 // What a predictor tells the task planner about the person (see the top of
 // cell_benchmark.h): at a time t, with the newest skeleton frame.
 class PersonOutlook {
@@ -52,13 +85,15 @@ class PersonOutlook {
 
   supervisor::ActionOutlook At(double t, int frame) {
     supervisor::ActionOutlook o;
-    if (predictor_ == Predictor::kOracle) {
+    if (predictor_ == Predictor::kOracle || predictor_ == Predictor::kOracleAction) {
       const std::size_t i = SpanAt(spec_.actions, t);
       const supervisor::HumanActionSpan& span = spec_.actions[i];
       o.belief = {{span.action, 1.0}};
       o.elapsed = t - span.start;
-      o.remaining = std::max(0.0, span.end() - t);
-      if (i + 1 < spec_.actions.size()) o.next = spec_.actions[i + 1].action;
+      if (predictor_ == Predictor::kOracle) {
+        o.remaining = std::max(0.0, span.end() - t);
+        if (i + 1 < spec_.actions.size()) o.next = spec_.actions[i + 1].action;
+      }
     } else if (predictor_ == Predictor::kModel) {
       // Every belief up to the newest frame, as the supervisor receives them.
       for (; fed_ < frame; ++fed_) {
@@ -88,9 +123,9 @@ class PersonOutlook {
 // the loop's task feed.
 CellEpisodeResult RunOne(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, Predictor p,
                          const PersonStream& person, ModelTrack* track, const TrueCovariances& covariances,
-                         supervisor::TaskPlanner* planner) {
+                         const OracleOptions& oracle, supervisor::TaskPlanner* planner) {
   const supervisor::TaskGraph& graph = planner->graph();
-  const PredictorSources sources(setup.base, person, track, p);
+  const PredictorSources sources(setup.base, person, track, p, oracle);
   PersonOutlook outlook(p, spec, person, track);
   CellEpisodeResult out;
   out.episode = spec.index;
@@ -187,6 +222,7 @@ std::string CellBenchmarkSetup::Validate() const {
   if (const std::string why = learning.Validate(); !why.empty()) return "learning: " + why;
   if (!(pause_between_tasks >= 0)) return "pause_between_tasks must be >= 0";
   if (!(episode_limit > 0) || !(task_time_limit > 0)) return "the episode and task limits must be > 0";
+  if (!(oracle_error_std >= 0) || !std::isfinite(oracle_error_std)) return "oracle_error_std must be finite and >= 0";
   return "";
 }
 
@@ -216,17 +252,36 @@ std::vector<std::unique_ptr<supervisor::TaskPlanner>> MakeCellPlanners(const Cel
   return out;
 }
 
+PersonStream EpisodePersonStream(const CellBenchmarkSetup& setup, const EpisodeSpec& spec) {
+  if (const std::string why = setup.Validate(); !why.empty()) throw std::invalid_argument(why);
+  return EpisodePerson(setup, spec, StreamDuration(setup));
+}
+
+PersonStream ContinuedActionStream(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, std::size_t span) {
+  if (const std::string why = setup.Validate(); !why.empty()) throw std::invalid_argument(why);
+  if (span >= spec.actions.size()) {
+    throw std::out_of_range("ContinuedActionStream: span " + std::to_string(span) + " of " +
+                            std::to_string(spec.actions.size()) + " actions");
+  }
+  return ContinuedPerson(setup, spec, span);
+}
+
 std::vector<CellEpisodeResult> RunCellEpisode(const CellBenchmarkSetup& setup, const EpisodeSpec& spec,
                                               const std::vector<Predictor>& predictors,
                                               std::vector<std::unique_ptr<supervisor::TaskPlanner>>* planners) {
   if (const std::string why = setup.Validate(); !why.empty()) throw std::invalid_argument(why);
   if (planners->size() != predictors.size()) throw std::invalid_argument("RunCellEpisode: one task planner per predictor");
-  const PersonStream person = EpisodePerson(setup, spec);
+  const PersonStream person = EpisodePerson(setup, spec, StreamDuration(setup));
   ModelTrack track(setup.base, person);
   const TrueCovariances covariances(setup.base, &track);
+  ContinuedActions continued(setup, spec, person);
+  OracleOptions oracle;
+  oracle.action_continued = [&continued](int frame) -> const PersonStream& { return continued.At(frame); };
+  oracle.error_std = setup.oracle_error_std;
+  oracle.error_seed = Mix(spec.noise_seed ^ 0x0ac1e000ULL);
   std::vector<CellEpisodeResult> out;
   for (std::size_t p = 0; p < predictors.size(); ++p) {
-    out.push_back(RunOne(setup, spec, predictors[p], person, &track, covariances, (*planners)[p].get()));
+    out.push_back(RunOne(setup, spec, predictors[p], person, &track, covariances, oracle, (*planners)[p].get()));
   }
   return out;
 }

@@ -26,7 +26,14 @@
 //   model:  the model's action belief at the newest skeleton and how long
 //       its most likely action has lasted (supervisor::ActionTracker fed
 //       every belief);
-//   oracle: the true current action, when it ends and the true next action.
+//   oracle: the true current action, when it ends and the true next action;
+//   oracle-action: the true current action and how long it has lasted (a
+//       perfect recogniser), nothing of when it ends or what follows; its
+//       motion forecast is the current action's true motion continued (the
+//       person's script with the action lasting for ever), so it measures
+//       what a forecaster of each action's motion could give at best.
+// CellBenchmarkSetup::oracle_error_std adds an error to both oracles'
+// forecast means: how precise a forecast must be to gain what they gain.
 //
 // Units: m, rad, s; world frame W. Not thread-safe; allocates.
 #pragma once
@@ -53,6 +60,10 @@ struct CellBenchmarkSetup {
   double pause_between_tasks = 0.5;      ///< s from an outcome to the next command
   double episode_limit = 120;            ///< s from the first command; an unfinished episode counts this long
   double task_time_limit = 20;           ///< s per task (the replanner fails it after)
+  /// m per axis, >= 0: the oracles' (oracle, oracle-action) forecast means
+  /// are off by e_j (k + 1) / D at step k of D, e_j ~ N(0, oracle_error_std^2
+  /// I) drawn per frame and joint (seeded by the episode); 0: exact.
+  double oracle_error_std = 0;
   /// Empty when usable, else why not (missing models, no human graph, a
   /// human action the synthetic person cannot do, goals not of the robot's
   /// size, no rest task, ...).
@@ -108,6 +119,17 @@ struct CellEpisodeResult {
 /// Throws std::invalid_argument as supervisor::TaskPlanner.
 std::vector<std::unique_ptr<supervisor::TaskPlanner>> MakeCellPlanners(const CellBenchmarkSetup& setup,
                                                                        const std::vector<Predictor>& predictors);
+
+/// The person of `spec` as the episode's runs see them: true and observed
+/// skeletons at the sensor rate, for the episode limit and the forecast's
+/// look-ahead past it. Throws std::invalid_argument on an unusable setup.
+PersonStream EpisodePersonStream(const CellBenchmarkSetup& setup, const EpisodeSpec& spec);
+
+/// What oracle-action knows while action `span` of `spec` goes on: the same
+/// person with that action lasting for ever, so their motion up to its end
+/// is the episode's; sampled to its end plus the forecast's look-ahead.
+/// Throws std::out_of_range when `span` is not an index of spec.actions.
+PersonStream ContinuedActionStream(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, std::size_t span);
 
 /// Runs `spec` once per predictor, predictor p with (*planners)[p], which
 /// learns from it and starts its next episode afterwards. Results in the

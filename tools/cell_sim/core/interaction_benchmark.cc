@@ -182,6 +182,7 @@ const char* ToString(Predictor p) {
     case Predictor::kConstantVelocity: return "constant-velocity";
     case Predictor::kModel: return "model";
     case Predictor::kOracle: return "oracle";
+    case Predictor::kOracleAction: return "oracle-action";
   }
   return "unknown";
 }
@@ -189,7 +190,7 @@ const char* ToString(Predictor p) {
 std::vector<std::string> PredictorNames() {
   std::vector<std::string> names;
   for (Predictor p : {Predictor::kNone, Predictor::kConstantPosition, Predictor::kConstantVelocity, Predictor::kModel,
-                      Predictor::kOracle}) {
+                      Predictor::kOracle, Predictor::kOracleAction}) {
     names.push_back(ToString(p));
   }
   return names;
@@ -197,7 +198,7 @@ std::vector<std::string> PredictorNames() {
 
 std::optional<Predictor> ParsePredictor(const std::string& name) {
   for (Predictor p : {Predictor::kNone, Predictor::kConstantPosition, Predictor::kConstantVelocity, Predictor::kModel,
-                      Predictor::kOracle}) {
+                      Predictor::kOracle, Predictor::kOracleAction}) {
     if (name == ToString(p)) return p;
   }
   return std::nullopt;

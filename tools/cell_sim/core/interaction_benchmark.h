@@ -50,7 +50,12 @@
 //                      estimator (window, belief filter), as in the cell;
 //   oracle             the true future motion at the model's steps, with the
 //                      model's covariances (the within-action part, sum_c p_c
-//                      Sigma_c): the limit of what prediction can give.
+//                      Sigma_c): the limit of what prediction can give;
+//   oracle-action      (iplan eval cell only, cell_benchmark.h) as oracle, but
+//                      the person's current action's motion as if it went on
+//                      for ever: what a per-action forecaster with a perfect
+//                      recogniser could give, not knowing when an action
+//                      ends.
 // The collision-risk monitor gets the same prediction as the planner, as the
 // cell's one prediction topic would carry it (MonitorInput::kSame, the
 // default); with `none` it gets the model's: the cell's intent service still
@@ -87,9 +92,10 @@ namespace iplan::cell_sim {
 /// simulated time), its joints named `joints`.
 collision::JointMixture Stamped(collision::JointMixture m, const std::vector<std::string>& joints, int64_t t0_ns);
 
-enum class Predictor { kNone, kConstantPosition, kConstantVelocity, kModel, kOracle };
+enum class Predictor { kNone, kConstantPosition, kConstantVelocity, kModel, kOracle, kOracleAction };
 
-/// "none", "constant-position", "constant-velocity", "model", "oracle".
+/// "none", "constant-position", "constant-velocity", "model", "oracle",
+/// "oracle-action".
 const char* ToString(Predictor p);
 /// The predictor named `name` (as ToString), or nullopt.
 std::optional<Predictor> ParsePredictor(const std::string& name);

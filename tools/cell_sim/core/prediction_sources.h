@@ -6,7 +6,10 @@
 #pragma once
 
 #include <algorithm>
+#include <cstdint>
+#include <functional>
 #include <optional>
+#include <random>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -14,6 +17,7 @@
 #include <Eigen/Core>
 
 #include "tools/cell_sim/core/interaction_benchmark.h"
+#include "tools/cell_sim/core/scenario_draws.h"
 
 namespace iplan::cell_sim::internal {
 
@@ -103,12 +107,33 @@ class BaselineSource {
   int last_ = -1;
 };
 
+// What an oracle knows of the future: from frame `frame` on, the person's
+// motion is that of the stream it returns (the person's own for the oracle;
+// for oracle-action the person's current action going on for ever).
+using FutureOf = std::function<const PersonStream&(int frame)>;
+
+// How the oracles see the future (cell_benchmark.h, CellBenchmarkSetup).
+struct OracleOptions {
+  FutureOf action_continued;  ///< oracle-action's future; empty: oracle-action cannot run
+  /// m per axis at the last step: each forecast's means get an error, drawn
+  /// per frame and joint, growing linearly over the steps (0: exact).
+  double error_std = 0;
+  uint64_t error_seed = 0;
+};
+
 // The true future at the model's steps with the model's within-action
-// covariances.
+// covariances, plus the error of OracleOptions.
 class OracleSource {
  public:
-  OracleSource(const PersonStream& person, ModelTrack* model, const intent::IntentModel& config)
-      : person_(person), model_(model), dt_(1.0 / config.config.rate), steps_(config.config.horizon) {}
+  OracleSource(FutureOf future, double error_std, uint64_t error_seed, ModelTrack* model,
+               const PersonStream& person, const intent::IntentModel& config)
+      : future_(std::move(future)),
+        error_std_(error_std),
+        error_seed_(error_seed),
+        person_(person),
+        model_(model),
+        dt_(1.0 / config.config.rate),
+        steps_(config.config.horizon) {}
 
   const collision::JointMixture* At(int frame) {
     if (frame == frame_) return &current_;
@@ -124,11 +149,21 @@ class OracleSource {
     current_.probabilities = {1.0};
     current_.means.assign(1, std::vector<Eigen::Vector3d>(static_cast<std::size_t>(steps_) * J));
     current_.covariances.assign(1, std::vector<Eigen::Matrix3d>(static_cast<std::size_t>(steps_) * J));
+    // The error at the last step, per joint: the same draws for a frame
+    // whatever the order of the calls.
+    error_.assign(J, Eigen::Vector3d::Zero());
+    if (error_std_ > 0) {
+      std::mt19937_64 g(Mix(error_seed_ ^ Mix(static_cast<uint64_t>(frame))));
+      std::normal_distribution<double> n(0.0, error_std_);
+      for (auto& e : error_) e = Eigen::Vector3d(n(g), n(g), n(g));
+    }
+    const PersonStream& future = future_(frame);
     for (int k = 0; k < steps_; ++k) {
-      person_.TrueAt(person_.stamp(frame) + (k + 1) * dt_, &p_WJ_);
+      future.TrueAt(person_.stamp(frame) + (k + 1) * dt_, &p_WJ_);
+      const double grown = static_cast<double>(k + 1) / steps_;
       for (std::size_t j = 0; j < J; ++j) {
         const std::size_t o = static_cast<std::size_t>(k) * J + j;
-        current_.means[0][o] = p_WJ_.col(model_->body_index(j));
+        current_.means[0][o] = p_WJ_.col(model_->body_index(j)) + grown * error_[j];
         current_.covariances[0][o] = model_->WithinCovariance(frame, k, j);
       }
     }
@@ -136,22 +171,28 @@ class OracleSource {
   }
 
  private:
+  FutureOf future_;
+  double error_std_;
+  uint64_t error_seed_;
   const PersonStream& person_;
   ModelTrack* model_;
   double dt_;
   int steps_;
   int frame_ = -1;
   collision::JointMixture current_;
+  std::vector<Eigen::Vector3d> error_;
   Eigen::Matrix3Xd p_WJ_;
 };
 
 // What one predictor's run is fed: the planner's prediction source and the
 // monitor's (BenchmarkSetup::monitor_input; with none the monitor gets the
 // model's, as the cell's intent service still runs). Holds the sources it
-// points into: not copyable or movable.
+// points into: not copyable or movable. Throws std::invalid_argument for
+// oracle-action without OracleOptions::action_continued.
 class PredictorSources {
  public:
-  PredictorSources(const BenchmarkSetup& setup, const PersonStream& person, ModelTrack* track, Predictor p) {
+  PredictorSources(const BenchmarkSetup& setup, const PersonStream& person, ModelTrack* track, Predictor p,
+                   const OracleOptions& oracle = {}) {
     model_ = [track](int f) { return track->At(f); };
     const intent::IntentModel& model = *setup.intent_model;
     switch (p) {
@@ -171,9 +212,18 @@ class PredictorSources {
         planner_ = model_;
         break;
       case Predictor::kOracle:
-        oracle_.emplace(person, track, model);
+      case Predictor::kOracleAction: {
+        FutureOf future = [&person](int) -> const PersonStream& { return person; };
+        if (p == Predictor::kOracleAction) {
+          if (!oracle.action_continued) {
+            throw std::invalid_argument("the oracle-action predictor needs the person's actions (iplan eval cell only)");
+          }
+          future = oracle.action_continued;
+        }
+        oracle_.emplace(std::move(future), oracle.error_std, oracle.error_seed, track, person, model);
         planner_ = [this](int f) { return oracle_->At(f); };
         break;
+      }
     }
     own_ = setup.monitor_input == MonitorInput::kSame && p != Predictor::kNone;
   }

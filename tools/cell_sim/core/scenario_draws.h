@@ -1,6 +1,7 @@
-// Internal to the interaction benchmark (interaction_benchmark.cc and
-// shared_space.cc): the seeded draws every scenario is made of and the
-// helpers both suites draw with. Units: m, rad, s; world frame W.
+// Internal to the benchmarks of tools/cell_sim (interaction_benchmark.cc,
+// shared_space.cc, cell_benchmark.cc, prediction_sources.h): the seeded
+// draws every scenario is made of and the helpers both suites draw with.
+// Units: m, rad, s; world frame W.
 #pragma once
 
 #include <cstdint>

@@ -3,10 +3,13 @@
 // for a seed, its person's actions follow the task graph's human_graph and
 // cover the whole run, a setup without the person's graph is refused by
 // name, and the summary's ratios and the share of the oracle's gain are
-// computed as documented. Drawing needs no trained intent model (only
-// running does), so the setup carries an empty one.
+// computed as documented, and oracle-action's future is the episode's
+// person until the action ends and that action going on after it. Drawing
+// needs no trained intent model (only running does), so the setup carries
+// an empty one.
 #include "tools/cell_sim/core/cell_benchmark.h"
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 
@@ -82,6 +85,49 @@ TEST_F(CellBenchmarkTest, ASetupWithoutThePersonsGraphIsRefusedByName) {
   EXPECT_EQ(setup.Validate(), "the synthetic person has no action 'idle' of the human graph");
   setup = Setup();
   EXPECT_THROW(MakeCellEpisodes(setup, 0, 1), std::invalid_argument);
+}
+
+TEST_F(CellBenchmarkTest, OracleActionSeesTheEpisodeUntilTheActionEndsAndTheActionGoingOnAfter) {
+  const CellBenchmarkSetup setup = Setup();
+  const EpisodeSpec e = MakeCellEpisodes(setup, 1, 4)[0];
+  const PersonStream person = EpisodePersonStream(setup, e);
+  // An `assemble` that ends within the episode and is followed by another action.
+  std::size_t span = e.actions.size();
+  for (std::size_t i = 0; i + 1 < e.actions.size(); ++i) {
+    if (e.actions[i].action == "assemble" && e.actions[i + 1].action != "assemble" && e.actions[i].end() > 1.0 &&
+        e.actions[i].end() + 3.0 < setup.episode_limit) {
+      span = i;
+      break;
+    }
+  }
+  ASSERT_LT(span, e.actions.size()) << "seed 4's episode has no assemble followed by another action";
+  const PersonStream continued = ContinuedActionStream(setup, e, span);
+  const double end = e.actions[span].end();
+  const int last_shared = static_cast<int>(std::floor(end * person.rate_hz));
+  ASSERT_GE(continued.num_frames(), last_shared + static_cast<int>(person.rate_hz));
+  for (int f = 0; f <= last_shared; ++f) {
+    ASSERT_TRUE(continued.truth[static_cast<std::size_t>(f)].isApprox(person.truth[static_cast<std::size_t>(f)], 1e-12))
+        << "frame " << f << " (the action ends at " << end << " s)";
+  }
+  // After the end the person does something else; oracle-action's person
+  // goes on assembling, a motion of the action's period.
+  const auto it = std::find_if(setup.base.person.actions.begin(), setup.base.person.actions.end(),
+                               [](const auto& a) { return a.name == "assemble"; });
+  ASSERT_NE(it, setup.base.person.actions.end());
+  const double period = it->period;
+  Eigen::Matrix3Xd now, later, truth;
+  double largest_change = 0;
+  // (The stream reaches 1 s of forecast and 1 s beyond the action's end.)
+  ASSERT_LT(period, 1.3);
+  for (double t = end + 0.1; t < end + 0.7; t += 0.1) {
+    continued.TrueAt(t, &now);
+    continued.TrueAt(t + period, &later);
+    EXPECT_LT((now - later).norm(), 1e-6) << "t " << t;
+    person.TrueAt(t, &truth);
+    largest_change = std::max(largest_change, (truth - now).colwise().norm().maxCoeff());
+  }
+  EXPECT_GT(largest_change, 0.05) << "the next action moved no joint 5 cm from where assembling would";
+  EXPECT_THROW(ContinuedActionStream(setup, e, e.actions.size()), std::out_of_range);
 }
 
 TEST_F(CellBenchmarkTest, TheSummaryPairsEveryPredictorWithNone) {
