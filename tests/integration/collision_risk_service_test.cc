@@ -170,6 +170,10 @@ TEST(CollisionRiskService, PersonWhoStaysAwayIsOk) {
   int evaluated = 0;
   for (const auto& r : risks) {
     if (r.reason == "no robot state yet" || r.prediction_stamp.sec == 0) continue;
+    // The first prediction may come before the first skeleton (the topics'
+    // first samples arrive in any order); once a verdict has counted, the
+    // person must stay tracked.
+    if (evaluated == 0 && r.reason.rfind("no person tracked yet", 0) == 0) continue;
     ++evaluated;
     EXPECT_EQ(r.verdict, msg::CollisionRisk::OK) << r.reason;
     EXPECT_LT(r.max_bound, 0.05 * 0.5);
