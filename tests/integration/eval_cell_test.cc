@@ -32,6 +32,12 @@ class EvalCell : public ::testing::Test {
     return rc.value_or(-1);
   }
 
+  // `args` followed by `more`.
+  static std::vector<std::string> With(std::vector<std::string> args, const std::vector<std::string>& more) {
+    args.insert(args.end(), more.begin(), more.end());
+    return args;
+  }
+
   ScratchCell scratch_{"eval-cell"};
   const fs::path dir_ = scratch_.dir();
 };
@@ -41,14 +47,10 @@ TEST_F(EvalCell, OneEpisodeWritesEveryFieldAndRepeatsForASeed) {
   const std::vector<std::string> args = {"--episodes", "1", "--seed", "3", "--predictors", "none,model,oracle",
                                          "--episode-limit", "40"};
   std::string out;
-  std::vector<std::string> first = args;
-  first.insert(first.end(), {"--json", a});
-  ASSERT_EQ(Run(first, &out), 0) << out;
+  ASSERT_EQ(Run(With(args, {"--json", a}), &out), 0) << out;
   EXPECT_NE(out.find("against none"), std::string::npos) << out;
   EXPECT_NE(out.find("model recovers of the oracle's gain"), std::string::npos) << out;
-  std::vector<std::string> second = args;
-  second.insert(second.end(), {"--json", b});
-  ASSERT_EQ(Run(second, &out), 0) << out;
+  ASSERT_EQ(Run(With(args, {"--json", b}), &out), 0) << out;
   const std::string text = core::ReadFile(a);
   EXPECT_EQ(text, core::ReadFile(b)) << "the same seed gave different results";
 
@@ -106,12 +108,8 @@ TEST_F(EvalCell, OracleActionKnowsTheActionAndTheOracleErrorMovesOnlyTheOracles)
   const std::vector<std::string> args = {"--episodes", "1", "--seed", "3", "--predictors", "none,oracle,oracle-action",
                                          "--episode-limit", "40"};
   std::string out;
-  std::vector<std::string> first = args;
-  first.insert(first.end(), {"--json", exact});
-  ASSERT_EQ(Run(first, &out), 0) << out;
-  std::vector<std::string> second = args;
-  second.insert(second.end(), {"--json", off, "--oracle-error", "0.05"});
-  ASSERT_EQ(Run(second, &out), 0) << out;
+  ASSERT_EQ(Run(With(args, {"--json", exact}), &out), 0) << out;
+  ASSERT_EQ(Run(With(args, {"--json", off, "--oracle-error", "0.05"}), &out), 0) << out;
   const nlohmann::json a = nlohmann::json::parse(core::ReadFile(exact)), b = nlohmann::json::parse(core::ReadFile(off));
   EXPECT_EQ(a["oracle_error_std_m"], 0.0);
   EXPECT_EQ(b["oracle_error_std_m"], 0.05);

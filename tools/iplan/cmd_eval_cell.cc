@@ -128,9 +128,8 @@ const cell_sim::CellSummary* Find(const std::vector<cell_sim::CellSummary>& summ
   return nullptr;
 }
 
-// The oracle's gain over none that the model recovers, per figure (when
-// all three ran), for the JSON and the table.
-// What the model recovers of `oracle`'s gain over none; null without the three.
+// The gain over none of `reference` (oracle or oracle-action) that the model
+// recovers, per figure, for the JSON and the table; null unless all three ran.
 Json GainJson(const std::vector<cell_sim::CellSummary>& summary, Predictor reference) {
   const auto* none = Find(summary, Predictor::kNone);
   const auto* model = Find(summary, Predictor::kModel);
