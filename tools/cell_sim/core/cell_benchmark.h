@@ -128,7 +128,8 @@ PersonStream EpisodePersonStream(const CellBenchmarkSetup& setup, const EpisodeS
 /// What oracle-action knows while action `span` of `spec` goes on: the same
 /// person with that action lasting for ever, so their motion up to its end
 /// is the episode's; sampled to its end plus the forecast's look-ahead.
-/// Throws std::out_of_range when `span` is not an index of spec.actions.
+/// Throws std::invalid_argument on an unusable setup and std::out_of_range
+/// when `span` is not an index of spec.actions.
 PersonStream ContinuedActionStream(const CellBenchmarkSetup& setup, const EpisodeSpec& spec, std::size_t span);
 
 /// Runs `spec` once per predictor, predictor p with (*planners)[p], which
@@ -153,8 +154,9 @@ struct CellSummary {
   int tasks_done = 0;  ///< total
   int tasks_total = 0; ///< episodes x tasks of the graph
   /// What the task planner was told at its choices (predictors that give it
-  /// a belief: model, oracle): the choices, those whose most likely action
-  /// was the person's true one, and for those |believed_for - person_for|.
+  /// a belief: model, oracle, oracle-action): the choices, those whose most
+  /// likely action was the person's true one, and for those |believed_for -
+  /// person_for|.
   int choices_with_belief = 0;
   int belief_right = 0;
   Spread age_error;  ///< s; empty (0) without a right belief
