@@ -4,7 +4,7 @@ nearer the robot.
 
 The person of `perception.yaml` (section perception.synthetic) steps
 DISTANCE metres the way they face (`facing_yaw`; the shipped person faces
--x, the robot): their torso (and `more_people`'s) and every action's `target` move by
+-x, the robot): their torso and every action's `target` move by
 DISTANCE x (cos yaw, sin yaw, 0) in the world frame. Nothing else
 changes; the copy leaves out `models/`, so the commands that need the
 cell's intent model (`iplan eval cell`, `iplan demo`) train it for the
@@ -17,8 +17,8 @@ How far into the shared space the person works decides whether foresight
 can pay at all (docs/benchmarks.md, "How near the person works").
 
 Exit code 2 on bad input (a DISTANCE that is not finite, an OUT that
-exists, a perception.yaml without the synthetic person), with the reason
-on stderr.
+exists, a perception.yaml without the synthetic person, or with
+`more_people`), with the reason on stderr.
 """
 
 import argparse
@@ -34,7 +34,7 @@ _VEC = r"\[\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*,\s*([-+0-9.eE]+)\s*\]"
 
 def _fmt(v):
     """A coordinate as the file writes them (m, no trailing noise)."""
-    s = f"{v:.4f}".rstrip("0")
+    s = f"{round(v, 4) + 0.0:.4f}".rstrip("0")  # + 0.0: no "-0.0"
     return s + "0" if s.endswith(".") else s
 
 
@@ -68,6 +68,10 @@ def move_person(text, distance):
             break
     if yaw is None:
         raise ValueError("the synthetic person has no facing_yaw")
+    for line in lines[first:end]:
+        m = re.match(r"^\s*more_people:\s*(.*)$", line.partition("#")[0])
+        if m and m.group(1).strip() != "[]":
+            raise ValueError("more_people is not empty: which way each of them steps is not defined")
     dx, dy = distance * math.cos(yaw), distance * math.sin(yaw)
 
     def shift(m):

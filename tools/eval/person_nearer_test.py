@@ -75,6 +75,7 @@ class PersonNearerTest(unittest.TestCase):
         text = ("perception:\n  synthetic:\n    torso: [1.0, -0.5, 0.25]  # m\n"
                 "    facing_yaw: 1.5707963268\n    actions:\n"
                 "      a: {motion: reach, hand: right, target: [0.8, -0.2, 0.1], period: 3.0}\n"
+                "    more_people: []  # none\n"
                 "  replay:\n    torso: [9.0, 9.0, 9.0]\n")
         moved, n = pn.move_person(text, 0.25)
         self.assertEqual(n, 2)
@@ -102,6 +103,9 @@ class PersonNearerTest(unittest.TestCase):
         self.assertIn("synthetic", r.stderr)
         with self.assertRaises(ValueError):
             pn.move_person("perception:\n  synthetic:\n    torso: [1, 0, 0]\n", 0.1)  # no facing_yaw
+        with self.assertRaisesRegex(ValueError, "more_people"):
+            pn.move_person("perception:\n  synthetic:\n    torso: [1, 0, 0]\n    facing_yaw: 0\n"
+                           "    more_people: [{torso: [2, 0, 0], facing_yaw: 1.0}]\n", 0.1)
 
 
 if __name__ == "__main__":
