@@ -56,6 +56,7 @@ class SupervisorService : public framework::Service {
     permit_period_ = settings.permit_period;
     permit_validity_ = settings.permit_validity;
     resend_period_ = settings.command_resend_period;
+    tracker_ = ActionTracker(settings.tracker);
     try {
       TaskGraph graph = LoadTaskGraph(config.ResolvePath(graph_file));
       for (const std::string& note : ResolveGoals(config, settings, &graph)) node.log().info("{}", note);
@@ -200,9 +201,7 @@ class SupervisorService : public framework::Service {
     }
     // The anticipating choice (docs/supervisor.md): the belief and how long
     // its action has lasted, as of the newest belief.
-    ActionOutlook outlook;
-    outlook.belief = belief_;
-    outlook.elapsed = tracker_.Elapsed(belief_at_);
+    const ActionOutlook outlook = tracker_.Outlook(belief_, belief_at_);
     current_task_ = planner_->Choose(outlook);
     if (current_task_ < 0) return;
     const RobotTask& t = planner_->graph().tasks[static_cast<std::size_t>(current_task_)];
@@ -218,10 +217,11 @@ class SupervisorService : public framework::Service {
     command_writer_->Write(c);
     last_command_at_ = std::chrono::steady_clock::now();
     node.log().info("task {} '{}' (episode {}, state {:#x}, epsilon {:.3f}; expected conflict {:.2f} s of {:.2f} s, "
-                    "person: {} for {:.1f} s)",
+                    "person: {} for {}{:.1f} s)",
                     task_id_, t.name, episodes_ + 1, planner_->state(), planner_->Epsilon(),
                     planner_->ExpectedConflict(current_task_, outlook), planner_->TaskDuration(current_task_),
-                    tracker_.action().empty() ? "unknown" : tracker_.action(), outlook.elapsed);
+                    tracker_.action().empty() ? "unknown" : tracker_.action(), outlook.elapsed_at_least ? "at least " : "",
+                    outlook.elapsed);
   }
 
   void ResendCommand() {

@@ -51,6 +51,7 @@ CellBenchmarkSetup CellConfig::MakeCellSetup() const {
   s.base = MakeSetup();
   s.graph = graph;
   s.learning = learning;
+  s.tracker = tracker;
   s.pause_between_tasks = pause_between_tasks;
   return s;
 }
@@ -101,6 +102,7 @@ CellConfig LoadCellConfig(const std::string& dir, int planner_threads, const std
   for (const auto& t : graph.tasks) c.tasks.push_back({t.name, ToEigen(t.goal), ToEigen(t.retreat)});
   c.graph = std::move(graph);
   c.learning = settings.learning;
+  c.tracker = settings.tracker;
   c.pause_between_tasks = settings.pause_between_tasks;
 
   // The sensor and the synthetic person.

@@ -36,6 +36,7 @@ struct CellConfig {
   /// robot (joint goals), with the person's human_graph.
   supervisor::TaskGraph graph;
   supervisor::QLearningParams learning;  ///< supervisor.yaml's Q-learning and anticipation parameters
+  supervisor::ActionTrackerParams tracker;  ///< supervisor.yaml's: how the model's belief dates its action
   double pause_between_tasks = 0.5;      ///< s, supervisor.yaml
   /// Places of the task graph whose joint positions were not used as
   /// written (supervisor::ResolveTaskGoals), for the tool to print.

@@ -46,6 +46,24 @@ double Survival(const HumanActionStep& s, double tau) {
   return (b - tau) / (b - a);
 }
 
+// Adds `p` of an action's mass to its age bins (bin b: age b dt): at the
+// age `elapsed`, or, met part way through and at least that old, spread
+// over the ages from there in proportion to the survival (the age of an
+// action found in progress has that density; one already past its most
+// ends at once).
+void AddAged(const HumanActionStep& s, const ActionOutlook& outlook, double dt, double p, std::vector<double>* bins) {
+  const std::size_t age = std::min(bins->size() - 1, static_cast<std::size_t>(std::max(0.0, outlook.elapsed) / dt));
+  double total = 0;
+  if (outlook.elapsed_at_least) {
+    for (std::size_t b = age; b < bins->size(); ++b) total += Survival(s, b * dt);
+  }
+  if (!(total > 0)) {
+    (*bins)[age] += p;
+    return;
+  }
+  for (std::size_t b = age; b < bins->size(); ++b) (*bins)[b] += p * Survival(s, b * dt) / total;
+}
+
 }  // namespace
 
 int HumanGraph::Find(const std::string& action) const {
@@ -132,9 +150,7 @@ ActionForecast ForecastActions(const HumanGraph& graph, const ActionOutlook& out
     } else if (outlook.remaining >= 0) {
       pinned[static_cast<std::size_t>(i)] += p;
     } else {
-      auto& bins = mass[static_cast<std::size_t>(i)];
-      const double age = std::max(0.0, outlook.elapsed) / dt;
-      bins[std::min(bins.size() - 1, static_cast<std::size_t>(age))] += p;
+      AddAged(graph.actions[static_cast<std::size_t>(i)].second, outlook, dt, p, &mass[static_cast<std::size_t>(i)]);
     }
   }
   // Where the mass of action i goes when it ends (the oracle's next for the
@@ -184,19 +200,60 @@ ActionForecast ForecastActions(const HumanGraph& graph, const ActionOutlook& out
   return f;
 }
 
+std::string ActionTrackerParams::Validate() const {
+  if (!(action_switch_confirm >= 0 && action_switch_confirm <= 10)) return "action_switch_confirm must be in [0, 10] s";
+  if (!(action_recognition_delay >= 0 && action_recognition_delay <= 10))
+    return "action_recognition_delay must be in [0, 10] s";
+  return "";
+}
+
+ActionTracker::ActionTracker(const ActionTrackerParams& params) : params_(params) {
+  if (const std::string why = params.Validate(); !why.empty()) throw std::invalid_argument("ActionTracker: " + why);
+}
+
 void ActionTracker::Update(double stamp, const std::map<std::string, double>& belief) {
   if (belief.empty()) {
     action_.clear();
+    candidate_.clear();
+    start_seen_ = false;
     return;
   }
   const auto best = std::max_element(belief.begin(), belief.end(),
                                      [](const auto& a, const auto& b) { return a.second < b.second; });
-  if (best->first != action_) {
+  if (action_.empty()) {  // the first belief: its action began before it
     action_ = best->first;
     since_ = stamp;
+    start_seen_ = false;
+    candidate_.clear();
+    return;
+  }
+  if (best->first == action_) {
+    candidate_.clear();
+    return;
+  }
+  if (best->first != candidate_) {
+    candidate_ = best->first;
+    candidate_since_ = stamp;
+  }
+  if (stamp - candidate_since_ >= params_.action_switch_confirm) {
+    action_ = candidate_;
+    since_ = candidate_since_;
+    start_seen_ = true;
+    candidate_.clear();
   }
 }
 
-double ActionTracker::Elapsed(double now) const { return action_.empty() ? 0.0 : std::max(0.0, now - since_); }
+double ActionTracker::Elapsed(double now) const {
+  if (action_.empty()) return 0.0;
+  return std::max(0.0, now - since_) + (start_seen_ ? params_.action_recognition_delay : 0.0);
+}
+
+ActionOutlook ActionTracker::Outlook(const std::map<std::string, double>& belief, double now) const {
+  ActionOutlook o;
+  o.belief = belief;
+  o.elapsed = Elapsed(now);
+  o.elapsed_at_least = !action_.empty() && !start_seen_;
+  return o;
+}
 
 }  // namespace iplan::supervisor

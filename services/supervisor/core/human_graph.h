@@ -89,6 +89,11 @@ struct ActionOutlook {
   /// newest belief); empty: nothing is known (no forecast).
   std::map<std::string, double> belief;
   double elapsed = 0;  ///< s the current action has lasted (an estimate, e.g. ActionTracker)
+  /// True when the action began before anything was seen of the person (the
+  /// first belief already showed it): it has lasted at least `elapsed`, and
+  /// the forecast takes its age as that of an action met part way through,
+  /// from `elapsed` on (ActionTracker::StartSeen false).
+  bool elapsed_at_least = false;
   /// Only an oracle knows these: the current action ends in `remaining` s
   /// (< 0: unknown) and `next` follows it ("": unknown, the graph's
   /// successors).
@@ -116,23 +121,61 @@ struct ActionForecast {
 /// when dt <= 0 or steps < 0. Allocates.
 ActionForecast ForecastActions(const HumanGraph& graph, const ActionOutlook& outlook, double dt, int steps);
 
+/// How the action tracker reads the belief stream (section supervisor of
+/// supervisor.yaml; our extension, docs/supervisor.md "How long the action
+/// has lasted"). Times in s.
+struct ActionTrackerParams {
+  /// A new most likely action is taken as a change of action only once it
+  /// has stayed the most likely this long; a shorter flip (a reach's hand
+  /// passing its rest between two reaches) does not restart the age. The
+  /// change is then dated when the flip began. 0: every flip is a change.
+  double action_switch_confirm = 0.0;
+  /// How long after an action starts the belief makes it the most likely:
+  /// added to the age of an action whose start was seen. 0: none.
+  double action_recognition_delay = 0.0;
+
+  template <class Archive>
+  void Serialize(Archive* a) {
+    a->Visit(IPLAN_NVP(action_switch_confirm,
+                       "s a new most likely action must stay so before the person's action counts as changed, in [0, 10]"));
+    a->Visit(IPLAN_NVP(action_recognition_delay,
+                       "s the belief recognises an action after it starts, added to its age, in [0, 10]"));
+  }
+  /// "" when valid, else the reason naming the key.
+  std::string Validate() const;
+};
+
 /// How long the person has been doing what the belief says: fed every
-/// belief with its stamp, it keeps the most likely action and when it
-/// became the most likely one. Not thread-safe.
+/// belief with its stamp, it keeps the person's action (the most likely one,
+/// changed only after ActionTrackerParams::action_switch_confirm) and when
+/// it began. Not thread-safe.
 class ActionTracker {
  public:
+  /// Throws std::invalid_argument when params.Validate() fails.
+  explicit ActionTracker(const ActionTrackerParams& params = {});
   /// A belief (action: probability) at `stamp` (s, non-decreasing). An
-  /// empty belief forgets the action.
+  /// empty belief forgets the action (the next one starts unseen again).
   void Update(double stamp, const std::map<std::string, double>& belief);
-  /// The most likely action of the newest belief ("" before any).
+  /// The person's action as tracked ("" before any belief).
   const std::string& action() const { return action_; }
-  /// s the most likely action has been the most likely one at `now` (s;
-  /// 0 before any belief, never negative).
+  /// s the action has lasted at `now` (s): since it became the most likely
+  /// one, plus action_recognition_delay when its start was seen; 0 before
+  /// any belief, never negative.
   double Elapsed(double now) const;
+  /// False while the action is the one the first belief showed: it began
+  /// before anything was seen, and Elapsed is a lower bound.
+  bool StartSeen() const { return start_seen_; }
+  /// The outlook the task choice takes: `belief` (the newest), Elapsed(now)
+  /// and whether that is a lower bound.
+  ActionOutlook Outlook(const std::map<std::string, double>& belief, double now) const;
 
  private:
+  ActionTrackerParams params_;
   std::string action_;
   double since_ = 0;
+  bool start_seen_ = false;
+  std::string candidate_;  // a new most likely action, not yet confirmed
+  double candidate_since_ = 0;
 };
 
 }  // namespace iplan::supervisor

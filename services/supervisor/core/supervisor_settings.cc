@@ -14,6 +14,7 @@ std::string InRange(const char* key, double v, double lo, double hi) {
 std::string SupervisorSettings::Validate() const {
   if (mode != "learning" && mode != "deployment") return "mode must be learning or deployment, got '" + mode + "'";
   if (std::string why = learning.Validate(); !why.empty()) return why;
+  if (std::string why = tracker.Validate(); !why.empty()) return why;
   if (watch.empty() && mode == "deployment") {
     return "watch must name at least one topic in deployment (an empty list switches the deadline monitor off)";
   }

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "services/supervisor/core/human_graph.h"
 #include "services/supervisor/core/task_planner.h"
 #include "iplan/core/name_value.h"
 
@@ -18,6 +19,7 @@ struct SupervisorSettings {
   std::string q_table = "state/q_table.bin";
   std::string mode = "learning";
   QLearningParams learning;  ///< its keys sit in the section itself
+  ActionTrackerParams tracker;  ///< so do these
   std::vector<std::string> watch = {"human_skeleton", "human_prediction", "joint_states", "robot_trajectory",
                                     "collision_risk"};
   double pause_between_tasks = 0.5;
@@ -35,6 +37,7 @@ struct SupervisorSettings {
     a->Visit(IPLAN_NVP(q_table, "Q-table file, relative to the configuration file; empty = not kept"));
     a->Visit(IPLAN_NVP(mode, "learning or deployment (greedy, no updates)"));
     learning.Serialize(a);
+    tracker.Serialize(a);
     a->Visit(IPLAN_NVP(watch, "topics of the deadline / liveliness monitor; not empty in deployment"));
     a->Visit(IPLAN_NVP(pause_between_tasks, "s; >= 0"));
     a->Visit(IPLAN_NVP(resume_delay, "s; causes of a stop stay clear this long before resuming, in [0, 10]"));
@@ -44,7 +47,8 @@ struct SupervisorSettings {
     a->Visit(IPLAN_NVP(command_resend_period, "s; an unanswered task command is resent, in [0.1, 60]"));
   }
   /// "" when valid, else the reason naming the key (all ranges, including
-  /// QLearningParams::Validate()'s).
+  /// QLearningParams::Validate()'s and
+  /// ActionTrackerParams::Validate()'s).
   std::string Validate() const;
 };
 

@@ -171,6 +171,93 @@ TEST(HumanGraph, TheForecastIsTheSemiMarkovChains) {
   EXPECT_DOUBLE_EQ(mixed.p.back().back(), 0.3);
 }
 
+TEST(HumanGraph, AnActionMetPartWayThroughIsAgedByItsSurvival) {
+  // assemble lasts 1-3 s (uniform). Found in progress, at least `elapsed`
+  // old, its age has density proportional to the survival S from `elapsed`
+  // on, so P(still assembling t later) = int S(a + t) / int S(a) over a >=
+  // elapsed; with the age known exactly it is S(elapsed + t) / S(elapsed).
+  const HumanGraph g = Person();
+  const double dt = 0.05;
+  auto still = [&](double elapsed, bool at_least, double t) {
+    ActionOutlook o;
+    o.belief = {{"assemble", 1.0}};
+    o.elapsed = elapsed;
+    o.elapsed_at_least = at_least;
+    const ActionForecast f = ForecastActions(g, o, dt, 80);
+    for (const auto& p : f.p) EXPECT_NEAR(p[0] + p[1], 1.0, 1e-9);
+    return f.p[static_cast<std::size_t>(std::lround(t / dt))][1];
+  };
+  EXPECT_NEAR(still(0.0, false, 1.5), 0.75, 0.03);  // S(1.5)
+  EXPECT_NEAR(still(0.0, true, 1.5), 0.28, 0.03);   // (1.5^2 / 4) / 2
+  EXPECT_NEAR(still(0.0, true, 0.5), 0.75, 0.03);   // (0.5 + 1) / 2
+  EXPECT_NEAR(still(2.0, false, 0.5), 0.5, 0.03);   // S(2.5) / S(2)
+  EXPECT_NEAR(still(2.0, true, 0.5), 0.25, 0.03);   // (0.5^2 / 4) / (1 / 4)
+  // Past its most it ends at once either way.
+  EXPECT_EQ(still(3.5, true, 0.1), 0.0);
+  EXPECT_EQ(still(3.5, false, 0.1), 0.0);
+}
+
+TEST(ActionTracker, AShortFlipKeepsTheAgeAndAChangeIsDatedWhenItBegan) {
+  ActionTrackerParams params;
+  params.action_switch_confirm = 0.5;
+  params.action_recognition_delay = 0.7;
+  ActionTracker tracker(params);
+  const std::map<std::string, double> a = {{"reach", 0.8}, {"idle", 0.2}}, b = {{"reach", 0.3}, {"idle", 0.7}};
+  EXPECT_EQ(tracker.action(), "");
+  EXPECT_EQ(tracker.Elapsed(1.0), 0.0);
+  EXPECT_FALSE(tracker.Outlook({}, 1.0).elapsed_at_least);
+  // The first belief: begun before it, so at least this old, no delay added.
+  tracker.Update(10.0, a);
+  tracker.Update(11.0, a);
+  EXPECT_EQ(tracker.action(), "reach");
+  EXPECT_FALSE(tracker.StartSeen());
+  EXPECT_DOUBLE_EQ(tracker.Elapsed(11.0), 1.0);
+  ActionOutlook o = tracker.Outlook(a, 11.0);
+  EXPECT_TRUE(o.elapsed_at_least);
+  EXPECT_DOUBLE_EQ(o.elapsed, 1.0);
+  EXPECT_EQ(o.belief, a);
+  // A flip shorter than the confirmation: still reaching, the age goes on.
+  for (double t : {12.0, 12.1, 12.2, 12.4}) tracker.Update(t, b);
+  tracker.Update(12.5, a);
+  EXPECT_EQ(tracker.action(), "reach");
+  EXPECT_DOUBLE_EQ(tracker.Elapsed(12.5), 2.5);
+  // A lasting one: idle from when it began (13.0), plus the recognition delay.
+  for (double t : {13.0, 13.2, 13.4}) tracker.Update(t, b);
+  EXPECT_EQ(tracker.action(), "reach");
+  tracker.Update(13.5, b);
+  EXPECT_EQ(tracker.action(), "idle");
+  EXPECT_TRUE(tracker.StartSeen());
+  EXPECT_DOUBLE_EQ(tracker.Elapsed(14.0), 1.0 + 0.7);
+  EXPECT_FALSE(tracker.Outlook(b, 14.0).elapsed_at_least);
+  // An empty belief forgets: the next action starts unseen again.
+  tracker.Update(15.0, {});
+  EXPECT_EQ(tracker.action(), "");
+  tracker.Update(16.0, a);
+  EXPECT_FALSE(tracker.StartSeen());
+  EXPECT_DOUBLE_EQ(tracker.Elapsed(16.5), 0.5);
+}
+
+TEST(ActionTracker, WithTheDefaultsEveryFlipIsAChange) {
+  ActionTracker tracker;
+  tracker.Update(0.0, {{"reach", 1.0}});
+  tracker.Update(1.0, {{"idle", 1.0}});
+  EXPECT_EQ(tracker.action(), "idle");
+  EXPECT_TRUE(tracker.StartSeen());
+  EXPECT_DOUBLE_EQ(tracker.Elapsed(1.5), 0.5);
+}
+
+TEST(ActionTracker, BadParametersAreRefusedWithTheKey) {
+  ActionTrackerParams p;
+  EXPECT_EQ(p.Validate(), "");
+  p.action_switch_confirm = -0.1;
+  EXPECT_NE(p.Validate().find("action_switch_confirm"), std::string::npos);
+  EXPECT_THROW(ActionTracker{p}, std::invalid_argument);
+  p = {};
+  p.action_recognition_delay = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_NE(p.Validate().find("action_recognition_delay"), std::string::npos);
+  EXPECT_THROW(ActionTracker{p}, std::invalid_argument);
+}
+
 TEST(TaskPlanner, TheAnticipatingChoiceAvoidsTheActionPredictedNext) {
   // The person assembles, 1 s into an action of 1-3 s, and then reaches into
   // the bin (always). pick_left (the bin) does not conflict with assembling,

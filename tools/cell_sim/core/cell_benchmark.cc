@@ -80,8 +80,9 @@ class ContinuedActions {
 // cell_benchmark.h): at a time t, with the newest skeleton frame.
 class PersonOutlook {
  public:
-  PersonOutlook(Predictor p, const EpisodeSpec& spec, const PersonStream& person, ModelTrack* track)
-      : predictor_(p), spec_(spec), person_(person), track_(track) {}
+  PersonOutlook(Predictor p, const EpisodeSpec& spec, const PersonStream& person, ModelTrack* track,
+                const supervisor::ActionTrackerParams& tracker)
+      : predictor_(p), spec_(spec), person_(person), track_(track), tracker_(tracker) {}
 
   supervisor::ActionOutlook At(double t, int frame) {
     supervisor::ActionOutlook o;
@@ -103,8 +104,7 @@ class PersonOutlook {
         for (std::size_t a = 0; a < m->actions.size(); ++a) belief_[m->actions[a]] = m->probabilities[a];
         tracker_.Update(person_.stamp(fed_ + 1), belief_);
       }
-      o.belief = belief_;
-      o.elapsed = frame >= 0 ? tracker_.Elapsed(person_.stamp(frame)) : 0.0;
+      if (frame >= 0) o = tracker_.Outlook(belief_, person_.stamp(frame));
     }
     return o;
   }
@@ -126,7 +126,7 @@ CellEpisodeResult RunOne(const CellBenchmarkSetup& setup, const EpisodeSpec& spe
                          const OracleOptions& oracle, supervisor::TaskPlanner* planner) {
   const supervisor::TaskGraph& graph = planner->graph();
   const PredictorSources sources(setup.base, person, track, p, oracle);
-  PersonOutlook outlook(p, spec, person, track);
+  PersonOutlook outlook(p, spec, person, track, setup.tracker);
   CellEpisodeResult out;
   out.episode = spec.index;
   out.predictor = p;

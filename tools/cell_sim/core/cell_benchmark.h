@@ -57,6 +57,7 @@ struct CellBenchmarkSetup {
   /// human_graph (not empty).
   supervisor::TaskGraph graph;
   supervisor::QLearningParams learning;  ///< the task planners' (learning mode is forced)
+  supervisor::ActionTrackerParams tracker;  ///< how model's belief dates its action (supervisor.yaml's)
   double pause_between_tasks = 0.5;      ///< s from an outcome to the next command
   double episode_limit = 120;            ///< s from the first command; an unfinished episode counts this long
   double task_time_limit = 20;           ///< s per task (the replanner fails it after)
