@@ -4,6 +4,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "iplan/core/config.h"
 #include "iplan/core/params.h"
 
 namespace iplan::supervisor {
@@ -201,9 +202,10 @@ ActionForecast ForecastActions(const HumanGraph& graph, const ActionOutlook& out
 }
 
 std::string ActionTrackerParams::Validate() const {
-  if (!(action_switch_confirm >= 0 && action_switch_confirm <= 10)) return "action_switch_confirm must be in [0, 10] s";
-  if (!(action_recognition_delay >= 0 && action_recognition_delay <= 10))
-    return "action_recognition_delay must be in [0, 10] s";
+  const core::Check<double> seconds = core::InRange(0.0, 10.0);
+  if (const std::string why = seconds(action_switch_confirm); !why.empty()) return "action_switch_confirm " + why + " s";
+  if (const std::string why = seconds(action_recognition_delay); !why.empty())
+    return "action_recognition_delay " + why + " s";
   return "";
 }
 
