@@ -362,8 +362,9 @@ class DemoRun {
     const auto [done, waiting_total] = Tally(mon);
     std::cout << "\nSummary (" << Fixed(elapsed_, 0) << " s)\n"
               << "  episodes completed            " << done.size() << " / " << o_.episodes << "\n"
-              << "  tasks completed               " << mon.succeeded_tasks_ << " (failed or cancelled: " << mon.failed_tasks_
-              << ")\n";
+              << "  tasks completed               " << mon.tally().succeeded_tasks()
+              << " (failed or cancelled: " << mon.tally().failed_tasks() << "; outcomes repeated, counted once: "
+              << mon.tally().repeated_outcomes() << ")\n";
     if (!done.empty()) {
       std::vector<double> times;
       for (const auto* e : done) times.push_back(e->completion());
@@ -469,8 +470,9 @@ class DemoRun {
     j["duration_s"] = elapsed_;
     j["episodes_requested"] = o_.episodes;
     j["episodes_completed"] = done.size();
-    j["tasks_completed"] = mon.succeeded_tasks_;
-    j["tasks_failed_or_cancelled"] = mon.failed_tasks_;
+    j["tasks_completed"] = mon.tally().succeeded_tasks();
+    j["tasks_failed_or_cancelled"] = mon.tally().failed_tasks();
+    j["task_outcomes_repeated"] = mon.tally().repeated_outcomes();
     j["robot_waiting_time_s"] = waiting_total;
     j["min_separation_m"] = min_true_sep;
     j["min_observed_separation_m"] = mon.min_observed_separation_ < 1e9 ? mon.min_observed_separation_ : -1.0;

@@ -18,6 +18,7 @@
 #include <utility>
 #include <vector>
 
+#include "episode_tally.h"
 #include "fixed_text.h"
 #include "iplan/adapters/adapters.h"
 #include "iplan/framework/node.h"
@@ -26,21 +27,10 @@
 
 namespace iplan::cli {
 
-// One episode of the task graph, as the demo saw it.
-struct Episode {
-  int number = 0;
-  double start = -1, end = -1;  // s since the demo started
-  int succeeded = 0, failed = 0;
-  double waiting = 0;            // s, sum of the tasks' delays
-  std::vector<std::string> order;
-  bool done = false;
-  double completion() const { return end - start; }
-};
-
 class CellMonitor {
  public:
   using Clock = std::chrono::steady_clock;
-  CellMonitor(framework::Node& node, int num_tasks, Clock::time_point t0) : num_tasks_(num_tasks), t0_(t0) {
+  CellMonitor(framework::Node& node, int num_tasks, Clock::time_point t0) : tally_(num_tasks), t0_(t0) {
     using SI = const dds::SampleInfo&;
     namespace topics = framework::topics;
     const framework::SubscribeOptions any_order{false};
@@ -130,15 +120,12 @@ class CellMonitor {
   bool auditing_stops() const { return judge_ != nullptr; }
   /// s since the demo started of the first task command (the stops before
   /// it are the cell's safe start); infinity before it.
-  double first_task_s() const {
-    return episodes_.empty() ? std::numeric_limits<double>::infinity() : episodes_.begin()->second.start;
-  }
+  double first_task_s() const { return tally_.first_task_s(); }
 
   double Now() const { return std::chrono::duration<double>(Clock::now() - t0_).count(); }
-  const std::map<int, Episode>& episodes() const { return episodes_; }
-  int completed_episodes() const {
-    return static_cast<int>(std::count_if(episodes_.begin(), episodes_.end(), [](const auto& e) { return e.second.done; }));
-  }
+  const EpisodeTally& tally() const { return tally_; }
+  const std::map<int, Episode>& episodes() const { return tally_.episodes(); }
+  int completed_episodes() const { return tally_.completed_episodes(); }
   std::string Diag(const std::string& service, const std::string& key, const std::string& otherwise = "") const {
     auto s = diag_.find(service);
     if (s == diag_.end()) return otherwise;
@@ -157,12 +144,12 @@ class CellMonitor {
   // The progress line.
   std::string Progress(int total_episodes) const {
     std::ostringstream s;
-    const int e = current_episode_;
+    const int e = tally_.current_episode();
     s << "  [" << std::setw(4) << Fixed(Now(), 0) << " s] ";
     if (e == 0) {
       s << "waiting for the cell (supervisor: " << Diag("supervisor", "safety", "starting") << ")";
     } else {
-      s << "episode " << e << "/" << total_episodes << ": " << (current_task_.empty() ? "-" : current_task_)
+      s << "episode " << e << "/" << total_episodes << ": " << (tally_.current_task().empty() ? "-" : tally_.current_task())
         << (waiting_ ? " (waiting)" : "");
     }
     s << " | person: " << Diag("perception", "action", "?") << " | separation "
@@ -179,58 +166,26 @@ class CellMonitor {
   std::vector<double> intent_ms_, queue_ms_, planning_ms_;
   double max_bound_ = 0, max_plan_bound_ = 0;
   double separation_ = 1e18, min_observed_separation_ = 1e18;
-  uint64_t stops_ = 0, failed_tasks_ = 0, succeeded_tasks_ = 0, slow_downs_ = 0;
+  uint64_t stops_ = 0, slow_downs_ = 0;
   bool slowed_ = false;  // the last verdict slowed the robot
   double stop_since_ = 0, stop_time_s_ = 0;  // s since the demo started; s stopped (ended stops)
   std::vector<std::string> stop_reasons_;
 
  private:
   void OnCommand(const msg::TaskCommand& m) {
-    if (m.command != msg::TaskCommand::START || m.episode == 0) return;
-    const int e = static_cast<int>(m.episode);
-    if (task_episode_.count(m.task_id)) return;  // a re-sent command
-    task_episode_[m.task_id] = e;
-    Episode& ep = episodes_[e];
-    if (ep.start < 0) {
-      ep.number = e;
-      ep.start = Now();
-    }
-    current_episode_ = e;
-    current_task_ = m.task_name;
+    if (m.command != msg::TaskCommand::START) return;
+    tally_.Started(m.task_id, static_cast<int>(m.episode), m.task_name, Now());
   }
   void OnOutcome(const msg::TaskOutcome& m) {
-    auto it = task_episode_.find(m.task_id);
-    if (it == task_episode_.end()) return;
-    Episode& ep = episodes_[it->second];
-    ep.waiting += m.delay;
-    if (m.status == msg::TaskOutcome::SUCCEEDED) {
-      ++ep.succeeded;
-      ++succeeded_tasks_;
-      ep.order.push_back(m.task_name);
-    } else {
-      ++ep.failed;
-      ++failed_tasks_;
-      events_.push_back("task '" + m.task_name + "' " + (m.status == msg::TaskOutcome::FAILED ? "failed" : "cancelled") +
-                        (m.reason.empty() ? "" : ": " + m.reason));
-    }
-    current_task_.clear();
-    if (!ep.done && ep.succeeded == num_tasks_) {
-      ep.done = true;
-      ep.end = Now();
-      std::ostringstream s;
-      s << "episode " << ep.number << " done in " << Fixed(ep.completion(), 1) << " s, robot waiting "
-        << Fixed(ep.waiting, 1) << " s:";
-      for (const auto& t : ep.order) s << " " << t;
-      events_.push_back(s.str());
-    }
+    const EpisodeTally::Ending ending = m.status == msg::TaskOutcome::SUCCEEDED ? EpisodeTally::Ending::kSucceeded
+                                        : m.status == msg::TaskOutcome::FAILED  ? EpisodeTally::Ending::kFailed
+                                                                                : EpisodeTally::Ending::kCancelled;
+    for (std::string& e : tally_.Ended(m.task_id, ending, m.task_name, m.delay, m.reason, Now()))
+      events_.push_back(std::move(e));
   }
 
-  int num_tasks_;
+  EpisodeTally tally_;
   Clock::time_point t0_;
-  std::map<uint32_t, int> task_episode_;
-  std::map<int, Episode> episodes_;
-  int current_episode_ = 0;
-  std::string current_task_;
   bool waiting_ = false, stopped_ = false;
   std::map<std::string, bool> permit_stops_;  // per monitor: its last permit is a STOP
   std::map<std::string, std::map<std::string, std::string>> diag_;
