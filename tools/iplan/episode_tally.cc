@@ -3,13 +3,14 @@
 #include <algorithm>
 #include <limits>
 #include <sstream>
+#include <utility>
 
 #include "fixed_text.h"
 
 namespace iplan::cli {
 
 void EpisodeTally::Started(uint32_t task_id, int episode, const std::string& name, double t) {
-  if (episode < 1 || !task_episode_.emplace(task_id, episode).second) return;  // a re-sent command
+  if (episode < 1 || !tasks_.emplace(task_id, Task{episode, false}).second) return;  // a re-sent command
   Episode& ep = episodes_[episode];
   if (ep.start < 0) {
     ep.number = episode;
@@ -22,13 +23,13 @@ void EpisodeTally::Started(uint32_t task_id, int episode, const std::string& nam
 std::vector<std::string> EpisodeTally::Ended(uint32_t task_id, Ending ending, const std::string& name,
                                              double delay_s, const std::string& reason, double t) {
   std::vector<std::string> events;
-  const auto it = task_episode_.find(task_id);
-  if (it == task_episode_.end()) return events;
-  if (!ended_.insert(task_id).second) {
+  const auto it = tasks_.find(task_id);
+  if (it == tasks_.end()) return events;
+  if (std::exchange(it->second.ended, true)) {
     ++repeated_outcomes_;
     return events;
   }
-  Episode& ep = episodes_[it->second];
+  Episode& ep = episodes_[it->second.episode];
   ep.waiting += delay_s;
   if (ending == Ending::kSucceeded) {
     ++ep.succeeded;

@@ -16,7 +16,6 @@
 
 #include <cstdint>
 #include <map>
-#include <set>
 #include <string>
 #include <vector>
 
@@ -66,9 +65,12 @@ class EpisodeTally {
   int repeated_outcomes() const { return repeated_outcomes_; }
 
  private:
+  struct Task {
+    int episode = 0;
+    bool ended = false;  // its outcome is counted
+  };
   int num_tasks_;
-  std::map<uint32_t, int> task_episode_;  // task id -> episode
-  std::set<uint32_t> ended_;              // task ids whose outcome is counted
+  std::map<uint32_t, Task> tasks_;  // by task id
   std::map<int, Episode> episodes_;
   int current_episode_ = 0;
   std::string current_task_;
